@@ -1,0 +1,14 @@
+"""CLI commands, one module each; :func:`register_all` adds the ones beyond ``specimen``."""
+
+
+def register_all(subparsers, common):
+    """Add later commands (ucs, creep, analyze, demo) to the CLI as they exist."""
+    import importlib
+    for name in ("ucs", "creep", "analyze", "demo"):
+        try:
+            module = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"{__name__}.{name}":
+                continue
+            raise
+        module.register(subparsers, common)

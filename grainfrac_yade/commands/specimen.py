@@ -1,0 +1,65 @@
+"""``specimen`` command: tessellate, allocate minerals, lay out bonds; write JSON and PNG."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..layout import build_layout
+from ..plotting import specimen_figure
+from ..runio import prepare_run_dir, write_json
+from ..specimen import build_specimen
+
+
+def specimen_record(specimen, layout) -> dict:
+    """``specimen.json`` content: specimen summary plus bond counts of the layout."""
+    is_inter = specimen.face_is_inter[layout.bond_face]
+    face_sum = np.bincount(layout.bond_face, weights=layout.bond_area, minlength=specimen.tessellation.n_faces)
+    summary = specimen.summary()
+    summary.update({
+        "spheres_per_cell_parameter": None,
+        "n_spheres": layout.n_spheres,
+        "mean_spheres_per_cell": layout.n_spheres / specimen.n_cells,
+        "n_bonds": layout.n_bonds,
+        "n_bonds_inter": int(is_inter.sum()),
+        "n_bonds_intra": int((~is_inter).sum()),
+        "max_face_area_mismatch_rel": float(np.max(np.abs(face_sum / specimen.face_area - 1.0))),
+    })
+    return summary
+
+
+def bond_segments(specimen, layout) -> tuple:
+    """(b, 2, 2) segments joining the two cell centroids of each bond, and is_inter."""
+    t = specimen.tessellation
+    cells = t.face_cells[layout.bond_face]
+    seg = np.stack([t.cell_centroid[cells[:, 0], :2], t.cell_centroid[cells[:, 1], :2]], axis=1)
+    return seg, specimen.face_is_inter[layout.bond_face]
+
+
+def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bool = False) -> dict:
+    out = prepare_run_dir(out, "specimen", params, seed, overwrite=overwrite)
+    specimen = build_specimen(params, seed)
+    layout = build_layout(specimen, params.resolution.spheres_per_cell)
+    record = specimen_record(specimen, layout)
+    record["spheres_per_cell_parameter"] = params.resolution.spheres_per_cell
+    write_json(Path(out) / "specimen.json", record)
+    specimen_figure(specimen, Path(out) / "specimen.png",
+                    bonds=bond_segments(specimen, layout) if draw_bonds else None)
+    record["out"] = str(out)
+    return record
+
+
+def run_specimen_in_yade():
+    """Entry of ``yade_scripts/specimen.py``: parameters from the batch table; counts read from YADE."""
+    from ..params import load_parameters
+    from ..yade_adapter.batch import read_table, run_folder_name
+    from ..yade_adapter.scene import build_scene
+    overrides, controls = read_table()
+    params = load_parameters(overrides=overrides)
+    out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
+    record = run_specimen(params, int(controls["seed"]), out, overwrite=False)
+    scene = build_scene(build_specimen(params, int(controls["seed"])), params)
+    record["n_bonds_yade"] = scene.O.interactions.countReal()
+    record["engines"] = scene.engine_names()
+    write_json(Path(out) / "specimen.json", {k: v for k, v in record.items() if k != "out"})
+    print(f"specimen: {record['n_cells']} cells, {record['n_bonds_yade']} bonds in YADE -> {out}")

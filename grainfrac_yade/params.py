@@ -1,0 +1,442 @@
+"""Typed, validated model parameters loaded from TOML files in ``params/``.
+
+A parameter set is the merge of one or more TOML files (later files win) plus
+``--set section.key=value`` overrides.  The merged set must name every key of
+the schema below and nothing else; each value is checked (sign, range, type).
+Errors are :class:`~grainfrac_yade.errors.ParameterError` with one line naming
+the file, the key and the fix.
+
+Units are SI; friction angles are given in degrees in files (``*_deg`` keys)
+and exposed in radians.  Mixed mineral pairs take the arithmetic average of
+the two pure-mineral rows of Table 2 (paper section 3.1) unless the files give
+the pair explicitly.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field
+from itertools import combinations_with_replacement
+from pathlib import Path
+from typing import Any, Mapping
+
+from .errors import ParameterError
+
+PARAMS_DIR = Path(__file__).resolve().parent.parent / "params"
+DEFAULT_FILES = ("ldb_granite.toml", "stress_corrosion.toml", "numerics.toml", "loading.toml")
+
+#: Tolerance on the sum of area fractions (they are printed to 3 decimals in the paper).
+FRACTION_SUM_TOLERANCE = 1e-6
+
+
+def _spec(unit: str, check: str, doc: str = "", choices: tuple = ()):
+    """Field metadata: SI unit, validation rule and meaning."""
+    return field(metadata={"unit": unit, "check": check, "doc": doc, "choices": choices})
+
+
+# --------------------------------------------------------------------------- schema
+@dataclass(frozen=True, kw_only=True)
+class SpecimenParams:
+    """Specimen geometry (paper section 3.1)."""
+    width: float = _spec("m", "positive", "specimen width")
+    height: float = _spec("m", "positive", "specimen height")
+    thickness: float = _spec("m", "positive", "layer thickness (2D) or box depth (3D)")
+    grain_size: float = _spec("m", "positive", "equivalent diameter of a Voronoi cell")
+    lloyd_iterations: int = _spec("1", "nonnegative_int", "Lloyd relaxations of the seeds")
+    dimension: int = _spec("1", "choice", "2 = plane model, 3 = box", (2, 3))
+
+
+@dataclass(frozen=True, kw_only=True)
+class GrainParams:
+    """Elastic, unbreakable grain of one mineral (paper Table 1)."""
+    young: float = _spec("Pa", "positive", "Young's modulus E")
+    poisson: float = _spec("1", "poisson", "Poisson's ratio")
+    density: float = _spec("kg/m3", "positive", "density")
+
+    @property
+    def shear_modulus(self) -> float:
+        """Shear modulus G = E / (2 (1 + nu)) [Pa]."""
+        return self.young / (2.0 * (1.0 + self.poisson))
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactParams:
+    """Elasto-plastic Mohr-Coulomb contact with tension cut-off (paper Table 2, Eq. 4-5)."""
+    normal_stiffness: float = _spec("Pa/m", "positive", "contact normal stiffness k_n")
+    shear_stiffness_ratio: float = _spec("1", "positive", "k_s / k_n")
+    tensile_strength: float = _spec("Pa", "positive", "tensile strength J^T")
+    residual_tensile_strength: float = _spec("Pa", "nonnegative", "residual tensile strength J^T_r")
+    cohesion: float = _spec("Pa", "positive", "cohesion J^C")
+    residual_cohesion: float = _spec("Pa", "nonnegative", "residual cohesion J^C_r")
+    friction_angle_deg: float = _spec("deg", "angle", "friction angle phi")
+    residual_friction_ratio: float = _spec("1", "unit_interval", "phi_r / phi")
+
+    @property
+    def shear_stiffness(self) -> float:
+        """Contact shear stiffness k_s = k_n * (k_s/k_n) [Pa/m]."""
+        return self.normal_stiffness * self.shear_stiffness_ratio
+
+    @property
+    def friction_angle(self) -> float:
+        """Friction angle phi [rad]."""
+        return math.radians(self.friction_angle_deg)
+
+    @property
+    def residual_friction_angle(self) -> float:
+        """Residual friction angle phi_r = phi * (phi_r/phi) [rad] (Table 2: ratio 0.5)."""
+        return self.friction_angle * self.residual_friction_ratio
+
+
+@dataclass(frozen=True, kw_only=True)
+class ResolutionParams:
+    """How finely a Voronoi cell is resolved by spheres."""
+    spheres_per_cell: int = _spec("1", "positive_int", "target spheres per cell clump; 1 = one sphere")
+
+
+@dataclass(frozen=True, kw_only=True)
+class NumericsParams:
+    """DEM integration knobs."""
+    damping: float = _spec("1", "unit_interval_open", "Cundall non-viscous damping")
+    timestep_safety: float = _spec("1", "unit_interval_open", "fraction of the critical time step")
+    density_scale: float = _spec("1", "positive", "mass scaling factor for quasi-static runs")
+
+
+@dataclass(frozen=True, kw_only=True)
+class StressCorrosionParams:
+    """Hillig-Charles stress corrosion (paper Eq. 7) and its creep clocks (Eq. 8 and ours)."""
+    beta1: float = _spec("Pa/s", "positive", "rate constant beta1 (paper Eq. 7)")
+    beta2: float = _spec("1/Pa", "positive", "stress sensitivity beta2 (paper Eq. 7)")
+    mode: str = _spec("", "choice", "what corrosion degrades", ("strength", "area"))
+    clock: str = _spec("", "choice", "creep clock", ("event", "paper"))
+    dt_min: float = _spec("s", "positive", "smallest creep step (paper Eq. 8)")
+    dt_max: float = _spec("s", "positive", "largest creep step (paper Eq. 8)")
+    unbalanced_force_threshold: float = _spec("N or 1", "positive", "F_u threshold (paper Eq. 8)")
+    unbalanced_force_reference: str = _spec("", "choice", "F_u absolute [N] or relative",
+                                            ("absolute", "relative"))
+    engine_period: int = _spec("1", "positive_int", "DEM steps between applications of the law")
+    max_strength_loss_fraction: float = _spec("1", "unit_interval_open",
+                                              "event clock: largest relative strength loss per interval")
+    creep_time_limit: float = _spec("s", "positive", "creep time after which a run stops unfailed")
+
+
+@dataclass(frozen=True, kw_only=True)
+class UcsParams:
+    """Strain-controlled uniaxial compression with rigid platens."""
+    strain_rate: float = _spec("1/s", "positive", "axial strain rate of the platens (DEM time)")
+    stop_stress_ratio: float = _spec("1", "unit_interval_open", "stop when stress falls below this x peak")
+    max_strain: float = _spec("1", "positive", "stop at this axial strain")
+    record_strain_increment: float = _spec("1", "positive", "axial strain between history rows")
+    platen_lateral: str = _spec("", "choice", "platen-end cells free (smooth) or fixed (rough) laterally",
+                                ("free", "fixed"))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Parameters:
+    """A complete, validated parameter set."""
+    specimen: SpecimenParams
+    composition: Mapping[str, float]
+    grains: Mapping[str, GrainParams]
+    contacts: Mapping[tuple, ContactParams]
+    resolution: ResolutionParams
+    numerics: NumericsParams
+    stress_corrosion: StressCorrosionParams
+    ucs: UcsParams
+    sources: tuple = ()
+
+    @property
+    def minerals(self) -> tuple:
+        """Mineral names in file order."""
+        return tuple(self.composition)
+
+    def contact(self, mineral_a: str, mineral_b: str) -> ContactParams:
+        """Contact parameters of a mineral pair (order does not matter)."""
+        return self.contacts[pair_key(mineral_a, mineral_b)]
+
+    def to_dict(self) -> dict:
+        """Plain nested dict (file layout, SI units) for JSON run records."""
+        out = {}
+        for f in dataclasses.fields(self):
+            if f.name == "sources":
+                continue
+            value = getattr(self, f.name)
+            if dataclasses.is_dataclass(value):
+                out[f.name] = dataclasses.asdict(value)
+            elif f.name == "composition":
+                out[f.name] = dict(value)
+            elif f.name == "grains":
+                out[f.name] = {m: dataclasses.asdict(g) for m, g in value.items()}
+            elif f.name == "contacts":
+                out[f.name] = {"/".join(k): dataclasses.asdict(c) for k, c in value.items()}
+        out["sources"] = list(self.sources)
+        return out
+
+
+SECTION_CLASSES = {
+    "specimen": SpecimenParams,
+    "resolution": ResolutionParams,
+    "numerics": NumericsParams,
+    "stress_corrosion": StressCorrosionParams,
+    "ucs": UcsParams,
+}
+
+
+def pair_key(mineral_a: str, mineral_b: str) -> tuple:
+    """Canonical key of a mineral pair: the two names sorted."""
+    return tuple(sorted((mineral_a, mineral_b)))
+
+
+def average_contact(a: ContactParams, b: ContactParams) -> ContactParams:
+    """Contact of a mixed pair: arithmetic average of each parameter (paper section 3.1)."""
+    return ContactParams(**{f.name: 0.5 * (getattr(a, f.name) + getattr(b, f.name))
+                            for f in dataclasses.fields(ContactParams)})
+
+
+# --------------------------------------------------------------------------- validation
+def _check_value(value: Any, spec: Mapping, source: str, key: str):
+    """Check one value against its field metadata; return it typed."""
+    check, unit = spec["check"], spec["unit"]
+    unit_txt = f" [{unit}]" if unit and unit != "1" else ""
+
+    def fail(problem, fix):
+        raise ParameterError(source, key, problem, fix)
+
+    if check == "choice":
+        choices = spec["choices"]
+        if value not in choices:
+            fail(f"{value!r} is not one of {list(choices)}", f"use one of {list(choices)}")
+        return value
+    if check.endswith("_int"):
+        if isinstance(value, bool) or not isinstance(value, int):
+            fail(f"{value!r} is not an integer", "give a whole number")
+        if check == "positive_int" and value < 1:
+            fail(f"{value} must be >= 1", "give a positive whole number")
+        if check == "nonnegative_int" and value < 0:
+            fail(f"{value} must be >= 0", "give a whole number >= 0")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        fail(f"{value!r} is not a number", f"give a number{unit_txt}")
+    value = float(value)
+    if not math.isfinite(value):
+        fail(f"{value} is not finite", f"give a finite number{unit_txt}")
+    rules = {
+        "positive": (value > 0, f"must be > 0 (got {value:g})", f"give a positive value{unit_txt}"),
+        "nonnegative": (value >= 0, f"must be >= 0 (got {value:g})", f"give a value >= 0{unit_txt}"),
+        "fraction": (0 <= value <= 1, f"must lie in [0, 1] (got {value:g})", "give a fraction between 0 and 1"),
+        "unit_interval": (0 < value <= 1, f"must lie in (0, 1] (got {value:g})", "give a value in (0, 1]"),
+        "unit_interval_open": (0 < value < 1, f"must lie in (0, 1) (got {value:g})", "give a value in (0, 1)"),
+        "poisson": (-1 < value < 0.5, f"must lie in (-1, 0.5) (got {value:g})", "give a Poisson's ratio below 0.5"),
+        "angle": (0 <= value < 90, f"must lie in [0, 90) degrees (got {value:g})", "give an angle in degrees"),
+    }
+    ok, problem, fix = rules[check]
+    if not ok:
+        fail(problem, fix)
+    return value
+
+
+def _build(cls, table: Mapping, origins: Mapping, section: str):
+    """Build dataclass ``cls`` from a TOML table, rejecting unknown and missing keys."""
+    names = [f.name for f in dataclasses.fields(cls)]
+    for key in table:
+        if key not in names:
+            close = [n for n in names if n.startswith(key[:3])]
+            hint = f"did you mean {close[0]!r}?" if close else f"known keys: {', '.join(names)}"
+            raise ParameterError(origins.get(f"{section}.{key}".replace('"', ""), "parameters"), f"{section}.{key}",
+                                 "unknown key", f"remove it or correct the spelling ({hint})")
+    values = {}
+    for f in dataclasses.fields(cls):
+        dotted = f"{section}.{f.name}"
+        origin_key = dotted.replace('"', "")
+        if f.name not in table:
+            raise ParameterError(_section_origin(origins, section), dotted, "missing key",
+                                 f"add `{f.name} = ...` [{f.metadata['unit']}] ({f.metadata['doc']})")
+        values[f.name] = _check_value(table[f.name], f.metadata, origins.get(origin_key, "parameters"), dotted)
+    return cls(**values)
+
+
+def _section_origin(origins: Mapping, section: str) -> str:
+    section = section.replace('"', "")
+    files = sorted({v for k, v in origins.items() if k.startswith(section + ".")})
+    return " + ".join(files) if files else "parameter files"
+
+
+# --------------------------------------------------------------------------- loading
+def _flatten(table: Mapping, prefix: str = "") -> dict:
+    out = {}
+    for key, value in table.items():
+        dotted = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(_flatten(value, dotted + "."))
+        else:
+            out[dotted] = value
+    return out
+
+
+def _merge(base: dict, new: Mapping, origins: dict, source: str, prefix: str = ""):
+    for key, value in new.items():
+        dotted = f"{prefix}{key}"
+        if isinstance(value, dict):
+            _merge(base.setdefault(key, {}), value, origins, source, dotted + ".")
+        else:
+            base[key] = value
+            origins[dotted] = source
+
+
+def read_toml(path) -> dict:
+    """Read one TOML file; a missing or malformed file raises ParameterError."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise ParameterError(str(path), "(file)", "file not found",
+                             f"check the path; shipped files are in {PARAMS_DIR}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(str(path), "(syntax)", f"not valid TOML ({exc})",
+                             "fix the syntax at that line") from None
+
+
+def parse_override(text: str) -> tuple:
+    """Split ``section.key=value``; the value is read as TOML, else as a plain string."""
+    if "=" not in text or "." not in text.split("=", 1)[0]:
+        raise ParameterError("--set", text, "not of the form section.key=value",
+                             "write e.g. --set stress_corrosion.beta1=0.002")
+    key, raw = (s.strip() for s in text.split("=", 1))
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key, value
+
+
+def _nest(dotted: str, value) -> dict:
+    """``a.b.c`` -> {"a": {"b": {"c": value}}}; quoted parts ("a/b") kept whole."""
+    parts = []
+    buf, quoted = "", False
+    for ch in dotted:
+        if ch == '"':
+            quoted = not quoted
+        elif ch == "." and not quoted:
+            parts.append(buf)
+            buf = ""
+        else:
+            buf += ch
+    parts.append(buf)
+    out = value
+    for part in reversed(parts):
+        out = {part: out}
+    return out
+
+
+def default_files() -> list:
+    """The shipped parameter files, in merge order."""
+    return [PARAMS_DIR / name for name in DEFAULT_FILES]
+
+
+def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
+    """Load, merge and validate parameters.
+
+    Parameters
+    ----------
+    files : list of paths, optional
+        Files merged in order (later wins). Default: :func:`default_files`.
+    overrides : iterable of str
+        ``section.key=value`` strings applied last (as ``--set`` on the CLI).
+    extra_files : list of paths
+        Files merged after ``files`` (the CLI's ``--params``).
+    """
+    files = list(default_files() if files is None else files) + list(extra_files)
+    merged, origins = {}, {}
+    for path in files:
+        _merge(merged, read_toml(path), origins, str(path))
+    for text in overrides:
+        key, value = parse_override(text) if isinstance(text, str) else text
+        flat_known = _flatten(merged)
+        if key not in flat_known and not _is_new_pair_key(key):
+            raise ParameterError("--set", key, "no such parameter",
+                                 "use a dotted key that exists in the parameter files, e.g. "
+                                 "stress_corrosion.beta1")
+        _merge(merged, _nest(key, value), origins, "--set")
+    return build_parameters(merged, origins, tuple(str(p) for p in files))
+
+
+def _is_new_pair_key(key: str) -> bool:
+    return key.startswith("contacts.")
+
+
+def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameters:
+    """Validate a merged nested dict into :class:`Parameters`."""
+    known = set(SECTION_CLASSES) | {"composition", "grains", "contacts"}
+    for section in merged:
+        if section not in known:
+            raise ParameterError(_section_origin(origins, section), section, "unknown section",
+                                 f"remove it or use one of {sorted(known)}")
+    for section in known:
+        if section not in merged:
+            raise ParameterError(" + ".join(sources) or "parameters", section, "missing section",
+                                 f"add a [{section}] table (see {PARAMS_DIR})")
+    typed = {name: _build(cls, merged[name], origins, name) for name, cls in SECTION_CLASSES.items()}
+    composition = _composition(merged["composition"], origins)
+    minerals = tuple(composition)
+    grains = {}
+    for mineral, table in merged["grains"].items():
+        if mineral not in composition:
+            raise ParameterError(origins.get(f"grains.{mineral}.young", "parameters"), f"grains.{mineral}",
+                                 "mineral not in [composition]", f"add it to [composition] or remove it")
+        grains[mineral] = _build(GrainParams, table, origins, f"grains.{mineral}")
+    for mineral in minerals:
+        if mineral not in grains:
+            raise ParameterError(_section_origin(origins, "grains"), f"grains.{mineral}", "missing mineral",
+                                 f"add a [grains.{mineral}] table (paper Table 1)")
+    typed["contacts"] = _contacts(merged["contacts"], origins, minerals)
+    sc = typed["stress_corrosion"]
+    if sc.dt_min > sc.dt_max:
+        raise ParameterError(origins.get("stress_corrosion.dt_min", "parameters"), "stress_corrosion.dt_min",
+                             f"dt_min = {sc.dt_min:g} s exceeds dt_max = {sc.dt_max:g} s",
+                             "make dt_min <= dt_max")
+    return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
+
+
+def _composition(table: Mapping, origins: Mapping) -> dict:
+    out = {}
+    for mineral, value in table.items():
+        out[mineral] = _check_value(value, {"check": "fraction", "unit": "1"},
+                                    origins.get(f"composition.{mineral}", "parameters"), f"composition.{mineral}")
+    if not out:
+        raise ParameterError(_section_origin(origins, "composition"), "composition", "no minerals",
+                             "list each mineral's area fraction")
+    total = sum(out.values())
+    if abs(total - 1.0) > FRACTION_SUM_TOLERANCE:
+        raise ParameterError(_section_origin(origins, "composition"), "composition",
+                             f"area fractions sum to {total:.6g}, not 1",
+                             "make the fractions add up to 1 (paper: 0.071, 0.511, 0.318, 0.100)")
+    return out
+
+
+def _contacts(table: Mapping, origins: Mapping, minerals: tuple) -> dict:
+    given = {}
+    for name, row in table.items():
+        parts = name.split("/")
+        if len(parts) != 2 or any(p not in minerals for p in parts):
+            raise ParameterError(origins.get(f"contacts.{name}.normal_stiffness", "parameters"),
+                                 f'contacts."{name}"', "not a pair of known minerals",
+                                 f'name it "a/b" with a and b from {list(minerals)}')
+        key = pair_key(*parts)
+        if key in given:
+            raise ParameterError(origins.get(f"contacts.{name}.normal_stiffness", "parameters"),
+                                 f'contacts."{name}"', "pair given twice", "keep one of the two tables")
+        given[key] = _build(ContactParams, row, origins, f'contacts."{name}"')
+    contacts = {}
+    for a, b in combinations_with_replacement(minerals, 2):
+        key = pair_key(a, b)
+        if key in given:
+            contacts[key] = given[key]
+        elif a == b:
+            raise ParameterError(_section_origin(origins, "contacts"), f'contacts."{a}/{a}"',
+                                 "missing pure-mineral contact", f'add a [contacts."{a}/{a}"] table (paper Table 2)')
+        else:
+            pa, pb = pair_key(a, a), pair_key(b, b)
+            if pa not in given or pb not in given:
+                continue  # reported when the loop reaches the pure pair
+            contacts[key] = average_contact(given[pa], given[pb])
+    return contacts

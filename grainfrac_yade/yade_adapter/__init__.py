@@ -1,0 +1,36 @@
+"""The only part of grainfrac_yade that imports YADE.
+
+YADE 2023.02a (Debian bookworm) is built for Debian's ``/usr/bin/python3``;
+its Python package lives outside ``sys.path`` (see shared/yade_notes.md).
+:func:`load_yade` is the one place that knows where.
+"""
+from __future__ import annotations
+
+import sys
+
+from ..errors import GrainfracError
+
+#: Where Debian's yade package installs its Python modules (double precision build).
+YADE_PY_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"
+#: The interpreter YADE is built for.
+DEBIAN_PYTHON = "/usr/bin/python3"
+
+_yade = None
+
+
+def load_yade():
+    """Import YADE once and return the ``yade`` module; clear error if impossible."""
+    global _yade
+    if _yade is not None:
+        return _yade
+    if YADE_PY_PATH not in sys.path:
+        sys.path.insert(0, YADE_PY_PATH)
+    try:
+        import yade  # noqa: F401
+        from yade import wrapper  # noqa: F401
+    except ImportError as exc:
+        raise GrainfracError(
+            f"YADE cannot be imported in {sys.executable} ({exc}); fix: run with {DEBIAN_PYTHON} "
+            "after `apt-get install yade` (see README)") from None
+    _yade = yade
+    return yade

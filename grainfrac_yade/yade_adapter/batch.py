@@ -1,0 +1,48 @@
+"""Parameters for scripts run by ``yade`` / ``yade-batch`` (YADE's ``readParamsFromTable``).
+
+Every parameter path (``section.key``, the names of ``--set``) is a possible
+column of a batch table, plus ``seed``, ``out`` and ``study``.  Values are read
+with YADE's own ``readParamsFromTable`` and validated like files.
+"""
+from __future__ import annotations
+
+import re
+
+from ..params import _flatten, default_files, read_toml
+from . import load_yade
+
+#: Table columns that are not model parameters: run controls, with defaults.
+RUN_COLUMNS = {"seed": 1, "out": "", "study": "default", "description": ""}
+
+
+def parameter_defaults() -> dict:
+    """Flattened shipped parameters: {"section.key": value}."""
+    merged = {}
+    for path in default_files():
+        merged.update(_flatten(read_toml(path)))
+    return merged
+
+
+def read_table(extra_columns=None) -> tuple:
+    """Read this run's row (or the defaults outside a batch).
+
+    Returns (overrides list of (key, value), run controls dict).
+    """
+    yade = load_yade()
+    from yade import utils
+    defaults = parameter_defaults()
+    run_defaults = dict(RUN_COLUMNS, **(extra_columns or {}))
+    utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
+    table = yade.params.table
+    overrides = [(k, getattr(table, k)) for k, v in defaults.items() if getattr(table, k) != v]
+    controls = {k: getattr(table, k) for k in run_defaults}
+    if not controls["description"]:
+        controls["description"] = yade.O.tags.get("description", "") if hasattr(yade.O.tags, "get") else ""
+    return overrides, controls
+
+
+def run_folder_name(controls: dict, overrides) -> str:
+    """Folder name of a batch row: its description, else the overridden values and seed."""
+    desc = controls.get("description") or "_".join(f"{k.split('.')[-1]}={v}" for k, v in overrides)
+    desc = f"{desc}_seed{controls['seed']}" if "seed" not in desc else desc
+    return re.sub(r"[^A-Za-z0-9_.=+-]+", "_", desc).strip("_") or f"seed{controls['seed']}"

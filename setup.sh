@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs what grainfrac-yade needs on Debian bookworm, if missing. Idempotent.
+# YADE and the scientific stack all come from Debian, so they share one numpy
+# and run on Debian's /usr/bin/python3 (whatever python3 is first on PATH).
+set -euo pipefail
+PACKAGES="yade python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest git"
+missing=""
+for p in $PACKAGES; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  echo "installing:$missing"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
+fi
+/usr/bin/python3 -c "import numpy, scipy, pandas, matplotlib, pytest" \
+  || { echo "setup.sh: Debian's python3 cannot import the scientific stack; fix: apt-get install $PACKAGES"; exit 1; }

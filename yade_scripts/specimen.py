@@ -1,0 +1,14 @@
+"""Build a grain specimen and its YADE scene; write specimen.json and specimen.png.
+
+    yade -x yade_scripts/specimen.py                      # defaults (paper-size specimen)
+    yade-batch params/specimen_small.table yade_scripts/specimen.py
+Columns: any parameter path (e.g. specimen.width), plus seed, out, study.
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))))
+
+from grainfrac_yade.commands.specimen import run_specimen_in_yade  # noqa: E402
+
+run_specimen_in_yade()
