@@ -1,0 +1,68 @@
+"""Specimen-scale results of a uniaxial compression test, from its history (pure numpy).
+
+Conventions: compression positive (axial stress and strain); lateral strain
+negative in expansion; volumetric strain of the plane model eps_v = eps_a + eps_l.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: Stress window, as fractions of the peak, for Young's modulus and Poisson's ratio
+#: (ISRM-style tangent fit on the pre-peak loading branch).
+ELASTIC_WINDOW = (0.10, 0.50)
+#: Crack initiation: first stress at which the broken-bond count reaches this fraction of the
+#: count at peak and keeps growing (at least CI_MIN_BONDS bonds), i.e. "first sustained breaking".
+CI_FRACTION_OF_PEAK_COUNT = 0.02
+CI_MIN_BONDS = 3
+
+
+def elastic_constants(stress, axial_strain, lateral_strain, peak_index=None):
+    """Young's modulus [Pa] and Poisson's ratio: least-squares slopes between 10 and 50 % of peak.
+
+    E = d(sigma)/d(eps_a) (tangent modulus averaged over the window);
+    nu = -d(eps_l)/d(eps_a) over the same points.
+    """
+    stress, ea, el = (np.asarray(x, float) for x in (stress, axial_strain, lateral_strain))
+    ip = int(np.argmax(stress)) if peak_index is None else peak_index
+    peak = stress[ip]
+    sel = np.zeros(len(stress), bool)
+    sel[: ip + 1] = (stress[: ip + 1] >= ELASTIC_WINDOW[0] * peak) & (stress[: ip + 1] <= ELASTIC_WINDOW[1] * peak)
+    if sel.sum() < 3:
+        return float("nan"), float("nan")
+    young = np.polyfit(ea[sel], stress[sel], 1)[0]
+    poisson = -np.polyfit(ea[sel], el[sel], 1)[0]
+    return float(young), float(poisson)
+
+
+def crack_initiation_stress(stress, broken_count):
+    """Axial stress at the first sustained bond breaking [Pa] (see CI_FRACTION_OF_PEAK_COUNT)."""
+    stress, n = np.asarray(stress, float), np.asarray(broken_count, float)
+    ip = int(np.argmax(stress))
+    threshold = max(CI_MIN_BONDS, CI_FRACTION_OF_PEAK_COUNT * n[ip])
+    hit = np.flatnonzero(n[: ip + 1] >= threshold)
+    return float(stress[hit[0]]) if len(hit) else float("nan")
+
+
+def crack_damage_stress(stress, axial_strain, lateral_strain):
+    """Axial stress at the onset of volumetric strain reversal [Pa]: max of eps_a + eps_l before peak."""
+    stress = np.asarray(stress, float)
+    ip = int(np.argmax(stress))
+    ev = np.asarray(axial_strain, float)[: ip + 1] + np.asarray(lateral_strain, float)[: ip + 1]
+    return float(stress[int(np.argmax(ev))])
+
+
+def ucs_summary(history: dict) -> dict:
+    """UCS, E, Poisson, crack initiation and crack damage stress from history columns."""
+    s = np.asarray(history["axial_stress_pa"], float)
+    ea, el = history["axial_strain"], history["lateral_strain"]
+    ip = int(np.argmax(s))
+    young, poisson = elastic_constants(s, ea, el, ip)
+    return {
+        "ucs_pa": float(s[ip]),
+        "peak_axial_strain": float(np.asarray(ea)[ip]),
+        "young_pa": young,
+        "young_method": "tangent: least-squares slope of stress vs axial strain between 10 and 50 % of peak",
+        "poisson": poisson,
+        "crack_initiation_pa": crack_initiation_stress(s, history["broken_total"]),
+        "crack_damage_pa": crack_damage_stress(s, ea, el),
+    }

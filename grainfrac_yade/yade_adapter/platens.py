@@ -1,0 +1,88 @@
+"""Rigid platens acting on the end cells of a specimen, and the specimen-scale measures.
+
+The cells with a face on the top (bottom) wall form the top (bottom) platen:
+their vertical motion is prescribed together, their rotation is blocked (the
+platen face stays flat), and their lateral motion is free (smooth platen,
+``platen_lateral = "free"``) or blocked (rough platen, ``"fixed"``).  The axial
+stress is the platens' reaction over the specimen cross-section (width x
+thickness); lateral strain comes from the cells on the side walls.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: DOFs blocked on platen cells: y prescribed, z and all rotations blocked (pseudo-2D, flat platen).
+PLATEN_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
+
+
+class Platens:
+    """Top and bottom platen cells of a 2D scene; axial velocity control and measurements."""
+
+    name = "Platens"
+
+    def __init__(self, scene, lateral: str = "free"):
+        t = scene.specimen.tessellation
+        self.scene = scene
+        self.top = t.cells_on_side("top")
+        self.bottom = np.setdiff1d(t.cells_on_side("bottom"), self.top)
+        self.left = t.cells_on_side("left")
+        self.right = t.cells_on_side("right")
+        self.width, self.height = float(t.box[0]), float(t.box[1])
+        self.cross_section = self.width * scene.specimen.thickness
+        O = scene.O
+        self._top_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.top]]
+        self._bottom_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.bottom]]
+        self._left_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.left]]
+        self._right_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.right]]
+        for b in self._top_bodies + self._bottom_bodies:
+            b.state.blockedDOFs = PLATEN_BLOCKED[lateral]
+            b.state.vel = (0, 0, 0)
+            b.state.angVel = (0, 0, 0)
+        self.y0_top = np.mean([b.state.pos[1] for b in self._top_bodies])
+        self.y0_bottom = np.mean([b.state.pos[1] for b in self._bottom_bodies])
+        self.x0_gap = self._side_gap()
+        self.velocity = 0.0
+
+    def set_axial_velocity(self, closing_speed: float):
+        """Platens approach each other at ``closing_speed`` [m/s] (half each)."""
+        self.velocity = closing_speed
+        for b in self._top_bodies:
+            b.state.vel = (b.state.vel[0], -0.5 * closing_speed, 0)
+        for b in self._bottom_bodies:
+            b.state.vel = (b.state.vel[0], 0.5 * closing_speed, 0)
+
+    def shift(self, closing: float):
+        """Move both platens towards each other by ``closing`` [m] in one jump (servo/creep hold)."""
+        for b in self._top_bodies:
+            p = b.state.pos
+            b.state.pos = (p[0], p[1] - 0.5 * closing, p[2])
+        for b in self._bottom_bodies:
+            p = b.state.pos
+            b.state.pos = (p[0], p[1] + 0.5 * closing, p[2])
+
+    def axial_strain(self) -> float:
+        """Platen closure over specimen height (shortening positive) [1]."""
+        top = np.mean([b.state.pos[1] for b in self._top_bodies])
+        bottom = np.mean([b.state.pos[1] for b in self._bottom_bodies])
+        return ((self.y0_top - self.y0_bottom) - (top - bottom)) / self.height
+
+    def _side_gap(self) -> float:
+        return (np.mean([b.state.pos[0] for b in self._right_bodies])
+                - np.mean([b.state.pos[0] for b in self._left_bodies]))
+
+    def lateral_strain(self) -> float:
+        """Change of the distance between the side cells over the width [1].
+
+        Compression positive, as the axial strain: lateral expansion is negative.
+        """
+        return -(self._side_gap() - self.x0_gap) / self.width
+
+    def axial_stress(self) -> float:
+        """Mean reaction of the two platens over the cross-section (compression positive) [Pa]."""
+        f = self.scene.O.forces.f
+        top = sum(f(b.id)[1] for b in self._top_bodies)
+        bottom = sum(f(b.id)[1] for b in self._bottom_bodies)
+        return 0.5 * (top - bottom) / self.cross_section
+
+    def before_step(self, scene):
+        """Platen velocities are set once and kept by YADE (blocked DOFs keep their velocity)."""
