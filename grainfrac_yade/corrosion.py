@@ -43,9 +43,11 @@ MODE_CORRODED = 3   # area mode only: a reaches 0 before either criterion is met
 GL_NODES = 10       # Gauss-Legendre nodes per panel: machine precision for log-variation < ~10
 N_PANELS = 64       # geometric panels per bond: 25 decades of u at ratio <= 2.5 per panel
 FIRST_PANEL = 0.1   # first panel width in units of 1/K: log-variation <= 0.1 across it
-K_GRID_MAX = 1e100  # cap on K for the grid: beyond it the lifetime is 0 to float precision
-TAIL_RATIO = 1e16   # a below a_from/1e16 counts as a = 0; the dropped tail is <= ~2e-16
-                    # relative (rate >= beta1/J^C0 there, see area_time)
+K_GRID_MAX = 1e40   # cap on K for the grid: beyond it every exponent k*u (u >= 1) is clipped
+                    # at +-LOG_LIMIT, so the integrand is flat and needs no finer panel
+AREA_MIN = 1e-250   # a below this counts as 0: keeps u = 1/a, TAIL_RATIO*u and grid ratios finite
+TAIL_RATIO = 1e16   # a below a_from/1e16 counts as 0: as |da/dt| >= beta1/J^C0, the dropped
+                    # tail lasts <= 1e-16 a_from J^C0/beta1 (1e-3 s for the paper's constants)
 BISECTION_STEPS = 60  # halvings inside one panel in degrade_area: 2^-60 < float64 resolution
 CHUNK = 2048        # bonds per quadrature batch: <= CHUNK*N_PANELS*GL_NODES*8 B = 10 MB/array
 ASYMPTOTIC_X = 50.0  # x above which x e^x E1(x) uses its asymptotic series (e^x E1 overflows)
@@ -83,7 +85,8 @@ def _quotient(numerator, log_denominator):
     log_q = np.log(num) - log_denominator
     with np.errstate(all="ignore"):  # discarded where |log_q| >= LOG_LIMIT
         direct = num / np.exp(log_denominator)
-    return np.where(np.abs(log_q) < LOG_LIMIT, direct, np.exp(np.clip(log_q, -LOG_LIMIT, LOG_LIMIT)))
+    clipped = np.exp(np.clip(log_q, -LOG_LIMIT, LOG_LIMIT))
+    return np.where(np.abs(log_q) < LOG_LIMIT, direct, clipped)
 
 
 def degradation_rate(stress, beta1, beta2):
@@ -192,8 +195,9 @@ def degrade(tensile_strength, cohesion, normal_stress, shear_stress, dt, beta1, 
     b1, b2 = _check_law(beta1, beta2)
     _check_shear(shear_stress)
     d = _check_dt(dt)
-    jt = _arr(tensile_strength) - _loss(_log_rate(_arr(normal_stress), b1, b2), d)
-    jc = _arr(cohesion) - _loss(_log_rate(_arr(shear_stress), b1, b2), d)
+    with np.errstate(over="ignore"):  # only for strengths near -1.8e308, clipped to 0 below
+        jt = _arr(tensile_strength) - _loss(_log_rate(_arr(normal_stress), b1, b2), d)
+        jc = _arr(cohesion) - _loss(_log_rate(_arr(shear_stress), b1, b2), d)
     return np.maximum(jt, 0.0), np.maximum(jc, 0.0)
 
 
@@ -229,14 +233,13 @@ def time_to_failure(tensile_strength, cohesion, normal_stress, shear_stress, tan
     _check_shear(shear_stress)
     jt, jc, sigma, tau, tphi = np.broadcast_arrays(*map(_arr, (
         tensile_strength, cohesion, normal_stress, shear_stress, tan_friction)))
-    gap_t = jt - sigma
+    with np.errstate(over="ignore"):  # inf only where sigma < 0 ('never' anyway)
+        gap_t = jt - sigma
+        gap_s = shear_strength(jc, sigma, tphi) - tau  # cohesion still to lose; +inf: never
     t_t = np.where(gap_t <= 0, 0.0, np.where(
         sigma >= 0, _quotient(gap_t, _log_rate(sigma, b1, b2)), np.inf))
-    gap_s = shear_strength(jc, sigma, tphi) - tau  # cohesion still to lose
-    with np.errstate(invalid="ignore"):  # inf-inf only where |sigma tan(phi)| overflowed
-        never_s = ~(gap_s <= jc)
     t_s = np.where(gap_s <= 0, 0.0, np.where(
-        never_s, np.inf, _quotient(gap_s, _log_rate(tau, b1, b2))))
+        gap_s > jc, np.inf, _quotient(gap_s, _log_rate(tau, b1, b2))))
     mode = np.where(t_t <= t_s, MODE_TENSION, MODE_SHEAR)
     mode = np.where(np.isinf(t_t) & np.isinf(t_s), MODE_NEVER, mode)
     return np.minimum(t_t, t_s), mode
@@ -247,6 +250,7 @@ def _area_args(area_fraction, p, q, jt0, jc0, beta1, beta2):
     a = _arr(area_fraction)
     if not np.all((a > 0) & (a <= 1)):
         raise ValueError("area_fraction must be in (0, 1]; drop bonds whose area reached 0")
+    a = np.maximum(a, AREA_MIN)
     for name, v in (("tensile_strength0", jt0), ("cohesion0", jc0)):
         if not np.all((_arr(v) > 0) & np.isfinite(_arr(v))):
             raise ValueError(f"{name} must be finite and > 0 Pa (got {v!r})")
@@ -413,8 +417,7 @@ def area_time(area_from, area_to, normal_force_per_area0, shear_force_per_area0,
 
     t = int_{a_to}^{a_from} da / |da/dt| = int du / (u^2 |da/dt|), u = 1/a, by composite
     Gauss-Legendre on N_PANELS geometric panels per bond (module constants). a_to below
-    a_from/TAIL_RATIO is a = 0; the dropped tail is <= a_to_cut J^C0/beta1, i.e. <= ~2e-16 of t
-    unless J^C0/J^T0 is astronomically large.
+    a_from/TAIL_RATIO counts as a = 0; the dropped tail lasts <= a_from J^C0/(beta1 TAIL_RATIO).
 
     Parameters
     ----------
@@ -437,7 +440,8 @@ def area_time(area_from, area_to, normal_force_per_area0, shear_force_per_area0,
     a_to = np.clip(np.broadcast_to(_arr(area_to), shape).ravel(), 0.0, a)
     k_t, k_s, l_t, l_s = (np.broadcast_to(r, shape).ravel() for r in rates)
     u_lo = 1.0 / a
-    u_hi = np.where(a_to * TAIL_RATIO > a, 1.0 / np.maximum(a_to, a / TAIL_RATIO), u_lo * TAIL_RATIO)
+    a_cut = np.maximum(a / TAIL_RATIO, AREA_MIN)
+    u_hi = 1.0 / np.maximum(a_to, a_cut)
     log_t = np.empty(a.size)
     for s in _chunks(a.size):
         _, cum = _cumulative(u_lo[s], u_hi[s], (l_t[s], k_t[s], l_s[s], k_s[s]))
@@ -496,14 +500,14 @@ def degrade_area(area_fraction, normal_force_per_area0, shear_force_per_area0,
                            tensile_strength0, cohesion0, beta1, beta2)
     d = _check_dt(dt)
     shape = np.broadcast_shapes(a.shape, d.shape, *(r.shape for r in rates))
-    a, d = (np.broadcast_to(x, shape).ravel() for x in (a, d))
+    a, d, a_in = (np.broadcast_to(x, shape).ravel() for x in (a, d, _arr(area_fraction)))
     k_t, k_s, l_t, l_s = (np.broadcast_to(r, shape).ravel() for r in rates)
     log_dt = np.log(np.where(d > 0, d, 1.0))
-    out = a.copy()
+    out = a_in.astype(float)
     for s in _chunks(a.size):
         ra = (l_t[s], k_t[s], l_s[s], k_s[s])
         u_lo = 1.0 / a[s]
-        edges, cum = _cumulative(u_lo, u_lo * TAIL_RATIO, ra)
+        edges, cum = _cumulative(u_lo, 1.0 / np.maximum(a[s] / TAIL_RATIO, AREA_MIN), ra)
         j = np.argmax(cum >= log_dt[s, None], axis=1)  # first edge past dt (j >= 1)
         gone = cum[:, -1] < log_dt[s]
         j = np.where(gone, 1, j)
@@ -517,7 +521,7 @@ def degrade_area(area_fraction, normal_force_per_area0, shear_force_per_area0,
             below = _log_integral(lo, mid, ra) < log_rest
             left, right = np.where(below, mid, left), np.where(below, right, mid)
         new = 1.0 / (0.5 * (left + right))
-        out[s] = np.where(d[s] > 0, np.where(gone, 0.0, np.minimum(new, a[s])), a[s])
+        out[s] = np.where(d[s] > 0, np.where(gone, 0.0, np.minimum(new, a_in[s])), a_in[s])
     return out.reshape(shape)
 
 

@@ -158,7 +158,9 @@ def bond_properties(specimen: Specimen, layout: ClumpLayout, params: Parameters)
     where k_n, k_s [Pa/m] are the pair's contact stiffnesses (Table 2, mixed
     pairs averaged), G = E/(2(1+nu)) and E' = E/(1-nu^2) in 2D (plane strain,
     as UDEC) or E' = E in 3D (Table 1).  Strengths are stresses [Pa]; the
-    adapter multiplies them by A.
+    adapter multiplies them by A.  The calibration factors of
+    ``params.calibration`` scale both stiffnesses and both strengths of every
+    bond (one factor each, so Table 2's ratios stay).
     """
     t = specimen.tessellation
     names = specimen.mineral_names
@@ -183,8 +185,10 @@ def bond_properties(specimen: Specimen, layout: ClumpLayout, params: Parameters)
     kn = area / (1 / table["normal_stiffness"][ma, mb] + la / e_mod[ma] + lb / e_mod[mb])
     ks = area / (1 / table["shear_stiffness"][ma, mb] + la / g_mod[ma] + lb / g_mod[mb])
     pick = {k: v[ma, mb] for k, v in table.items()}
-    return BondProperties(normal_stiffness=kn, shear_stiffness=ks,
-                          tensile_strength=pick["tensile_strength"], cohesion=pick["cohesion"],
+    cal = params.calibration
+    return BondProperties(normal_stiffness=kn * cal.stiffness_scale, shear_stiffness=ks * cal.stiffness_scale,
+                          tensile_strength=pick["tensile_strength"] * cal.strength_scale,
+                          cohesion=pick["cohesion"] * cal.strength_scale,
                           friction_angle=pick["friction_angle"],
                           residual_friction_angle=pick["residual_friction_angle"],
                           residual_tensile_strength=pick["residual_tensile_strength"],

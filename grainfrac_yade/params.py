@@ -24,7 +24,8 @@ from typing import Any, Mapping
 from .errors import ParameterError
 
 PARAMS_DIR = Path(__file__).resolve().parent.parent / "params"
-DEFAULT_FILES = ("ldb_granite.toml", "stress_corrosion.toml", "numerics.toml", "loading.toml")
+DEFAULT_FILES = ("ldb_granite.toml", "stress_corrosion.toml", "numerics.toml", "loading.toml",
+                 "calibration.toml")
 
 #: Tolerance on the sum of area fractions (they are printed to 3 decimals in the paper).
 FRACTION_SUM_TOLERANCE = 1e-6
@@ -132,6 +133,16 @@ class UcsParams:
 
 
 @dataclass(frozen=True, kw_only=True)
+class CalibrationParams:
+    """Scale factors that map the paper's UDEC values onto this YADE packing (issue 4).
+
+    One factor for all mineral pairs, so the ratios of Table 2 stay as printed.
+    """
+    strength_scale: float = _spec("1", "positive", "multiplies J^T and J^C of every contact")
+    stiffness_scale: float = _spec("1", "positive", "multiplies the series normal and shear stiffness of every bond")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Parameters:
     """A complete, validated parameter set."""
     specimen: SpecimenParams
@@ -142,6 +153,7 @@ class Parameters:
     numerics: NumericsParams
     stress_corrosion: StressCorrosionParams
     ucs: UcsParams
+    calibration: CalibrationParams
     sources: tuple = ()
 
     @property
@@ -178,6 +190,7 @@ SECTION_CLASSES = {
     "numerics": NumericsParams,
     "stress_corrosion": StressCorrosionParams,
     "ucs": UcsParams,
+    "calibration": CalibrationParams,
 }
 
 

@@ -1,0 +1,357 @@
+"""Creep clocks: creep time (the stress-corrosion time axis) kept apart from DEM time.
+
+:class:`PaperClock` is the paper's adaptive creep step (Eq. 8); :class:`EventClock` jumps
+straight to the next bond failure under frozen stresses (closed form of Eq. 7, or the area
+mode of :mod:`grainfrac_yade.corrosion`), capped so no bond loses more than a set fraction of
+its current strength (or area fraction) in one interval. Both are plain validated objects with
+``state_dict()`` / ``from_state()`` for checkpoints; nothing here knows about YADE.
+"""
+import math
+
+import numpy as np
+
+from grainfrac_yade import corrosion
+
+STATE_VERSION = 1  # bump when a state_dict layout changes; from_state refuses other versions
+EVENT_REL_TOL = 1e-12  # bonds whose time to failure is within this relative distance of dt fail
+MODES = ("strength", "area")  # degradation modes, see grainfrac_yade.corrosion
+
+
+def _number(name, value, fix):
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number (got {value!r}); {fix}") from None
+    if math.isnan(x):
+        raise ValueError(f"{name} must not be NaN; {fix}")
+    return x
+
+
+def _check_state(state, kind):
+    if not isinstance(state, dict) or state.get("kind") != kind:
+        raise ValueError(f"state must be a dict with kind={kind!r} (got {state!r:.80})")
+    if state.get("version") != STATE_VERSION:
+        raise ValueError(f"state version must be {STATE_VERSION} (got {state.get('version')!r});"
+                         " the checkpoint was written by another release")
+
+
+class PaperClock:
+    """Adaptive creep step of paper Eq. 8.
+
+    dt_b = min(2 dt_{b-1}, dt_max) if the unbalanced force F_u < threshold, else dt_min; the
+    first step (and the first after :meth:`reset_step`) is dt_min.
+
+    Parameters
+    ----------
+    dt_min : float
+        Smallest creep step [s], > 0 (paper: 1e-5 s).
+    dt_max : float
+        Largest creep step [s], >= dt_min, finite (paper: 1e4 s).
+    unbalanced_force_threshold : float
+        F_u below which the step doubles [N], > 0 (paper: 100 N).
+    """
+
+    KIND = "PaperClock"
+
+    def __init__(self, dt_min=1e-5, dt_max=1e4, unbalanced_force_threshold=100.0):
+        lo = _number("dt_min", dt_min, "give a time step in s, e.g. 1e-5")
+        hi = _number("dt_max", dt_max, "give a time step in s, e.g. 1e4")
+        thr = _number("unbalanced_force_threshold", unbalanced_force_threshold,
+                      "give a force in N, e.g. 100")
+        if not math.isfinite(hi):
+            raise ValueError(f"dt_max must be finite (got {dt_max!r}); fix: e.g. 1e4 s")
+        if not 0 < lo <= hi:
+            raise ValueError(f"dt_min must be > 0 and <= dt_max (got dt_min={dt_min!r}, "
+                             f"dt_max={dt_max!r}); fix: choose 0 < dt_min <= dt_max")
+        if not (0 < thr < math.inf):
+            raise ValueError(f"unbalanced_force_threshold must be finite and > 0 N "
+                             f"(got {unbalanced_force_threshold!r}); fix: e.g. 100 N")
+        self.dt_min, self.dt_max, self.unbalanced_force_threshold = lo, hi, thr
+        self._creep_time = 0.0
+        self._dt = None  # last step [s]; None: the next step is the first
+        self._n_steps = 0
+
+    @property
+    def creep_time(self):
+        """Accumulated creep time [s]."""
+        return self._creep_time
+
+    @property
+    def dt(self):
+        """Last creep step [s], or None before the first step."""
+        return self._dt
+
+    @property
+    def n_steps(self):
+        """Number of creep steps taken."""
+        return self._n_steps
+
+    def next_step(self, unbalanced_force):
+        """Take one creep step (paper Eq. 8), advance creep_time by it and return it.
+
+        Parameters
+        ----------
+        unbalanced_force : float
+            F_u after the last DEM relaxation [N], finite and >= 0.
+
+        Returns
+        -------
+        float
+            dt_b [s], in [dt_min, dt_max].
+        """
+        f = _number("unbalanced_force", unbalanced_force, "pass the DEM's unbalanced force in N")
+        if not (0 <= f < math.inf):
+            raise ValueError(f"unbalanced_force must be finite and >= 0 N (got {f!r}); "
+                             "a non-finite value means the DEM blew up")
+        if self._dt is None or f >= self.unbalanced_force_threshold:
+            dt = self.dt_min
+        else:
+            dt = min(2.0 * self._dt, self.dt_max)
+        self._dt = dt
+        self._creep_time += dt
+        self._n_steps += 1
+        return dt
+
+    def advance_many(self, unbalanced_forces):
+        """Take one step per value of ``unbalanced_forces`` [N]; return the summed creep time [s].
+
+        For degradation applied every k DEM steps: the caller applies Eq. 7 once for the
+        returned total (exact under frozen stresses, as the rate is then constant).
+        """
+        total = 0.0
+        for f in np.asarray(unbalanced_forces, dtype=float).ravel():
+            total += self.next_step(f)
+        return total
+
+    def reset_step(self):
+        """Make the next step dt_min again (e.g. after a bond broke); creep_time is kept."""
+        self._dt = None
+
+    def state_dict(self):
+        """JSON-serialisable state; :meth:`from_state` restores it bit-identically."""
+        return {"kind": self.KIND, "version": STATE_VERSION, "dt_min": self.dt_min,
+                "dt_max": self.dt_max,
+                "unbalanced_force_threshold": self.unbalanced_force_threshold,
+                "creep_time": self._creep_time, "dt": self._dt, "n_steps": self._n_steps}
+
+    @classmethod
+    def from_state(cls, state):
+        """Rebuild a clock from :meth:`state_dict` output (validated)."""
+        _check_state(state, cls.KIND)
+        clock = cls(state["dt_min"], state["dt_max"], state["unbalanced_force_threshold"])
+        t = _number("creep_time", state["creep_time"], "state is corrupt")
+        if not (0 <= t < math.inf):
+            raise ValueError(f"creep_time must be finite and >= 0 s (got {t!r})")
+        dt = state["dt"]
+        if dt is not None and not (clock.dt_min <= _number("dt", dt, "state is corrupt")
+                                   <= clock.dt_max):
+            raise ValueError(f"dt must be None or in [dt_min, dt_max] (got {dt!r})")
+        n = state["n_steps"]
+        if not (isinstance(n, int) and n >= 0):
+            raise ValueError(f"n_steps must be an int >= 0 (got {n!r})")
+        clock._creep_time, clock._dt, clock._n_steps = t, None if dt is None else float(dt), n
+        return clock
+
+
+def _bond_arrays(*arrays):
+    out = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in arrays))
+    if out[0].ndim != 1:
+        raise ValueError("bond arrays must be 1-D (one value per bond) or scalars")
+    return [np.array(a) for a in out]
+
+
+class EventClock:
+    """Event-driven creep clock: jump to the next bond failure under frozen stresses.
+
+    Each interval dt = min(earliest closed-form time to failure of the intact bonds, earliest
+    time at which a bond loses ``max_strength_loss_fraction`` of its CURRENT strength in either
+    channel (area mode: of its current area fraction), time left to ``time_limit``). If no
+    intact bond can ever fail under the frozen stresses, dt = inf (capped by the time left).
+
+    Parameters
+    ----------
+    max_strength_loss_fraction : float
+        Cap on the relative loss per interval [-], in (0, 1).
+    time_limit : float
+        Creep time at which the run ends [s], > 0, may be inf.
+    """
+
+    KIND = "EventClock"
+
+    def __init__(self, max_strength_loss_fraction=0.1, time_limit=math.inf):
+        f = _number("max_strength_loss_fraction", max_strength_loss_fraction, "e.g. 0.1")
+        if not 0 < f < 1:
+            raise ValueError(f"max_strength_loss_fraction must be in (0, 1) "
+                             f"(got {max_strength_loss_fraction!r}); fix: e.g. 0.1")
+        lim = _number("time_limit", time_limit, "give seconds or inf")
+        if not lim > 0:
+            raise ValueError(f"time_limit must be > 0 s or inf (got {time_limit!r})")
+        self.max_strength_loss_fraction, self.time_limit = f, lim
+        self._creep_time = 0.0
+        self._n_intervals = self._n_events = self._n_failures = 0
+
+    creep_time = property(lambda self: self._creep_time, doc="Accumulated creep time [s].")
+    n_intervals = property(lambda self: self._n_intervals, doc="Intervals advanced.")
+    n_events = property(lambda self: self._n_events, doc="Intervals that ended in a failure.")
+    n_failures = property(lambda self: self._n_failures, doc="Bonds failed at interval ends.")
+
+    @property
+    def finished(self):
+        """True once creep_time has reached time_limit."""
+        return self._creep_time >= self.time_limit
+
+    @staticmethod
+    def _failure_times(mode, jt, jc, sigma, tau, tphi, beta1, beta2, area):
+        if mode == "strength":
+            return corrosion.time_to_failure(jt, jc, sigma, tau, tphi, beta1, beta2)
+        return corrosion.time_to_failure_area(area, sigma, tau, jt, jc, tphi, beta1, beta2)
+
+    def next_interval(self, tensile_strength, cohesion, normal_stress, shear_stress,
+                      tan_friction, beta1, beta2, mode="strength", area_fraction=None,
+                      intact=None):
+        """Length of the next creep interval and the bonds that fail at its end.
+
+        Parameters
+        ----------
+        tensile_strength, cohesion : array_like
+            strength mode: current J^T, J^C [Pa]; area mode: intrinsic J^T0, J^C0 [Pa].
+        normal_stress, shear_stress : array_like
+            strength mode: sigma (tension positive), tau >= 0 [Pa]; area mode: the forces per
+            intact area p = F_n/A0, q = |F_s|/A0 [Pa].
+        tan_friction : array_like
+            tan(phi) [-].
+        beta1, beta2 : float
+            Law constants [Pa/s], [1/Pa].
+        mode : {'strength', 'area'}
+            Degradation mode (see :mod:`grainfrac_yade.corrosion`).
+        area_fraction : array_like, optional
+            a in (0, 1] [-]; required in area mode.
+        intact : array_like of bool, optional
+            Bonds to consider (default: all).
+
+        Returns
+        -------
+        dt : float
+            [s]; inf if nothing can fail and no time limit is set.
+        failing_index : ndarray of int
+            Indices (into the given arrays) of bonds with t_fail <= dt (1 + EVENT_REL_TOL);
+            empty when the loss cap or the time limit set dt.
+        """
+        mode = _check_mode(mode, area_fraction)
+        arrays = [tensile_strength, cohesion, normal_stress, shear_stress, tan_friction]
+        if mode == "area":
+            arrays.append(area_fraction)
+        jt, jc, sigma, tau, tphi, *rest = _bond_arrays(*arrays)
+        keep = np.ones(jt.shape, bool) if intact is None else np.broadcast_to(
+            np.asarray(intact, bool), jt.shape)
+        idx = np.flatnonzero(keep)
+        time_left = max(self.time_limit - self._creep_time, 0.0)
+        if idx.size == 0:
+            return min(math.inf, time_left), np.empty(0, int)
+        sub = [x[idx] for x in (jt, jc, sigma, tau, tphi, *rest)]
+        area = sub[5] if mode == "area" else None
+        t_fail, _ = self._failure_times(mode, *sub[:5], beta1, beta2, area)
+        t_first = float(np.min(t_fail))
+        if math.isinf(t_first):
+            return time_left, np.empty(0, int)
+        dt = min(t_first, self._loss_cap(mode, *sub[:4], beta1, beta2, area), time_left)
+        failing = idx[t_fail <= dt * (1.0 + EVENT_REL_TOL)]
+        return dt, failing
+
+    def _loss_cap(self, mode, jt, jc, sigma, tau, beta1, beta2, area):
+        """Earliest time any bond loses the set fraction of its current strength or area."""
+        f = self.max_strength_loss_fraction
+        if mode == "area":
+            return float(np.min(corrosion.area_time(area, (1.0 - f) * area, sigma, tau, jt, jc,
+                                                    beta1, beta2)))
+        t_cap = math.inf
+        for strength, stress in ((jt, sigma), (jc, tau)):
+            loss = f * strength
+            if np.any(loss > 0):  # a channel at strength 0 cannot lose more
+                rate = corrosion.degradation_rate(stress[loss > 0], beta1, beta2)
+                with np.errstate(over="ignore"):  # inf: that bond imposes no cap
+                    t_cap = min(t_cap, float(np.min(loss[loss > 0] / rate)))
+        return t_cap
+
+    def advance(self, dt, failing_index=()):
+        """Add dt [s] to creep_time and count the interval (and its failures); return creep_time."""
+        d = _number("dt", dt, "pass the dt returned by next_interval")
+        if not 0 <= d < math.inf:
+            raise ValueError(f"dt must be finite and >= 0 s (got {dt!r}); inf means stop")
+        n_fail = len(np.atleast_1d(failing_index))
+        self._creep_time += d
+        self._n_intervals += 1
+        self._n_events += n_fail > 0
+        self._n_failures += n_fail
+        return self._creep_time
+
+    @staticmethod
+    def apply(dt, failing_index, tensile_strength, cohesion, normal_stress, shear_stress,
+              tan_friction, beta1, beta2, mode="strength", area_fraction=None):
+        """Degraded state after dt under frozen stresses; failing bonds set to their failure point.
+
+        Arguments as in :meth:`next_interval`, plus ``dt`` [s] and ``failing_index``.
+
+        Returns
+        -------
+        (new_tensile_strength, new_cohesion) [Pa] in strength mode: a failing bond's strength
+        in its failure channel is set so that :func:`corrosion.failed_now` holds exactly
+        (J^T = sigma, or J^C = tau + sigma tan(phi) to the last bit); new_area_fraction [-] in
+        area mode (failing bonds at exactly their failure area fraction).
+        """
+        mode = _check_mode(mode, area_fraction)
+        fi = np.asarray(failing_index, dtype=int).ravel()
+        if mode == "area":
+            area, sigma, tau, jt, jc, tphi = _bond_arrays(area_fraction, normal_stress,
+                                                          shear_stress, tensile_strength,
+                                                          cohesion, tan_friction)
+            new = corrosion.degrade_area(area, sigma, tau, jt, jc, dt, beta1, beta2)
+            a_fail, _ = corrosion.area_failure_point(sigma, tau, jt, jc, tphi)
+            new[fi] = np.where(area[fi] > a_fail[fi], a_fail[fi], new[fi])  # already failed: keep
+            return new
+        jt, jc, sigma, tau, tphi = _bond_arrays(tensile_strength, cohesion, normal_stress,
+                                                shear_stress, tan_friction)
+        new_t, new_c = corrosion.degrade(jt, jc, sigma, tau, dt, beta1, beta2)
+        _, fmode = corrosion.time_to_failure(jt[fi], jc[fi], sigma[fi], tau[fi], tphi[fi],
+                                             beta1, beta2)
+        ten, sh = fi[fmode == corrosion.MODE_TENSION], fi[fmode == corrosion.MODE_SHEAR]
+        new_t[ten] = np.where(jt[ten] > sigma[ten], sigma[ten], new_t[ten])  # already failed: keep
+        target = np.maximum(tau[sh] + sigma[sh] * tphi[sh], 0.0)
+        for _ in range(4):  # undo rounding of J^C - sigma tan(phi): a few ulps at most
+            short = tau[sh] < corrosion.shear_strength(target, sigma[sh], tphi[sh])
+            target = np.where(short & (target > 0), np.nextafter(target, -np.inf), target)
+        not_yet = tau[sh] < corrosion.shear_strength(jc[sh], sigma[sh], tphi[sh])
+        new_c[sh] = np.where(not_yet, target, new_c[sh])
+        return new_t, new_c
+
+    def state_dict(self):
+        """JSON-serialisable state (time_limit inf is stored as None)."""
+        return {"kind": self.KIND, "version": STATE_VERSION,
+                "max_strength_loss_fraction": self.max_strength_loss_fraction,
+                "time_limit": None if math.isinf(self.time_limit) else self.time_limit,
+                "creep_time": self._creep_time, "n_intervals": self._n_intervals,
+                "n_events": self._n_events, "n_failures": self._n_failures}
+
+    @classmethod
+    def from_state(cls, state):
+        """Rebuild a clock from :meth:`state_dict` output (validated)."""
+        _check_state(state, cls.KIND)
+        lim = state["time_limit"]
+        clock = cls(state["max_strength_loss_fraction"], math.inf if lim is None else lim)
+        t = _number("creep_time", state["creep_time"], "state is corrupt")
+        if not 0 <= t < math.inf:
+            raise ValueError(f"creep_time must be finite and >= 0 s (got {t!r})")
+        counts = [state[k] for k in ("n_intervals", "n_events", "n_failures")]
+        if not all(isinstance(n, int) and n >= 0 for n in counts):
+            raise ValueError(f"interval/event/failure counters must be ints >= 0 (got {counts})")
+        clock._creep_time = t
+        clock._n_intervals, clock._n_events, clock._n_failures = counts
+        return clock
+
+
+def _check_mode(mode, area_fraction):
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES} (got {mode!r})")
+    if mode == "area" and area_fraction is None:
+        raise ValueError("area_fraction is required in mode='area'")
+    return mode
