@@ -133,6 +133,22 @@ class UcsParams:
 
 
 @dataclass(frozen=True, kw_only=True)
+class CreepParams:
+    """Constant-load creep test: ramp, servo hold, equilibrium and failure (issue 5)."""
+    ramp_strain_rate: float = _spec("1/s", "positive", "strain rate of the ramp to the creep load (DEM time)")
+    servo_response_steps: int = _spec("1", "positive_int", "DEM steps in which the servo removes a stress error")
+    servo_max_strain_rate: float = _spec("1/s", "positive", "largest platen strain rate the servo may use")
+    equilibrium_tolerance: float = _spec("1", "unit_interval_open",
+                                         "equilibrium: mean unbalanced force on free cells / mean bond force")
+    stress_tolerance: float = _spec("1", "unit_interval_open", "equilibrium: |held - target| / target")
+    check_period: int = _spec("1", "positive_int", "DEM steps between equilibrium checks")
+    max_relaxation_steps: int = _spec("1", "positive_int",
+                                      "no equilibrium at the held load within this many steps = failure")
+    failure_strain: float = _spec("1", "positive", "axial strain at which a run counts as failed (safety cap)")
+    record_period: int = _spec("1", "positive_int", "paper clock: law applications between history rows")
+
+
+@dataclass(frozen=True, kw_only=True)
 class CalibrationParams:
     """Scale factors that map the paper's UDEC values onto this YADE packing (issue 4).
 
@@ -153,6 +169,7 @@ class Parameters:
     numerics: NumericsParams
     stress_corrosion: StressCorrosionParams
     ucs: UcsParams
+    creep: CreepParams
     calibration: CalibrationParams
     sources: tuple = ()
 
@@ -190,6 +207,7 @@ SECTION_CLASSES = {
     "numerics": NumericsParams,
     "stress_corrosion": StressCorrosionParams,
     "ucs": UcsParams,
+    "creep": CreepParams,
     "calibration": CalibrationParams,
 }
 

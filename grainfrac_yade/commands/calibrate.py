@@ -31,6 +31,7 @@ def register(sub, common):
     p.add_argument("--rounds", type=int, default=2, help="fixed-point rounds after the 'before' round")
     p.add_argument("--target-ucs", type=float, default=TARGET_UCS)
     p.add_argument("--target-young", type=float, default=TARGET_YOUNG)
+    p.add_argument("--jobs", type=int, default=1, help="seeds run in parallel (one process each)")
     p.add_argument("--write", default=str(CALIBRATION_FILE), help="calibration file to (over)write")
     p.set_defaults(func=cmd_calibrate)
 
@@ -39,7 +40,6 @@ def cmd_calibrate(args) -> int:
     from ..cli import overrides_from_args
     from ..params import load_parameters
     from ..runio import prepare_run_dir, write_csv
-    from .ucs import run_ucs_to_folder
     base = overrides_from_args(args)
     params = load_parameters(extra_files=args.params, overrides=base)
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,
@@ -49,8 +49,8 @@ def cmd_calibrate(args) -> int:
     for rnd in range(args.rounds + 1):
         p = load_parameters(extra_files=args.params, overrides=base + [
             ("calibration.strength_scale", strength), ("calibration.stiffness_scale", stiffness)])
-        for seed in args.seeds:
-            s = run_ucs_to_folder(p, seed, out / f"round{rnd}_seed{seed}", overwrite=True)
+        folders = [out / f"round{rnd}_seed{seed}" for seed in args.seeds]
+        for seed, s in zip(args.seeds, _run_seeds(p, args.seeds, folders, args.jobs)):
             rows.append({"round": rnd, "seed": seed, "strength_scale": strength, "stiffness_scale": stiffness,
                          "ucs_pa": s["ucs_pa"], "young_pa": s["young_pa"], "poisson": s["poisson"],
                          "crack_initiation_pa": s["crack_initiation_pa"], "crack_damage_pa": s["crack_damage_pa"],
@@ -67,6 +67,23 @@ def cmd_calibrate(args) -> int:
     write_calibration_file(Path(args.write), rows, args, base)
     print(f"written {args.write} and {out / 'calibration.csv'}")
     return 0
+
+
+def _run_one(job):
+    from .ucs import run_ucs_to_folder
+    params, seed, folder = job
+    return run_ucs_to_folder(params, seed, folder, overwrite=True)
+
+
+def _run_seeds(params, seeds, folders, jobs):
+    """UCS summaries of ``seeds`` (in order), ``jobs`` processes at a time (spawned, one YADE each)."""
+    work = [(params, seed, folder) for seed, folder in zip(seeds, folders)]
+    if jobs <= 1:
+        return [_run_one(w) for w in work]
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
+        return list(pool.map(_run_one, work))
 
 
 def _stats(rows, key):

@@ -16,7 +16,11 @@ PLATEN_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
 
 
 class Platens:
-    """Top and bottom platen cells of a 2D scene; axial velocity control and measurements."""
+    """Top and bottom platen cells of a 2D scene; axial velocity control and measurements.
+
+    Listed among the scene's engines; it needs no call per step (YADE keeps the
+    velocity of blocked DOFs).
+    """
 
     name = "Platens"
 
@@ -84,5 +88,28 @@ class Platens:
         bottom = sum(f(b.id)[1] for b in self._bottom_bodies)
         return 0.5 * (top - bottom) / self.cross_section
 
+
+class StressServo:
+    """Holds the axial stress at a target by moving the platens (a driver, called before each step).
+
+    The platen closing speed is set from the stress error so that the error
+    would be removed in ``response_steps`` DEM steps on a specimen of axial
+    stiffness ``young`` x cross-section / height:
+
+        v = (target - stress) * height / (young * response_steps * dt)
+
+    clipped to +-``max_speed``.
+    """
+
+    name = "StressServo"
+
+    def __init__(self, platens: Platens, target: float, young: float, response_steps: int, max_speed: float):
+        self.platens, self.target = platens, target
+        self.gain = platens.height / (young * response_steps)
+        self.max_speed = max_speed
+        self.stress = 0.0
+
     def before_step(self, scene):
-        """Platen velocities are set once and kept by YADE (blocked DOFs keep their velocity)."""
+        self.stress = self.platens.axial_stress()
+        speed = (self.target - self.stress) * self.gain / scene.O.dt
+        self.platens.set_axial_velocity(float(np.clip(speed, -self.max_speed, self.max_speed)))

@@ -49,7 +49,8 @@ class GrainScene:
     interactions: list
     law: object
     newton: object
-    drivers: list = field(default_factory=list)
+    drivers: list = field(default_factory=list)   # called before every DEM step
+    extras: list = field(default_factory=list)    # listed engines acting between steps (platens, corrosion)
     broken: np.ndarray = None
     break_mode: np.ndarray = None
     break_step: np.ndarray = None
@@ -84,8 +85,8 @@ class GrainScene:
         return self.specimen.face_minerals[self.layout.bond_face]
 
     def engine_names(self) -> list:
-        """YADE engines (class names) followed by the Python-side drivers."""
-        return [type(e).__name__ for e in self.O.engines] + [d.name for d in self.drivers]
+        """YADE engines (class names), then the Python-side drivers and extras."""
+        return [type(e).__name__ for e in self.O.engines] + [d.name for d in self.drivers + self.extras]
 
     # ------------------------------------------------------------------ stepping
     def run(self, n_steps: int):

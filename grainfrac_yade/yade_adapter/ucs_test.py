@@ -35,7 +35,7 @@ def run_ucs(specimen, params, progress=None, scene=None):
     scene = scene or build_scene(specimen, params)
     ucs = params.ucs
     platens = Platens(scene, ucs.platen_lateral)
-    scene.drivers.append(platens)
+    scene.extras.append(platens)
     closing_speed = ucs.strain_rate * platens.height
     platens.set_axial_velocity(closing_speed)
     dt = scene.O.dt

@@ -1,0 +1,138 @@
+"""``creep``: constant-load creep test to failure; history, cracks, summary, figures."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import GrainfracError
+
+#: Fractions of the lifetime (or of the last creep time) at which crack maps are drawn (paper Fig. 7).
+MAP_FRACTIONS = (0.0, 0.5, 0.9, 1.0)
+
+
+def register(sub, common):
+    p = sub.add_parser("creep", help="constant-load creep test to failure with stress corrosion")
+    common(p)
+    load = p.add_mutually_exclusive_group(required=True)
+    load.add_argument("--stress", type=float, help="creep stress [Pa], e.g. 160e6")
+    load.add_argument("--ratio", type=float, help="driving-stress ratio sigma/sigma_c (sigma_c: --ucs, else "
+                                                  "calibration.reference_ucs, the calibrated mean UCS)")
+    p.add_argument("--ucs", type=float, help="UCS [Pa] that --ratio refers to")
+    p.add_argument("--clock", choices=("event", "paper"), help="stress_corrosion.clock")
+    p.set_defaults(func=cmd_creep)
+
+
+def resolve_stress(params, stress=None, ratio=None, ucs=None):
+    """(stress [Pa], ratio, ucs used [Pa]); the ratio refers to ``ucs`` or the calibrated mean UCS."""
+    ref = ucs if ucs is not None else params.calibration.reference_ucs
+    if stress is None:
+        if not (0 < ratio < 1):
+            raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")
+        stress = ratio * ref
+    if not (math.isfinite(stress) and stress > 0):
+        raise GrainfracError(f"--stress {stress}: must be a positive finite stress in Pa; fix: e.g. --stress 160e6")
+    if stress >= ref:
+        raise GrainfracError(f"--stress {stress:.4g} Pa is at or above the UCS it refers to ({ref:.4g} Pa): the "
+                             "specimen fails during the ramp; fix: give a stress below the UCS (or --ucs)")
+    return stress, stress / ref, ref
+
+
+def cmd_creep(args) -> int:
+    from ..cli import load_params_from_args
+    if args.clock:
+        args.overrides.append(f"stress_corrosion.clock={args.clock}")
+    params = load_params_from_args(args)
+    stress, ratio, ref = resolve_stress(params, args.stress, args.ratio, args.ucs)
+    out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
+    s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print)
+    life = f"lifetime {s['lifetime_s']:.4g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.4g} s"
+    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}), {s['clock']} clock: {life}, {s['n_events']} events, "
+          f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
+    return 0
+
+
+def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None) -> dict:
+    import time
+
+    from ..creep_analysis import creep_stages, damage_index
+    from ..plotting import crack_map
+    from ..runio import code_version, prepare_run_dir, write_csv, write_json
+    from ..specimen import build_specimen
+    from ..yade_adapter.creep_test import run_creep
+    from ..yade_adapter.ucs_test import bond_segments
+    t0 = time.time()
+    out = prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
+    specimen = build_specimen(params, seed)
+    run = run_creep(specimen, params, stress, progress=progress)
+    rows = run.rows
+    hist = {k: np.array([r[k] for r in rows]) for k in rows[0]}
+    broken_creep = hist["broken_total"] - run.ramp_broken
+    t_end = float(hist["creep_time_s"][-1])
+    lifetime = t_end if run.failed else None
+    primary_end, tertiary_start = (creep_stages(hist["creep_time_s"], hist["axial_strain"]) if run.failed
+                                   else (None, None))
+    hist["broken_creep"] = broken_creep
+    hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
+    hist = {("creep_time_s" if k == "creep_time_s" else k): v for k, v in hist.items()}
+    write_csv(out / "history.csv", hist)
+    write_crack_list(out / "cracks.csv", run)
+    summary = {
+        "lifetime_s": lifetime, "failed": run.failed, "failure_reason": run.failure_reason,
+        "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
+        "clock": params.stress_corrosion.clock, "mode": params.stress_corrosion.mode,
+        "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
+        "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
+        "n_bonds": run.scene.n_bonds, "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
+        "primary_end_s": primary_end, "tertiary_start_s": tertiary_start,
+        "seed": seed, "code_version": code_version(), "params": params.to_dict(),
+    }
+    write_json(out / "summary.json", summary)
+    strain_time_figure(hist, summary, out / "strain_time.png")
+    t_ref = lifetime if lifetime else t_end
+    for frac in MAP_FRACTIONS:
+        t = frac * t_ref
+        idx = np.flatnonzero(run.scene.broken & (run.break_time <= t))
+        crack_map(specimen, out / f"crack_map_t{frac:.2f}.png", bond_segments(run.scene, idx),
+                  run.scene.break_mode[idx],
+                  title=f"{stress / 1e6:.0f} MPa: cracks at t = {t:.4g} s ({frac:.0%} of "
+                        f"{'lifetime' if lifetime else 'run'})")
+    return summary
+
+
+def write_crack_list(path, run):
+    """cracks.csv: bond, creep time (-1 = during the ramp), mode, kind, position, orientation."""
+    from ..runio import write_csv
+    from ..yade_adapter.scene import SHEAR
+    sc = run.scene
+    idx = np.flatnonzero(sc.broken)
+    normal = sc.specimen.tessellation.face_normal[sc.layout.bond_face[idx]]
+    write_csv(path, {
+        "bond": idx, "creep_time_s": run.break_time[idx],
+        "mode": np.where(sc.break_mode[idx] == SHEAR, "shear", "tensile"),
+        "kind": np.where(sc.bond_is_inter[idx], "inter", "intra"),
+        "x_m": sc.layout.bond_point[idx, 0], "y_m": sc.layout.bond_point[idx, 1],
+        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0})
+
+
+def strain_time_figure(hist, summary, path):
+    from ..plotting import plt
+    t = hist["creep_time_s"]
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    ax.plot(t, hist["axial_strain"] * 100, drawstyle="steps-post", label="axial strain")
+    for key, label in (("primary_end_s", "end of primary"), ("tertiary_start_s", "start of tertiary")):
+        if summary.get(key) is not None:
+            ax.axvline(summary[key], color="grey", ls=":", lw=0.8)
+            ax.text(summary[key], ax.get_ylim()[0], " " + label, rotation=90, va="bottom", fontsize=7)
+    ax2 = ax.twinx()
+    ax2.plot(t, hist["broken_creep"], color="tab:red", lw=0.8, drawstyle="steps-post", label="broken bonds (creep)")
+    ax2.set_ylabel("broken bonds since creep start", color="tab:red")
+    ax.set_xlabel("creep time [s]")
+    ax.set_ylabel("axial strain [%]")
+    state = f"lifetime {summary['lifetime_s']:.4g} s" if summary["failed"] else "not failed"
+    ax.set_title(f"{summary['stress_pa'] / 1e6:.0f} MPa ({summary['clock']} clock): {state}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    from ..plotting import plt as _plt
+    _plt.close(fig)

@@ -1,0 +1,275 @@
+"""Constant-load creep test to failure with stress corrosion (issue 5).
+
+1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
+   stress reaches the target; bonds broken during the ramp are counted apart.
+2. Hold: a servo keeps the axial stress at the target (:class:`StressServo`).
+3. Creep: the stress-corrosion driver degrades bonds as creep time passes, with
+   the ``event`` clock (exact jump to the next failure at equilibrium, ours) or
+   the ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is
+   below the threshold, applied every ``engine_period`` DEM steps).
+
+Failure: the platens cannot hold the load at equilibrium -- no equilibrium at the
+held stress within ``creep.max_relaxation_steps`` DEM steps (the strain runs
+away) -- or the axial strain exceeds ``creep.failure_strain``.  Lifetime is the
+creep time at failure.  Creep time is separate from DEM time.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .. import corrosion
+from ..clocks import EVENT_REL_TOL, EventClock, PaperClock
+from .corrosion_engine import StressCorrosion
+from .platens import Platens, StressServo
+from .scene import SHEAR, TENSION, build_scene
+
+#: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
+#: is per metre of thickness; it is scaled by the layer thickness here.
+UDEC_UNIT_THICKNESS = 1.0
+#: Events between progress lines.
+PROGRESS_EVERY = 20
+
+
+class CreepRun:
+    """State and bookkeeping of one creep test."""
+
+    def __init__(self, specimen, params, target_stress, progress=None):
+        self.params, self.target = params, target_stress
+        self.progress = progress or (lambda msg: None)
+        self.t0 = time.time()
+        self.scene = build_scene(specimen, params)
+        self.platens = Platens(self.scene, params.ucs.platen_lateral)
+        self.scene.extras.append(self.platens)
+        self.free = np.setdiff1d(np.arange(specimen.n_cells), np.union1d(self.platens.top, self.platens.bottom))
+        self._free_bodies = [self.scene.O.bodies[int(b)] for b in self.scene.cell_body[self.free]]
+        self.rows, self.ramp_broken = [], 0
+        self.failed, self.failure_reason = False, ""
+        self.corr = None
+        self.n_events = 0
+        self.break_time = np.full(self.scene.n_bonds, np.nan)
+
+    # ------------------------------------------------------------------ measures
+    def unbalanced(self, mean_bond_force):
+        """Largest and mean resultant force on free cells [N], and mean / mean_bond_force."""
+        f = self.scene.O.forces.f
+        res = np.array([f(b.id).norm() for b in self._free_bodies])
+        rel = res.mean() / mean_bond_force if mean_bond_force > 0 else math.inf
+        return res.max(), rel
+
+    def mean_bond_force(self):
+        idx = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
+        sample = idx[:: max(1, len(idx) // 500)]
+        fn, fs = self.scene.bond_forces(sample)
+        return float(np.mean(np.hypot(fn, fs))) if len(sample) else 0.0
+
+    def at_equilibrium(self, servo):
+        _, rel = self.unbalanced(self.mean_bond_force())
+        return rel < self.params.creep.equilibrium_tolerance and \
+            abs(servo.stress - self.target) < self.params.creep.stress_tolerance * self.target
+
+    def record(self, creep_time, stress=None):
+        sc = self.scene
+        b, inter = sc.broken, sc.bond_is_inter
+        self.rows.append({
+            "creep_time_s": creep_time, "axial_strain": self.platens.axial_strain(),
+            "lateral_strain": self.platens.lateral_strain(),
+            "axial_stress_pa": self.platens.axial_stress() if stress is None else stress,
+            "broken_total": int(b.sum()), "broken_tensile": int((sc.break_mode == TENSION).sum()),
+            "broken_shear": int((sc.break_mode == SHEAR).sum()), "broken_inter": int((b & inter).sum()),
+            "broken_intra": int((b & ~inter).sum()), "macrocracks": self.count_macrocracks(),
+            "dem_steps": int(sc.O.iter), "wall_s": time.time() - self.t0})
+
+    def count_macrocracks(self):
+        """Broken bonds on faces whose every bond is broken and open (cells fully separated)."""
+        sc = self.scene
+        idx = np.flatnonzero(sc.broken)
+        if not len(idx):
+            return 0
+        open_ = np.array([sc.interactions[k].geom.penetrationDepth - sc.interactions[k].phys.initD < 0 for k in idx])
+        face = sc.layout.bond_face
+        n_faces = sc.specimen.tessellation.n_faces
+        bonds_per_face = np.bincount(face, minlength=n_faces)
+        open_per_face = np.bincount(face[idx[open_]], minlength=n_faces)
+        separated = (bonds_per_face == open_per_face) & (bonds_per_face > 0)
+        return int(separated[face[idx]].sum())
+
+    def mark_breaks(self, creep_time):
+        new = np.flatnonzero(self.scene.broken & np.isnan(self.break_time))
+        self.break_time[new] = creep_time
+
+    # ------------------------------------------------------------------ phases
+    def ramp(self):
+        cp = self.params.creep
+        self.platens.set_axial_velocity(cp.ramp_strain_rate * self.platens.height)
+        steps = max(1, int(round(1e-5 / (cp.ramp_strain_rate * self.scene.O.dt))))
+        peak = 0.0
+        while True:
+            self.scene.run(steps)
+            s = self.platens.axial_stress()
+            peak = max(peak, s)
+            if s >= self.target:
+                break
+            if self.platens.axial_strain() > cp.failure_strain or (peak > 0 and s < 0.7 * peak):
+                self.failed, self.failure_reason = True, "failed during the ramp: load above the specimen's strength"
+                break
+        self.mark_breaks(0.0)
+        self.ramp_broken = int(self.scene.broken.sum())
+        self.break_time[self.scene.broken] = -1.0  # ramp cracks: before creep time 0
+
+    def hold_servo(self):
+        cp = self.params.creep
+        young = max(self.target / max(self.platens.axial_strain(), 1e-6), 1e9)
+        self.servo = StressServo(self.platens, self.target, young, cp.servo_response_steps,
+                                 cp.servo_max_strain_rate * self.platens.height)
+        self.scene.drivers.append(self.servo)
+
+    def relax(self, creep_time):
+        """Run DEM steps until equilibrium at the held load; False (and failed) if it never comes."""
+        cp = self.params.creep
+        done = 0
+        self.last_relaxation_steps = 0
+        while done < cp.max_relaxation_steps:
+            self.scene.run(cp.check_period)
+            done += cp.check_period
+            self.last_relaxation_steps = done
+            self.mark_breaks(creep_time)
+            if self.check_failure():
+                return False
+            if self.at_equilibrium(self.servo):
+                return True
+        self.failed, self.failure_reason = True, "no equilibrium at the held load (strain runs away)"
+        return False
+
+    def run_event_clock(self):
+        self.clock = EventClock(self.params.stress_corrosion.max_strength_loss_fraction,
+                                self.params.stress_corrosion.creep_time_limit)
+        self.n_events = event_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion)
+
+    def run_paper_clock(self):
+        self.clock = PaperClock(self.params.stress_corrosion.dt_min, self.params.stress_corrosion.dt_max,
+                                self.params.stress_corrosion.unbalanced_force_threshold)
+        paper_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, self.params.creep)
+        self.n_events = int(np.sum(self.break_time > 0))
+
+    def check_failure(self):
+        """Set ``failed`` if the axial strain passed the cap; return it."""
+        cp = self.params.creep
+        if self.platens.axial_strain() > cp.failure_strain:
+            self.failed, self.failure_reason = True, f"axial strain above {cp.failure_strain}"
+        return self.failed
+
+    def record_now(self, creep_time):
+        self.record(creep_time, self.servo.stress)
+
+    def run(self):
+        self.ramp()
+        self.record(0.0)
+        if self.failed:
+            return self
+        self.hold_servo()
+        self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
+        self.scene.extras.append(self.corr)
+        if self.params.stress_corrosion.clock == "event":
+            self.run_event_clock()
+        else:
+            self.run_paper_clock()
+        return self
+
+
+def event_clock_loop(holder, corr, clock, sc) -> int:
+    """Event clock (ours): at equilibrium, jump to the next bond failure under frozen stresses; repeat.
+
+    ``holder`` relaxes the scene (``relax(creep_time) -> bool``), records rows (``record_now``) and
+    reports progress. Returns the number of events (intervals that ended in a failure).
+    """
+    n_events = 0
+    if not holder.relax(0.0):
+        return n_events
+    holder.record_now(0.0)
+    while True:
+        idx = corr.intact()
+        sigma, tau = corr.stresses(idx)
+        jt, jc = corr.law_arrays(idx)
+        area = corr.area_fraction[idx] if sc.mode == "area" else None
+        if sc.mode == "strength":
+            # Eq. 7 lowers strength, not stiffness: stresses stay frozen until a bond fails, so the
+            # jump to the next failure is exact and needs no loss cap (a cap on bonds whose strength
+            # heads to 0 without failing would cut the interval geometrically, never reaching it).
+            t_fail, _ = corrosion.time_to_failure(jt, jc, sigma, tau, corr.tan_phi[idx], sc.beta1, sc.beta2)
+            t_first = float(t_fail.min()) if len(t_fail) else math.inf
+            dt = min(t_first, max(clock.time_limit - clock.creep_time, 0.0))
+            failing = np.flatnonzero(t_fail <= dt * (1 + EVENT_REL_TOL)) if math.isfinite(dt) else []
+        else:
+            dt, failing = clock.next_interval(jt, jc, sigma, tau, corr.tan_phi[idx], sc.beta1, sc.beta2,
+                                              mode=sc.mode, area_fraction=area)
+        if math.isfinite(dt) and dt >= 0:
+            new = clock.apply(dt, failing, jt, jc, sigma, tau, corr.tan_phi[idx], sc.beta1, sc.beta2,
+                              mode=sc.mode, area_fraction=area)
+        if not math.isfinite(dt) or (dt <= 0 and not len(failing)):
+            break
+        if sc.mode == "area":
+            corr.area_fraction[idx] = new
+        else:
+            corr.tensile[idx], corr.cohesion[idx] = new
+        corr.write(idx)
+        if len(failing):
+            if sc.mode == "area":
+                _, modes = corrosion.area_failure_point(sigma[failing], tau[failing], jt[failing], jc[failing],
+                                                        corr.tan_phi[idx][failing])
+            else:
+                _, modes = corrosion.time_to_failure(jt[failing], jc[failing], sigma[failing], tau[failing],
+                                                     corr.tan_phi[idx][failing], sc.beta1, sc.beta2)
+            corr.hand_over_failures(idx[failing], sigma[failing], tau[failing], modes)
+            n_events += 1
+        clock.advance(dt, failing)
+        corr.creep_time = clock.creep_time
+        ok = holder.relax(clock.creep_time)
+        holder.record_now(clock.creep_time)
+        if n_events % PROGRESS_EVERY == 0 and len(failing):
+            holder.progress(f"t {clock.creep_time:.4g} s  events {n_events}  broken "
+                            f"{int(corr.scene.broken.sum())}  relaxation {holder.last_relaxation_steps} steps")
+        if not ok or clock.finished:
+            break
+    return n_events
+
+
+
+def paper_clock_loop(holder, corr, clock, sc, cp):
+    """Paper clock (Eq. 8): every ``engine_period`` DEM steps advance creep time by the doubled or
+    reset step and degrade all intact bonds for it (paper Eq. 7).
+
+    F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
+    thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
+    the mean bond force.  With ``engine_period`` k > 1 the k steps share the F_u of the last one.
+    """
+    scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
+    holder.record_now(0.0)
+    applications, not_balanced_steps = 0, 0
+    while clock.creep_time < sc.creep_time_limit:
+        corr.scene.run(sc.engine_period)
+        idx = corr.intact()
+        sigma, tau = corr.stresses(idx)
+        mean_force = float(np.mean(np.hypot(sigma, tau) * corr.area0[idx])) if len(idx) else 0.0
+        f_max, rel = holder.unbalanced(mean_force)
+        f_u = f_max / scale if sc.unbalanced_force_reference == "absolute" else rel
+        dt_b = clock.advance_many([f_u] * sc.engine_period)
+        corr.degrade_for(dt_b, idx, sigma, tau)
+        holder.mark_breaks(clock.creep_time)
+        applications += 1
+        balanced = rel < cp.equilibrium_tolerance
+        not_balanced_steps = 0 if balanced else not_balanced_steps + sc.engine_period
+        if applications % cp.record_period == 0:
+            holder.record_now(clock.creep_time)
+        if not holder.check_failure() and not_balanced_steps > cp.max_relaxation_steps:
+            holder.failed, holder.failure_reason = True, "no equilibrium at the held load (strain runs away)"
+        if holder.failed:
+            break
+    holder.record_now(clock.creep_time)
+
+
+def run_creep(specimen, params, target_stress, progress=None) -> CreepRun:
+    """Ramp, hold and creep ``specimen`` at ``target_stress`` [Pa]; returns the finished run."""
+    return CreepRun(specimen, params, target_stress, progress).run()

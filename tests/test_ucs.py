@@ -1,0 +1,53 @@
+"""Uniaxial compression: scene contents, strength ordering, rate independence, regression band."""
+import numpy as np
+import pytest
+
+from conftest import needs_yade
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.ucs_analysis import crack_damage_stress, elastic_constants, ucs_summary
+
+pytestmark = [needs_yade, pytest.mark.yade]
+
+SMALL = ["specimen.width=6e-3", "specimen.height=12e-3"]
+
+
+def _ucs(overrides, seed=1):
+    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    p = load_parameters(overrides=SMALL + overrides)
+    hist, result, scene, _ = run_ucs(build_specimen(p, seed), p)
+    return ucs_summary(hist), result, scene
+
+
+def test_elastic_constants_of_a_linear_history():
+    """E and nu recovered exactly from a synthetic linear-elastic branch (expected values are the inputs)."""
+    young, poisson = 60e9, 0.25
+    ea = np.linspace(0, 0.004, 81)
+    s = young * ea
+    s[60:] = s[60] - (ea[60:] - ea[60]) * 1e11   # softening after the peak
+    el = -poisson * ea
+    e, nu = elastic_constants(s, ea, el)
+    assert e == pytest.approx(young, rel=1e-9) and nu == pytest.approx(poisson, rel=1e-9)
+    # volumetric strain eps_a + eps_l keeps growing on a linear branch: reversal only at the peak
+    assert crack_damage_stress(s, ea, el) == pytest.approx(s.max())
+
+
+def test_ucs_scene_has_no_stress_corrosion_engine():
+    summary, result, scene = _ucs([])
+    assert scene.engine_names() == ["ForceResetter", "InsertionSortCollider", "InteractionLoop",
+                                    "NewtonIntegrator", "Platens"]
+    assert summary["ucs_pa"] > 0 and result["broken_total"] > 0
+
+
+def test_doubled_strengths_give_a_higher_ucs():
+    base, _, _ = _ucs([])
+    p = load_parameters()
+    doubled, _, _ = _ucs([("calibration.strength_scale", 2 * p.calibration.strength_scale)])
+    assert doubled["ucs_pa"] > 1.3 * base["ucs_pa"]
+
+
+def test_halving_the_loading_rate_changes_the_peak_by_less_than_2_percent():
+    p = load_parameters()
+    fast, _, _ = _ucs([])
+    slow, _, _ = _ucs([("ucs.strain_rate", 0.5 * p.ucs.strain_rate)])
+    assert abs(slow["ucs_pa"] / fast["ucs_pa"] - 1) < 0.02
