@@ -106,6 +106,7 @@ class NumericsParams:
 @dataclass(frozen=True, kw_only=True)
 class StressCorrosionParams:
     """Hillig-Charles stress corrosion (paper Eq. 7) and its creep clocks (Eq. 8 and ours)."""
+    enabled: bool = _spec("", "bool", "stress corrosion on (creep tests); off: the load is only held")
     beta1: float = _spec("Pa/s", "positive", "rate constant beta1 (paper Eq. 7)")
     beta2: float = _spec("1/Pa", "positive", "stress sensitivity beta2 (paper Eq. 7)")
     mode: str = _spec("", "choice", "what corrosion degrades", ("strength", "area"))
@@ -156,6 +157,7 @@ class CalibrationParams:
     """
     strength_scale: float = _spec("1", "positive", "multiplies J^T and J^C of every contact")
     stiffness_scale: float = _spec("1", "positive", "multiplies the series normal and shear stiffness of every bond")
+    reference_ucs: float = _spec("Pa", "positive", "UCS a driving-stress ratio refers to: calibrated mean")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -232,6 +234,10 @@ def _check_value(value: Any, spec: Mapping, source: str, key: str):
     def fail(problem, fix):
         raise ParameterError(source, key, problem, fix)
 
+    if check == "bool":
+        if not isinstance(value, bool):
+            fail(f"{value!r} is not true or false", "write true or false")
+        return value
     if check == "choice":
         choices = spec["choices"]
         if value not in choices:

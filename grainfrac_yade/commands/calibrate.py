@@ -96,8 +96,8 @@ def write_calibration_file(path: Path, rows, args, overrides):
     last_round = max(r["round"] for r in rows)
     last = [r for r in rows if r["round"] == last_round]
     lines = ["# Calibration of the YADE packing to the paper's granite (issue 4), written by",
-             "#   python3 -m grainfrac_yade calibrate " + " ".join(f"--set {k}={v}" if isinstance(k, str) else ""
-                                                           for k, v in overrides).strip(),
+             "#   python3 -m grainfrac_yade calibrate --seeds " + " ".join(map(str, args.seeds))
+             + f" --rounds {args.rounds} " + " ".join(f"--set {k}={v}" for k, v in overrides).strip(),
              f"# seeds {args.seeds}; targets: UCS {args.target_ucs / 1e6:.1f} MPa (paper, simulated),",
              f"# E {args.target_young / 1e9:.1f} GPa (LdB lab). Table 1 and 2 stay as printed; these factors scale",
              "# every bond alike. Why: rigid Voronoi cells bonded across faces are weaker and softer than",
@@ -113,5 +113,7 @@ def write_calibration_file(path: Path, rows, args, overrides):
     lines += ["", "[calibration]",
               f"strength_scale = {last[0]['strength_scale']:.6g}    # 1, multiplies J^T and J^C of every contact pair",
               f"stiffness_scale = {last[0]['stiffness_scale']:.6g}   # 1, multiplies the series k_n and k_s of every bond",
+              f"reference_ucs = {_stats(last, 'ucs_pa')[0]:.6g}     # Pa, calibrated mean UCS (round {last_round}): "
+              "what a driving-stress ratio refers to, as in the lab",
               ""]
     path.write_text("\n".join(lines))

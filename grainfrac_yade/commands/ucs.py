@@ -84,3 +84,14 @@ def stress_strain_figure(history, summary, path):
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
+
+
+def run_ucs_in_yade():
+    """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults)."""
+    from ..params import load_parameters
+    from ..yade_adapter.batch import read_table, run_folder_name
+    overrides, controls = read_table()
+    params = load_parameters(overrides=overrides)
+    out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
+    s = run_ucs_to_folder(params, int(controls["seed"]), out)
+    print(f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {s['young_pa'] / 1e9:.1f} GPa -> {out}")

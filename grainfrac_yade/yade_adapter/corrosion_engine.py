@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import corrosion
+from .scene import SHEAR
 
 #: Relative margin below the current load given to a bond that has reached its strength,
 #: so that YADE's strict ">" test breaks it on the next step.
@@ -91,7 +92,9 @@ class StressCorrosion:
         inter = self.scene.interactions
         for k, s, t, m in zip(idx, sigma, tau, modes):
             ph = inter[k].phys
-            if m == corrosion.MODE_TENSION:
+            if m == corrosion.MODE_CORRODED:  # nothing left; friction alone carries it: break it ourselves
+                self.scene.break_bonds([k], SHEAR)
+            elif m == corrosion.MODE_TENSION:
                 ph.FnMax = max(float(s * self.area0[k]) * (1 - BREAK_MARGIN), MIN_STRENGTH_FRACTION * ph.FnMax)
             else:  # shear (or corroded away): Mohr-Coulomb limit just below the shear force
                 fn = -s * self.area0[k]  # compression positive

@@ -170,6 +170,13 @@ class CreepRun:
         if self.failed:
             return self
         self.hold_servo()
+        if not self.params.stress_corrosion.enabled:
+            # control run: the load is held, nothing corrodes; equilibrium must come and stay
+            if self.relax(0.0):
+                self.scene.run(self.params.creep.max_relaxation_steps)
+                self.check_failure()
+            self.record(0.0, self.servo.stress)
+            return self
         self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
         self.scene.extras.append(self.corr)
         if self.params.stress_corrosion.clock == "event":

@@ -129,6 +129,21 @@ class GrainScene:
         self._tens_seen = n_tens
         return new
 
+    def break_bonds(self, indices, mode: int):
+        """Break bonds ourselves (no JCFpm crack record): no cohesion or tension, residual friction.
+
+        Used where the law cannot break a bond whose strength has gone, e.g. a compressed bond
+        corroded to nothing while friction alone carries its shear (area mode, mode 3).
+        """
+        for k in np.atleast_1d(indices):
+            ph = self.interactions[int(k)].phys
+            ph.isCohesive = False
+            ph.FnMax = ph.FsMax = 0.0
+            ph.tanFrictionAngle = float(self.tan_residual[k])
+            self.broken[k] = True
+            self.break_mode[k] = mode
+            self.break_step[k] = self.O.iter
+
     # ------------------------------------------------------------------ reading state
     def bond_forces(self, indices=None):
         """Normal force (tension positive) and shear force magnitude [N] of bonds.

@@ -1,0 +1,39 @@
+"""``analyze-ucs``: table and figure of UCS tests in a study folder (resolution, size, calibration)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+#: Columns that define a model variant in a UCS study.
+VARIANT = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height")
+MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "dem_steps")
+
+
+def register(sub, common):
+    p = sub.add_parser("analyze-ucs", help="summarise UCS runs of a study folder (CSV, markdown, PNG)")
+    p.add_argument("folder")
+    p.set_defaults(func=cmd_analyze_ucs)
+
+
+def cmd_analyze_ucs(args) -> int:
+    from ..analysis import collect_runs, group_stats
+    from ..errors import GrainfracError
+    folder = Path(args.folder)
+    runs = collect_runs(folder)
+    if runs.empty or "ucs_pa" not in runs:
+        raise GrainfracError(f"{folder}: no finished UCS runs (summary.json with ucs_pa); fix: run the study first")
+    runs = runs[runs["command"] == "ucs"]
+    stats = group_stats(runs, VARIANT, MEASURES)
+    runs.to_csv(folder / "ucs_runs.csv", index=False)
+    stats.to_csv(folder / "ucs_stats.csv", index=False)
+    lines = ["| spheres/cell | grain [mm] | specimen [mm] | n | UCS [MPa] | E [GPa] | Poisson | CI/UCS | CD/UCS "
+             "| DEM steps | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for _, r in stats.iterrows():
+        lines.append(
+            f"| {r[VARIANT[0]]:.0f} | {r[VARIANT[1]] * 1e3:.2f} | {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} "
+            f"| {r['ucs_pa_count']:.0f} | {r['ucs_pa_mean'] / 1e6:.1f} +- {r['ucs_pa_std'] / 1e6:.1f} "
+            f"| {r['young_pa_mean'] / 1e9:.1f} +- {r['young_pa_std'] / 1e9:.1f} | {r['poisson_mean']:.3f} "
+            f"| {r['crack_initiation_pa_mean'] / r['ucs_pa_mean']:.2f} | {r['crack_damage_pa_mean'] / r['ucs_pa_mean']:.2f} "
+            f"| {r['dem_steps_mean']:.0f} | {r['wall_s_mean']:.1f} |")
+    (folder / "ucs_stats.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    return 0

@@ -1,0 +1,75 @@
+"""Creep tests on a small specimen: control run without corrosion, load ordering, CLI outputs."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from conftest import ROOT, needs_yade
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.specimen import build_specimen
+
+pytestmark = [needs_yade, pytest.mark.yade]
+
+SMALL = ["specimen.width=6e-3", "specimen.height=12e-3", "stress_corrosion.creep_time_limit=1e30"]
+
+
+@pytest.fixture(scope="module")
+def small_ucs():
+    """UCS of the small specimen (seed 1), measured: creep loads are ratios of it."""
+    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    p = load_parameters(overrides=SMALL)
+    hist, *_ = run_ucs(build_specimen(p, 1), p)
+    return ucs_summary(hist)["ucs_pa"]
+
+
+def _creep(ratio, ucs, extra=()):
+    from grainfrac_yade.yade_adapter.creep_test import run_creep
+    p = load_parameters(overrides=SMALL + list(extra))
+    return run_creep(build_specimen(p, 1), p, ratio * ucs)
+
+
+def test_without_stress_corrosion_a_load_below_ucs_is_held(small_ucs):
+    run = _creep(0.85, small_ucs, ["stress_corrosion.enabled=false"])
+    assert not run.failed, run.failure_reason
+    assert "StressCorrosion" not in run.scene.engine_names()
+    assert run.servo.stress == pytest.approx(0.85 * small_ucs, rel=0.01)
+
+
+def test_higher_load_fails_sooner(small_ucs):
+    low, high = _creep(0.8, small_ucs), _creep(0.9, small_ucs)
+    assert low.failed and high.failed
+    t_low, t_high = low.rows[-1]["creep_time_s"], high.rows[-1]["creep_time_s"]
+    assert 0 < t_high < t_low
+    assert "StressCorrosion" in high.scene.engine_names()
+
+
+def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
+    out = tmp_path / "creep"
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "creep", "--width", "6e-3", "--height", "12e-3",
+                          "--seed", "1", "--ratio", "0.9", "--ucs", str(small_ucs), "--clock", "event",
+                          "--set", "stress_corrosion.creep_time_limit=1e30", "--out", str(out)],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert res.returncode == 0, res.stderr
+    s = json.loads((out / "summary.json").read_text())
+    for key in ("lifetime_s", "failed", "stress_pa", "driving_stress_ratio", "ucs_pa", "clock", "n_events",
+                "dem_steps", "wall_s", "primary_end_s", "tertiary_start_s", "params", "seed", "code_version"):
+        assert key in s
+    assert s["failed"] and s["lifetime_s"] > 0 and s["driving_stress_ratio"] == pytest.approx(0.9)
+    h = pd.read_csv(out / "history.csv")
+    assert h["damage_index"].iloc[0] == 0 and h["damage_index"].iloc[-1] == 1
+    assert np.all(np.diff(h["creep_time_s"]) >= 0)
+    c = pd.read_csv(out / "cracks.csv")
+    assert set(c["mode"]) <= {"tensile", "shear"} and len(c) == s["broken_total"]
+    for png in ("strain_time.png", "crack_map_t1.00.png"):
+        assert (out / png).stat().st_size > 10_000
+
+
+def test_load_above_ucs_is_one_clear_line(tmp_path):
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "creep", "--stress", "300e6", "--ucs", "200e6",
+                          "--out", str(tmp_path / "x")], capture_output=True, text=True, cwd=ROOT)
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
+    assert "above the UCS" in res.stderr and "fix:" in res.stderr

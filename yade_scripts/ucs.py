@@ -1,0 +1,15 @@
+"""Uniaxial compression test, one run per yade-batch row.
+
+    yade -x yade_scripts/ucs.py
+    yade-batch -j 2 params/resolution_small.table yade_scripts/ucs.py
+Columns: any parameter path (e.g. resolution.spheres_per_cell, specimen.grain_size), plus seed, out, study.
+Each row writes results/<study>/<row name>/ (summary.json, history.csv, figures).
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))))
+
+from grainfrac_yade.commands.ucs import run_ucs_in_yade  # noqa: E402
+
+run_ucs_in_yade()
