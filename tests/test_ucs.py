@@ -51,3 +51,23 @@ def test_halving_the_loading_rate_changes_the_peak_by_less_than_2_percent():
     fast, _, _ = _ucs([])
     slow, _, _ = _ucs([("ucs.strain_rate", 0.5 * p.ucs.strain_rate)])
     assert abs(slow["ucs_pa"] / fast["ucs_pa"] - 1) < 0.02
+
+
+# Regression band for the 10 x 20 mm specimen with the shipped (calibrated) parameters.
+# Derived from seeds 1-5 of params/resolution_small.table (1 sphere per cell, 1 mm grains), measured
+# on 2026-11-23: UCS 282.0, 247.9, 215.2, 266.0, 278.7 MPa -> mean 258.0, sd 27.5 MPa;
+# E 72.0, 72.4, 73.2, 70.0, 71.7 GPa -> mean 71.9, sd 1.2 GPa. Band: mean +- 3 sd of that seed
+# scatter, so a change of the model that moves one seed outside the spread of the others fails.
+UCS_BAND_PA = (258.0e6 - 3 * 27.5e6, 258.0e6 + 3 * 27.5e6)
+YOUNG_BAND_PA = (71.9e9 - 3 * 1.2e9, 71.9e9 + 3 * 1.2e9)
+
+
+def test_small_specimen_ucs_regression():
+    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3"])
+    hist, result, _, _ = run_ucs(build_specimen(p, 1), p)
+    s = ucs_summary(hist)
+    assert UCS_BAND_PA[0] <= s["ucs_pa"] <= UCS_BAND_PA[1]
+    assert YOUNG_BAND_PA[0] <= s["young_pa"] <= YOUNG_BAND_PA[1]
+    assert 0.1 < s["poisson"] < 0.4
+    assert s["crack_initiation_pa"] < s["crack_damage_pa"] <= s["ucs_pa"]

@@ -61,7 +61,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..runio import code_version, prepare_run_dir, write_csv, write_json
     from ..specimen import build_specimen
     from ..yade_adapter.creep_test import run_creep
-    from ..yade_adapter.ucs_test import bond_segments
+    from ..yade_adapter.scene import bond_segments
     t0 = time.time()
     out = prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
@@ -75,7 +75,6 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                                    else (None, None))
     hist["broken_creep"] = broken_creep
     hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
-    hist = {("creep_time_s" if k == "creep_time_s" else k): v for k, v in hist.items()}
     write_csv(out / "history.csv", hist)
     write_crack_list(out / "cracks.csv", run)
     summary = {
@@ -134,5 +133,4 @@ def strain_time_figure(hist, summary, path):
     ax.set_title(f"{summary['stress_pa'] / 1e6:.0f} MPa ({summary['clock']} clock): {state}")
     fig.tight_layout()
     fig.savefig(path, dpi=150)
-    from ..plotting import plt as _plt
-    _plt.close(fig)
+    plt.close(fig)

@@ -28,7 +28,7 @@ def specimen_record(specimen, layout) -> dict:
     return summary
 
 
-def bond_segments(specimen, layout) -> tuple:
+def bond_network_segments(specimen, layout) -> tuple:
     """(b, 2, 2) segments joining the two cell centroids of each bond, and is_inter."""
     t = specimen.tessellation
     cells = t.face_cells[layout.bond_face]
@@ -44,7 +44,7 @@ def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bo
     record["spheres_per_cell_parameter"] = params.resolution.spheres_per_cell
     write_json(Path(out) / "specimen.json", record)
     specimen_figure(specimen, Path(out) / "specimen.png",
-                    bonds=bond_segments(specimen, layout) if draw_bonds else None)
+                    bonds=bond_network_segments(specimen, layout) if draw_bonds else None)
     record["out"] = str(out)
     return record
 

@@ -29,7 +29,8 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     from ..runio import code_version, prepare_run_dir, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
-    from ..yade_adapter.ucs_test import bond_segments, run_ucs
+    from ..yade_adapter.scene import bond_segments
+    from ..yade_adapter.ucs_test import run_ucs
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)

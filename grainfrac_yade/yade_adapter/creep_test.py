@@ -24,7 +24,7 @@ from .. import corrosion
 from ..clocks import EVENT_REL_TOL, EventClock, PaperClock
 from .corrosion_engine import StressCorrosion
 from .platens import Platens, StressServo
-from .scene import SHEAR, TENSION, build_scene
+from .scene import broken_counts, build_scene
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
 #: is per metre of thickness; it is scaled by the layer thickness here.
@@ -71,16 +71,12 @@ class CreepRun:
             abs(servo.stress - self.target) < self.params.creep.stress_tolerance * self.target
 
     def record(self, creep_time, stress=None):
-        sc = self.scene
-        b, inter = sc.broken, sc.bond_is_inter
         self.rows.append({
             "creep_time_s": creep_time, "axial_strain": self.platens.axial_strain(),
             "lateral_strain": self.platens.lateral_strain(),
             "axial_stress_pa": self.platens.axial_stress() if stress is None else stress,
-            "broken_total": int(b.sum()), "broken_tensile": int((sc.break_mode == TENSION).sum()),
-            "broken_shear": int((sc.break_mode == SHEAR).sum()), "broken_inter": int((b & inter).sum()),
-            "broken_intra": int((b & ~inter).sum()), "macrocracks": self.count_macrocracks(),
-            "dem_steps": int(sc.O.iter), "wall_s": time.time() - self.t0})
+            **broken_counts(self.scene), "macrocracks": self.count_macrocracks(),
+            "dem_steps": int(self.scene.O.iter), "wall_s": time.time() - self.t0})
 
     def count_macrocracks(self):
         """Broken bonds on faces whose every bond is broken and open (cells fully separated)."""

@@ -6,27 +6,7 @@ import time
 import numpy as np
 
 from .platens import Platens
-from .scene import SHEAR, TENSION, build_scene
-
-
-def broken_counts(scene) -> dict:
-    """Broken bonds by mode (tensile, shear) and kind (inter-, intra-granular)."""
-    b, inter = scene.broken, scene.bond_is_inter
-    return {"broken_total": int(b.sum()),
-            "broken_tensile": int((scene.break_mode == TENSION).sum()),
-            "broken_shear": int((scene.break_mode == SHEAR).sum()),
-            "broken_inter": int((b & inter).sum()), "broken_intra": int((b & ~inter).sum())}
-
-
-def bond_segments(scene, indices) -> np.ndarray:
-    """(c, 2, 2) face pieces of bonds [m]: centred on the bond point, as long as the bond's share."""
-    lay, t = scene.layout, scene.specimen.tessellation
-    idx = np.asarray(indices, dtype=np.int64)
-    normal = t.face_normal[lay.bond_face[idx]]
-    tangent = np.column_stack([-normal[:, 1], normal[:, 0]])
-    half = 0.5 * lay.bond_area[idx] / scene.specimen.thickness
-    p = lay.bond_point[idx, :2]
-    return np.stack([p - half[:, None] * tangent, p + half[:, None] * tangent], axis=1)
+from .scene import broken_counts, build_scene
 
 
 def run_ucs(specimen, params, progress=None, scene=None):
