@@ -113,13 +113,23 @@ class StressCorrosionParams:
     clock: str = _spec("", "choice", "creep clock", ("event", "paper"))
     dt_min: float = _spec("s", "positive", "smallest creep step (paper Eq. 8)")
     dt_max: float = _spec("s", "positive", "largest creep step (paper Eq. 8)")
-    unbalanced_force_threshold: float = _spec("N or 1", "positive", "F_u threshold (paper Eq. 8)")
+    unbalanced_force_threshold: float = _spec("N", "positive",
+                                              "F_u threshold per metre of thickness (paper Eq. 8, UDEC 2D)")
+    relative_unbalanced_force_threshold: float = _spec("1", "positive",
+                                                       "F_u threshold as mean resultant / mean bond force")
     unbalanced_force_reference: str = _spec("", "choice", "F_u absolute [N] or relative",
                                             ("absolute", "relative"))
     engine_period: int = _spec("1", "positive_int", "DEM steps between applications of the law")
     max_strength_loss_fraction: float = _spec("1", "unit_interval_open",
                                               "event clock: largest relative strength loss per interval")
     creep_time_limit: float = _spec("s", "positive", "creep time after which a run stops unfailed")
+
+
+def unbalanced_threshold(sc: "StressCorrosionParams") -> float:
+    """The F_u threshold of the paper clock for the chosen reference (absolute N/m or relative)."""
+    if sc.unbalanced_force_reference == "absolute":
+        return sc.unbalanced_force_threshold
+    return sc.relative_unbalanced_force_threshold
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -4,7 +4,7 @@ import math
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.params import load_parameters
+from grainfrac_yade.params import load_parameters, unbalanced_threshold
 
 pytestmark = [needs_yade, pytest.mark.yade]
 
@@ -35,7 +35,7 @@ def _run(clock, sigma, tau, extra=()):
         c = EventClock(sc.max_strength_loss_fraction, sc.creep_time_limit)
         event_clock_loop(holder, holder.corr, c, sc)
     else:
-        c = PaperClock(sc.dt_min, sc.dt_max, sc.unbalanced_force_threshold)
+        c = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
         paper_clock_loop(holder, holder.corr, c, sc, p.creep)
     return holder, c, p
 

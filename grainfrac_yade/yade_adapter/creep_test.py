@@ -22,6 +22,7 @@ import numpy as np
 
 from .. import corrosion
 from ..clocks import EVENT_REL_TOL, EventClock, PaperClock
+from ..params import unbalanced_threshold
 from .corrosion_engine import StressCorrosion
 from .platens import Platens, StressServo
 from .scene import broken_counts, build_scene
@@ -145,8 +146,8 @@ class CreepRun:
         self.n_events = event_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion)
 
     def run_paper_clock(self):
-        self.clock = PaperClock(self.params.stress_corrosion.dt_min, self.params.stress_corrosion.dt_max,
-                                self.params.stress_corrosion.unbalanced_force_threshold)
+        sc = self.params.stress_corrosion
+        self.clock = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
         paper_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, self.params.creep)
         self.n_events = int(np.sum(self.break_time > 0))
 
