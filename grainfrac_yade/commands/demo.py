@@ -22,7 +22,7 @@ def cmd_demo(args) -> int:
     from .specimen import run_specimen
     from ..yade_adapter.scene import build_scene
     params = load_params_from_args(args)
-    out = Path(args.out or "results/demo")
+    out = Path(args.out or time.strftime("results/demo_%Y%m%d-%H%M%S"))  # a new folder each run
     t0 = time.time()
     print(f"[demo] building the specimen ({params.specimen.width * 1e3:.1f} x {params.specimen.height * 1e3:.1f} mm)")
     record = run_specimen(params, args.seed, out, draw_bonds=False, overwrite=args.overwrite)
