@@ -87,6 +87,12 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "primary_end_s": primary_end, "tertiary_start_s": tertiary_start,
         "seed": seed, "code_version": code_version(), "params": params.to_dict(),
     }
+    if run.initial_bond_stresses is not None:
+        write_csv(out / "bond_stresses_start.csv", run.initial_bond_stresses)
+        bond_stress_figure(run.initial_bond_stresses, stress, out / "bond_stresses_start.png")
+        t = run.initial_bond_stresses["shear_stress_pa"]
+        summary.update(shear_stress_p99_pa=float(np.percentile(t, 99)), shear_stress_max_pa=float(t.max()),
+                       shear_utilisation_max=float(np.max(run.initial_bond_stresses["shear_utilisation"])))
     write_json(out / "summary.json", summary)
     strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
@@ -113,6 +119,21 @@ def write_crack_list(path, run):
         "kind": np.where(sc.bond_is_inter[idx], "inter", "intra"),
         "x_m": sc.layout.bond_point[idx, 0], "y_m": sc.layout.bond_point[idx, 1],
         "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0})
+
+
+def bond_stress_figure(table, stress, path):
+    """Histograms of bond normal and shear stress at the start of the creep phase (issue 5c)."""
+    from ..plotting import plt
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for ax, key, label in ((axes[0], "normal_stress_pa", "normal stress (tension +) [MPa]"),
+                           (axes[1], "shear_stress_pa", "shear stress [MPa]")):
+        ax.hist(np.asarray(table[key]) / 1e6, bins=60, log=True)
+        ax.set_xlabel(label)
+        ax.set_ylabel("bonds")
+    fig.suptitle(f"bond stresses at the creep load {stress / 1e6:.0f} MPa (after the ramp)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
 
 
 def strain_time_figure(hist, summary, path):

@@ -50,6 +50,7 @@ class CreepRun:
         self.failed, self.failure_reason = False, ""
         self.corr = None
         self.n_events = 0
+        self.initial_bond_stresses = None
         self.break_time = np.full(self.scene.n_bonds, np.nan)
 
     # ------------------------------------------------------------------ measures
@@ -140,6 +141,17 @@ class CreepRun:
         self.failed, self.failure_reason = True, "no equilibrium at the held load (strain runs away)"
         return False
 
+    def bond_stress_table(self) -> dict:
+        """Normal (tension positive) and shear stress of every intact bond, with its utilisation."""
+        corr = self.corr
+        idx = corr.intact()
+        sigma, tau = corr.stresses(idx)
+        jt, jc = corr.law_arrays(idx)
+        limit = corrosion.shear_strength(jc, sigma, corr.tan_phi[idx])
+        return {"bond": idx, "normal_stress_pa": sigma, "shear_stress_pa": tau,
+                "tensile_utilisation": sigma / jt, "shear_utilisation": np.where(limit > 0, tau / limit, np.inf),
+                "inter": self.scene.bond_is_inter[idx]}
+
     def run_event_clock(self):
         self.clock = EventClock(self.params.stress_corrosion.max_strength_loss_fraction,
                                 self.params.stress_corrosion.creep_time_limit)
@@ -176,6 +188,8 @@ class CreepRun:
             return self
         self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
         self.scene.extras.append(self.corr)
+        if self.relax(0.0):
+            self.initial_bond_stresses = self.bond_stress_table()
         if self.params.stress_corrosion.clock == "event":
             self.run_event_clock()
         else:
