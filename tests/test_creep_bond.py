@@ -1,6 +1,8 @@
 """One bond under constant stress in YADE: creep clocks against the closed form (paper Eq. 7)."""
 import math
 
+import numpy as np
+
 import pytest
 
 from conftest import needs_yade
@@ -75,3 +77,23 @@ def test_paper_clock_tension_within_one_creep_step():
     assert holder.failed
     dt_max = p.stress_corrosion.dt_max
     assert t_exact - dt_max <= holder.lifetime <= t_exact + dt_max
+
+
+def test_engine_state_round_trip():
+    """The corrosion engine's whole state (strengths, area fractions, creep time) saves and restores."""
+    import json
+    from grainfrac_yade.clocks import EventClock
+    from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
+    p = _params("event")
+    a = BondUnderForce(p, 5e6, 0.0)
+    a.corr.degrade_for(1e6, [0], np.array([a.sigma0]), np.array([a.tau0]))
+    clock = EventClock(0.1)
+    clock.advance(1e6)
+    saved = json.loads(json.dumps({"engine": a.corr.state_dict(), "clock": clock.state_dict()}))
+    b = BondUnderForce(p, 5e6, 0.0)
+    b.corr.load_state(saved["engine"])
+    restored = EventClock.from_state(saved["clock"])
+    assert b.corr.creep_time == a.corr.creep_time == restored.creep_time == 1e6
+    np.testing.assert_array_equal(b.corr.tensile, a.corr.tensile)
+    assert b.scene.interactions[0].phys.FnMax == a.scene.interactions[0].phys.FnMax
+    assert a.corr.tensile[0] < a.corr.tensile0[0]
