@@ -281,6 +281,9 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
         not_balanced_steps = 0 if balanced else not_balanced_steps + sc.engine_period
         if applications % cp.record_period == 0:
             holder.record_now(clock.creep_time)
+        if applications % (PROGRESS_EVERY * 100) == 0:
+            holder.progress(f"t {clock.creep_time:.4g} s  step {clock.dt:.3g} s  F_u {f_u:.3g}  broken "
+                            f"{int(corr.scene.broken.sum())}  applications {applications}")
         if not holder.check_failure() and not_balanced_steps > cp.max_relaxation_steps:
             holder.failed, holder.failure_reason = True, "no equilibrium at the held load (strain runs away)"
         if holder.failed:
