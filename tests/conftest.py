@@ -1,6 +1,7 @@
 """Shared fixtures. YADE tests are skipped with a clear reason where YADE cannot be imported."""
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -39,3 +40,11 @@ def small_params():
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+@pytest.fixture
+def strict_floats():
+    """Floating-point warnings (numpy and Python) raise inside the test."""
+    with np.errstate(all="raise"), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        yield

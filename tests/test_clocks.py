@@ -1,7 +1,6 @@
 """Creep clocks: paper Eq. 8 step rule, event clock, checkpoint round trips, validation."""
 import json
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -14,12 +13,7 @@ TAN55 = math.tan(math.radians(55.0))  # K-feldspar/K-feldspar friction angle, Ta
 F_U = 100.0  # paper's unbalanced-force threshold [N]
 
 
-@pytest.fixture(autouse=True)
-def strict_floats():
-    """Every test runs with floating-point warnings as errors."""
-    with np.errstate(all="raise"), warnings.catch_warnings():
-        warnings.simplefilter("error")
-        yield
+pytestmark = pytest.mark.usefixtures("strict_floats")  # conftest: float warnings are errors
 
 
 # ------------------------------------------------------------------ PaperClock (Eq. 8)

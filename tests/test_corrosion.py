@@ -13,12 +13,7 @@ B1, B2 = 1e-3, 1e-7  # paper section 4.1: beta1 [Pa/s], beta2 [1/Pa]
 TAN55 = math.tan(math.radians(55.0))  # K-feldspar/K-feldspar friction angle, Table 2
 
 
-@pytest.fixture(autouse=True)
-def strict_floats():
-    """Every test runs with floating-point warnings as errors."""
-    with np.errstate(all="raise"), warnings.catch_warnings():
-        warnings.simplefilter("error")
-        yield
+pytestmark = pytest.mark.usefixtures("strict_floats")  # conftest: float warnings are errors
 
 
 # ------------------------------------------------------------------ strength mode (paper)
