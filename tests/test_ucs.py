@@ -46,11 +46,20 @@ def test_doubled_strengths_give_a_higher_ucs():
     assert doubled["ucs_pa"] > 1.3 * base["ucs_pa"]
 
 
-def test_halving_the_loading_rate_changes_the_peak_by_less_than_2_percent():
+# Rate independence is judged on the mean peak of three seeds. The single-seed peak of a specimen
+# this small is chaotic: any perturbation (halving the rate, or merely running on 2 OpenMP threads)
+# can move it by up to 5 %, in either direction, measured 2026-11-23 on 6 x 12 mm, 1 thread:
+#   seed 1: 268.8 / 268.8 / 282.0 MPa at 0.5 / 0.25 / 0.125 1/s
+#   seed 2: 272.1 / 268.2 / 268.0     seed 3: 355.0 / 355.5 / 355.5
+# Seed means: 298.6 / 297.5 / 301.8 MPa (0.4 % and 1.4 % per halving).
+RATE_SEEDS = (1, 2, 3)
+
+
+def test_halving_the_loading_rate_changes_the_mean_peak_by_less_than_2_percent():
     p = load_parameters()
-    fast, _, _ = _ucs([])
-    slow, _, _ = _ucs([("ucs.strain_rate", 0.5 * p.ucs.strain_rate)])
-    assert abs(slow["ucs_pa"] / fast["ucs_pa"] - 1) < 0.02
+    fast = np.mean([_ucs([], seed)[0]["ucs_pa"] for seed in RATE_SEEDS])
+    slow = np.mean([_ucs([("ucs.strain_rate", 0.5 * p.ucs.strain_rate)], seed)[0]["ucs_pa"] for seed in RATE_SEEDS])
+    assert abs(slow / fast - 1) < 0.02
 
 
 # Regression band for the 10 x 20 mm specimen with the shipped (calibrated) parameters.

@@ -6,6 +6,7 @@ its Python package lives outside ``sys.path`` (see shared/yade_notes.md).
 """
 from __future__ import annotations
 
+import os
 import sys
 
 from ..errors import GrainfracError
@@ -14,6 +15,10 @@ from ..errors import GrainfracError
 YADE_PY_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"
 #: The interpreter YADE is built for.
 DEBIAN_PYTHON = "/usr/bin/python3"
+#: OpenMP threads per YADE run unless the user sets OMP_NUM_THREADS: one thread makes a run
+#: deterministic (shared/yade_notes.md, determinism; with 2 threads a 6 x 12 mm UCS peak moved
+#: by 5 %, 268.8 vs 282.2 MPa, measured 2026-11-23); studies run in parallel across runs instead.
+DEFAULT_THREADS = "1"
 
 _yade = None
 
@@ -23,6 +28,7 @@ def load_yade():
     global _yade
     if _yade is not None:
         return _yade
+    os.environ.setdefault("OMP_NUM_THREADS", DEFAULT_THREADS)
     if YADE_PY_PATH not in sys.path:
         sys.path.insert(0, YADE_PY_PATH)
     try:
