@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +28,9 @@ def register(sub, common):
 def resolve_stress(params, stress=None, ratio=None, ucs=None):
     """(stress [Pa], ratio, ucs used [Pa]); the ratio refers to ``ucs`` or the calibrated mean UCS."""
     ref = ucs if ucs is not None else params.calibration.reference_ucs
+    if stress is None and ratio is None:
+        raise GrainfracError("no creep load: give a stress [Pa] or a driving-stress ratio (CLI --stress/--ratio, "
+                             "batch column stress/ratio); fix: e.g. ratio 0.7")
     if stress is None:
         if not (0 < ratio < 1):
             raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")
@@ -100,25 +104,29 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         t = frac * t_ref
         idx = np.flatnonzero(run.scene.broken & (run.break_time <= t))
         crack_map(specimen, out / f"crack_map_t{frac:.2f}.png", bond_segments(run.scene, idx),
-                  run.scene.break_mode[idx],
+                  run.scene.break_mode[idx], macro=run.macro_time[idx] <= t,
                   title=f"{stress / 1e6:.0f} MPa: cracks at t = {t:.4g} s ({frac:.0%} of "
                         f"{'lifetime' if lifetime else 'run'})")
     return summary
 
 
 def write_crack_list(path, run):
-    """cracks.csv: bond, creep time (-1 = during the ramp), mode, kind, position, orientation."""
+    """cracks.csv: bond, creep time (-1 = during the ramp), mode, kind, position, orientation,
+    segment end points and the creep time its cells separated (macrocrack; empty if never)."""
     from ..runio import write_csv
-    from ..yade_adapter.scene import SHEAR
+    from ..yade_adapter.scene import SHEAR, bond_segments
     sc = run.scene
     idx = np.flatnonzero(sc.broken)
     normal = sc.specimen.tessellation.face_normal[sc.layout.bond_face[idx]]
+    seg = bond_segments(sc, idx)
     write_csv(path, {
         "bond": idx, "creep_time_s": run.break_time[idx],
         "mode": np.where(sc.break_mode[idx] == SHEAR, "shear", "tensile"),
         "kind": np.where(sc.bond_is_inter[idx], "inter", "intra"),
         "x_m": sc.layout.bond_point[idx, 0], "y_m": sc.layout.bond_point[idx, 1],
-        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0})
+        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
+        "x0_m": seg[:, 0, 0], "y0_m": seg[:, 0, 1], "x1_m": seg[:, 1, 0], "y1_m": seg[:, 1, 1],
+        "macro_time_s": run.macro_time[idx]})
 
 
 def bond_stress_figure(table, stress, path):
@@ -155,3 +163,38 @@ def strain_time_figure(hist, summary, path):
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
+
+
+#: yade-batch columns of a creep row that are not model parameters [Pa or 1; 0 = not given].
+CREEP_ROW_COLUMNS = {"ratio": 0.0, "stress": 0.0, "ucs": 0.0}
+
+
+def run_creep_in_yade():
+    """Entry of ``yade_scripts/creep.py``: one creep run per yade-batch row.
+
+    Columns: ``ratio`` (driving-stress ratio) or ``stress`` [Pa], optional ``ucs`` [Pa] that the
+    ratio refers to (default: calibration.reference_ucs), ``seed``, ``study``, ``out``, and any
+    parameter path.  A row whose folder already holds a summary.json is skipped (a study can be
+    rerun to complete it); an unfinished folder is started again.
+    """
+    from pathlib import Path
+
+    from ..params import load_parameters
+    from ..yade_adapter.batch import read_table, run_folder_name
+    overrides, controls = read_table(CREEP_ROW_COLUMNS)
+    try:
+        params = load_parameters(overrides=overrides)
+        given = {k: (float(controls[k]) or None) for k in CREEP_ROW_COLUMNS}
+        stress, ratio, ref = resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
+    except GrainfracError as exc:
+        print(f"error: {exc}")
+        sys.exit(2)
+    name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
+    out = Path(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, name_parts + overrides)}")
+    if (out / "summary.json").exists():
+        print(f"creep row already finished, skipped: {out}")
+        return
+    s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
+                            overwrite=(out / "run.json").exists(), progress=print)
+    life = f"lifetime {s['lifetime_s']:.4g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.4g} s"
+    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {life} -> {out}")

@@ -52,6 +52,8 @@ class CreepRun:
         self.n_events = 0
         self.initial_bond_stresses = None
         self.break_time = np.full(self.scene.n_bonds, np.nan)
+        #: creep time at which each bond's face was first seen fully separated (macrocrack) [s]
+        self.macro_time = np.full(self.scene.n_bonds, np.nan)
 
     # ------------------------------------------------------------------ measures
     def unbalanced(self, mean_bond_force):
@@ -77,11 +79,14 @@ class CreepRun:
             "creep_time_s": creep_time, "axial_strain": self.platens.axial_strain(),
             "lateral_strain": self.platens.lateral_strain(),
             "axial_stress_pa": self.platens.axial_stress() if stress is None else stress,
-            **broken_counts(self.scene), "macrocracks": self.count_macrocracks(),
+            **broken_counts(self.scene), "macrocracks": self.count_macrocracks(creep_time),
             "dem_steps": int(self.scene.O.iter), "wall_s": time.time() - self.t0})
 
-    def count_macrocracks(self):
-        """Broken bonds on faces whose every bond is broken and open (cells fully separated)."""
+    def count_macrocracks(self, creep_time):
+        """Broken bonds on faces whose every bond is broken and open (cells fully separated).
+
+        Marks ``macro_time`` of bonds seen separated for the first time with ``creep_time``.
+        """
         sc = self.scene
         idx = np.flatnonzero(sc.broken)
         if not len(idx):
@@ -92,7 +97,9 @@ class CreepRun:
         bonds_per_face = np.bincount(face, minlength=n_faces)
         open_per_face = np.bincount(face[idx[open_]], minlength=n_faces)
         separated = (bonds_per_face == open_per_face) & (bonds_per_face > 0)
-        return int(separated[face[idx]].sum())
+        macro = idx[separated[face[idx]]]
+        self.macro_time[macro[np.isnan(self.macro_time[macro])]] = creep_time
+        return len(macro)
 
     def mark_breaks(self, creep_time):
         new = np.flatnonzero(self.scene.broken & np.isnan(self.break_time))
@@ -176,6 +183,7 @@ class CreepRun:
     def run(self):
         self.ramp()
         self.record(0.0)
+        self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp
         if self.failed:
             return self
         self.hold_servo()

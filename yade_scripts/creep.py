@@ -1,0 +1,15 @@
+"""Constant-load creep test to failure, one run per yade-batch row.
+
+    yade -x yade_scripts/creep.py                       (defaults: needs a ratio or stress column)
+    yade-batch -j 2 --log 'results/lifetime_small/%.log' params/lifetime_small.table yade_scripts/creep.py
+Columns: ratio (or stress [Pa]), optional ucs [Pa], seed, study, out, and any parameter path
+(e.g. stress_corrosion.clock). Each row writes results/<study>/<row name>/.
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))))
+
+from grainfrac_yade.commands.creep import run_creep_in_yade  # noqa: E402
+
+run_creep_in_yade()
