@@ -22,7 +22,22 @@ def register(sub, common):
                                                   "calibration.reference_ucs, the calibrated mean UCS)")
     p.add_argument("--ucs", type=float, help="UCS [Pa] that --ratio refers to")
     p.add_argument("--clock", choices=("event", "paper"), help="stress_corrosion.clock")
+    p.add_argument("--vtk-times", type=_times, default=None, metavar="T1,T2,...",
+                   help="write VTK files of cells and bonds (state, remaining strength) for ParaView at these "
+                        "creep times [s] and at the end, into DIR/vtk/ (e.g. --vtk-times 0,1e7)")
     p.set_defaults(func=cmd_creep)
+
+
+def _times(text: str) -> list:
+    """Comma-separated creep times [s] (argparse type)."""
+    import argparse
+    try:
+        times = [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of times in s (e.g. 0,1e7)")
+    if any(not math.isfinite(t) or t < 0 for t in times):
+        raise argparse.ArgumentTypeError(f"{text!r}: creep times must be finite and >= 0 s")
+    return times
 
 
 def resolve_stress(params, stress=None, ratio=None, ucs=None):
@@ -50,14 +65,16 @@ def cmd_creep(args) -> int:
     params = load_params_from_args(args)
     stress, ratio, ref = resolve_stress(params, args.stress, args.ratio, args.ucs)
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
-    s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print)
+    s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
+                            vtk_times=args.vtk_times)
     life = f"lifetime {s['lifetime_s']:.4g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.4g} s"
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}), {s['clock']} clock: {life}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
     return 0
 
 
-def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None) -> dict:
+def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None,
+                        vtk_times=None) -> dict:
     import time
 
     from ..creep_analysis import creep_stages, damage_index
@@ -69,7 +86,10 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     t0 = time.time()
     out = prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
-    run = run_creep(specimen, params, stress, progress=progress)
+    outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", {k: [r[k] for r in rows] for k in rows[0]})}
+    if vtk_times is not None:
+        outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
+    run = run_creep(specimen, params, stress, progress=progress, **outputs)
     rows = run.rows
     hist = {k: np.array([r[k] for r in rows]) for k in rows[0]}
     broken_creep = hist["broken_total"] - run.ramp_broken
@@ -89,6 +109,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
         "primary_end_s": primary_end, "tertiary_start_s": tertiary_start,
+        "vtk_creep_times_s": run.vtk_written,
         "seed": seed, "code_version": code_version(), "params": params.to_dict(),
     }
     if run.initial_bond_stresses is not None:

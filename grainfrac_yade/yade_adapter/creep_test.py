@@ -32,13 +32,22 @@ from .scene import broken_counts, build_scene
 UDEC_UNIT_THICKNESS = 1.0
 #: Events between progress lines.
 PROGRESS_EVERY = 20
+#: History rows between writes of the partial history (an interrupted run keeps what it measured).
+HISTORY_FLUSH_ROWS = 50
 
 
 class CreepRun:
     """State and bookkeeping of one creep test."""
 
-    def __init__(self, specimen, params, target_stress, progress=None):
+    def __init__(self, specimen, params, target_stress, progress=None, vtk_folder=None, vtk_times=(),
+                 history_sink=None):
         self.params, self.target = params, target_stress
+        #: VTK snapshots: folder and the creep times [s] still to write (the first equilibrium state
+        #: at or after each time; the final state is always written when a folder is given)
+        self.vtk_folder, self.vtk_times = vtk_folder, sorted(float(t) for t in vtk_times)
+        self.vtk_written = []
+        #: called with the rows so far every HISTORY_FLUSH_ROWS rows (partial history.csv)
+        self.history_sink = history_sink
         self.progress = progress or (lambda msg: None)
         self.t0 = time.time()
         self.scene = build_scene(specimen, params)
@@ -179,6 +188,17 @@ class CreepRun:
 
     def record_now(self, creep_time):
         self.record(creep_time, self.servo.stress)
+        while self.vtk_folder is not None and self.vtk_times and self.vtk_times[0] <= creep_time:
+            self.vtk_times.pop(0)
+            self.write_vtk(creep_time)
+        if self.history_sink is not None and len(self.rows) % HISTORY_FLUSH_ROWS == 0:
+            self.history_sink(self.rows)
+
+    def write_vtk(self, creep_time):
+        from .vtk_output import write_snapshot
+        if self.corr is not None:
+            write_snapshot(self.scene, self.corr, self.vtk_folder, len(self.vtk_written), creep_time)
+            self.vtk_written.append(creep_time)
 
     def run(self):
         self.ramp()
@@ -202,6 +222,8 @@ class CreepRun:
             self.run_event_clock()
         else:
             self.run_paper_clock()
+        if self.vtk_folder is not None:
+            self.write_vtk(self.rows[-1]["creep_time_s"])
         return self
 
 
@@ -299,6 +321,9 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
     holder.record_now(clock.creep_time)
 
 
-def run_creep(specimen, params, target_stress, progress=None) -> CreepRun:
-    """Ramp, hold and creep ``specimen`` at ``target_stress`` [Pa]; returns the finished run."""
-    return CreepRun(specimen, params, target_stress, progress).run()
+def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:
+    """Ramp, hold and creep ``specimen`` at ``target_stress`` [Pa]; returns the finished run.
+
+    ``outputs``: ``vtk_folder`` and ``vtk_times`` (VTK snapshots), ``history_sink`` (partial history).
+    """
+    return CreepRun(specimen, params, target_stress, progress, **outputs).run()
