@@ -73,3 +73,15 @@ def test_load_above_ucs_is_one_clear_line(tmp_path):
                           "--out", str(tmp_path / "x")], capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
     assert "above the UCS" in res.stderr and "fix:" in res.stderr
+
+
+def test_event_clock_lifetime_scales_exactly_with_beta1(small_ucs):
+    """Strength mode, event clock: Eq. 7 makes every time to failure proportional to 1/beta1 while
+    the sequence of failures is unchanged, so beta1 x 10 must give lifetime / 10 and the same cracks
+    (this is what makes a single calibration factor on beta1 meaningful)."""
+    base = _creep(0.8, small_ucs)
+    p = load_parameters()
+    fast = _creep(0.8, small_ucs, [("stress_corrosion.beta1", 10 * p.stress_corrosion.beta1)])
+    assert base.failed and fast.failed
+    assert fast.n_events == base.n_events and int(fast.scene.broken.sum()) == int(base.scene.broken.sum())
+    assert fast.rows[-1]["creep_time_s"] == pytest.approx(base.rows[-1]["creep_time_s"] / 10, rel=1e-9)

@@ -95,8 +95,9 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     broken_creep = hist["broken_total"] - run.ramp_broken
     t_end = float(hist["creep_time_s"][-1])
     lifetime = t_end if run.failed else None
-    primary_end, tertiary_start = (creep_stages(hist["creep_time_s"], hist["axial_strain"]) if run.failed
-                                   else (None, None))
+    # stages from the history before the collapse row (the failure itself would dominate every rate)
+    primary_end, tertiary_start = (creep_stages(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end)
+                                   if run.failed and len(rows) > 3 else (None, None))
     hist["broken_creep"] = broken_creep
     hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
     write_csv(out / "history.csv", hist)
@@ -168,14 +169,24 @@ def bond_stress_figure(table, stress, path):
 def strain_time_figure(hist, summary, path):
     from ..plotting import plt
     t = hist["creep_time_s"]
+    strain = hist["axial_strain"] * 100
     fig, ax = plt.subplots(figsize=(6, 4.2))
-    ax.plot(t, hist["axial_strain"] * 100, drawstyle="steps-post", label="axial strain")
+    ax.plot(t, strain, drawstyle="steps-post", label="axial strain")
+    if summary["failed"] and len(strain) > 2:
+        # scale to the creep before the collapse row; the collapse is marked, not drawn to scale
+        lo, hi = strain[:-1].min(), strain[:-1].max()
+        pad = 0.1 * max(hi - lo, 1e-6)
+        ax.set_ylim(lo - pad, hi + 3 * pad)
+        ax.annotate(f"failure (strain {strain[-1]:.2f} %)", xy=(t[-1], hi + 2.5 * pad), ha="right", fontsize=7,
+                    xytext=(t[-1], hi + 2.5 * pad))
     for key, label in (("primary_end_s", "end of primary"), ("tertiary_start_s", "start of tertiary")):
         if summary.get(key) is not None:
             ax.axvline(summary[key], color="grey", ls=":", lw=0.8)
             ax.text(summary[key], ax.get_ylim()[0], " " + label, rotation=90, va="bottom", fontsize=7)
     ax2 = ax.twinx()
     ax2.plot(t, hist["broken_creep"], color="tab:red", lw=0.8, drawstyle="steps-post", label="broken bonds (creep)")
+    if summary["failed"] and len(t) > 2:
+        ax2.set_ylim(0, 1.3 * max(hist["broken_creep"][:-1].max(), 1))
     ax2.set_ylabel("broken bonds since creep start", color="tab:red")
     ax.set_xlabel("creep time [s]")
     ax.set_ylabel("axial strain [%]")

@@ -1,36 +1,112 @@
-"""``demo``: the main job. Builds the paper-size specimen and its YADE scene, writes summary and picture.
+"""``demo``: the main job, a small lifetime study end to end.
 
-Later issues grow it into a small lifetime study (UCS, creep at three ratios, analysis).
+1. specimen summary and picture (seed 1);
+2. UCS of the small specimen for each seed (yade-batch, ``yade_scripts/ucs.py``): the mean
+   is the UCS the driving-stress ratios refer to, as a lab refers to its mean UCS;
+3. creep to failure at each ratio and seed (yade-batch, ``yade_scripts/creep.py``);
+4. the analysis report of the creep runs (``analyze``).
+
+About 3-4 min on 2 cores with the defaults (measured in the notes); every run writes a new
+``results/demo_<date-time>/`` unless ``--out`` is given.
 """
 from __future__ import annotations
 
+import json
+import os
 import time
 from pathlib import Path
 
+#: Demo defaults: a 10 x 20 mm specimen (about 200 cells; a creep run takes 15-40 s on one core).
+DEMO_WIDTH_M, DEMO_HEIGHT_M = 10e-3, 20e-3
+DEMO_SEEDS = (1, 2)
+DEMO_RATIOS = (0.7, 0.8, 0.9)
+
+
+def _floats(text):
+    return [float(x) for x in text.split(",") if x.strip()]
+
+
+def _ints(text):
+    return [int(x) for x in text.split(",") if x.strip()]
+
 
 def register(sub, common):
-    p = sub.add_parser("demo", help="main job: paper-size specimen (grows into a small lifetime study)")
+    p = sub.add_parser("demo", help="main job: small lifetime study (specimen, UCS, creep at 3 ratios, report)")
     common(p, geometry=False)
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--ratios", type=_floats, default=list(DEMO_RATIOS), help="driving-stress ratios, e.g. 0.7,0.8,0.9")
+    p.add_argument("--seeds", type=_ints, default=list(DEMO_SEEDS), help="specimen seeds, e.g. 1,2")
+    p.add_argument("--width", type=float, default=DEMO_WIDTH_M, help="specimen width [m]")
+    p.add_argument("--height", type=float, default=DEMO_HEIGHT_M, help="specimen height [m]")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: cores)")
     p.set_defaults(func=cmd_demo)
 
 
+def _say(t0, msg):
+    print(f"[demo {time.time() - t0:6.0f} s] {msg}", flush=True)
+
+
 def cmd_demo(args) -> int:
+    from ..batchrun import run_batch, write_table
     from ..cli import load_params_from_args
-    from ..runio import write_json
-    from ..specimen import build_specimen
+    from ..errors import GrainfracError
     from .specimen import run_specimen
-    from ..yade_adapter.scene import build_scene
-    params = load_params_from_args(args)
-    out = Path(args.out or time.strftime("results/demo_%Y%m%d-%H%M%S"))  # a new folder each run
     t0 = time.time()
-    print(f"[demo] building the specimen ({params.specimen.width * 1e3:.1f} x {params.specimen.height * 1e3:.1f} mm)")
-    record = run_specimen(params, args.seed, out, draw_bonds=False, overwrite=args.overwrite)
-    print("[demo] building the YADE scene")
-    scene = build_scene(build_specimen(params, args.seed), params)
-    record.update(n_bonds_yade=scene.O.interactions.countReal(), dem_timestep_s=scene.O.dt,
-                  engines=scene.engine_names(), wall_s=time.time() - t0)
-    write_json(out / "specimen.json", {k: v for k, v in record.items() if k != "out"})
-    print(f"[demo] {record['n_cells']} cells, {record['n_bonds_yade']} bonds, DEM step {scene.O.dt:.3g} s")
-    print(f"[demo] done in {record['wall_s']:.1f} s: {out / 'specimen.json'}, {out / 'specimen.png'}")
+    repo = Path(__file__).resolve().parents[2]
+    out = Path(args.out or time.strftime("results/demo_%Y%m%d-%H%M%S")).resolve()  # a new folder each run
+    if out.exists() and any(out.iterdir()) and not args.overwrite:
+        raise GrainfracError(f"{out} already holds results; fix: choose another --out or add --overwrite")
+    geometry = [("specimen.width", args.width), ("specimen.height", args.height)]
+    args.overrides = list(args.overrides) + [f"{k}={v}" for k, v in geometry]
+    params = load_params_from_args(args)   # validates --params/--set before anything runs
+    extra = _flat_overrides(args.params, args.overrides)
+    _say(t0, f"specimen {args.width * 1e3:.0f} x {args.height * 1e3:.0f} mm, seeds {args.seeds}, "
+             f"ratios {args.ratios}, {args.jobs} jobs -> {out}")
+    rec = run_specimen(params, args.seeds[0], out / "specimen", overwrite=args.overwrite)
+    _say(t0, f"specimen: {rec['n_cells']} cells, {rec['n_bonds']} bonds")
+
+    ucs_rows = [dict(extra, seed=s, out=str(out / "ucs" / f"seed{s}")) for s in args.seeds]
+    table = write_table(out / "ucs.table", ucs_rows, "UCS rows of the demo")
+    run_batch(table, repo / "yade_scripts" / "ucs.py", args.jobs, out / "logs_ucs",
+              watch=[r["out"] for r in ucs_rows], repo=repo,
+              progress=lambda w: _say(t0, f"UCS {w.name}: {_read(w)['ucs_pa'] / 1e6:.1f} MPa"))
+    ucs = [_read(Path(r["out"]))["ucs_pa"] for r in ucs_rows if (Path(r["out"]) / "summary.json").exists()]
+    if not ucs:
+        raise GrainfracError(f"no UCS run finished; see the logs in {out / 'logs_ucs'}")
+    ucs_mean = sum(ucs) / len(ucs)
+    _say(t0, f"mean UCS {ucs_mean / 1e6:.1f} MPa ({len(ucs)} seeds): the reference of the ratios")
+
+    creep_rows = [dict(extra, ratio=r, ucs=ucs_mean, seed=s, out=str(out / "creep" / f"ratio{r:g}_seed{s}"))
+                  for r in args.ratios for s in args.seeds]
+    table = write_table(out / "creep.table", creep_rows, f"creep rows of the demo; ucs = mean of {len(ucs)} seeds")
+    run_batch(table, repo / "yade_scripts" / "creep.py", args.jobs, out / "logs_creep",
+              watch=[r["out"] for r in creep_rows], repo=repo, progress=lambda w: _say(t0, _creep_line(w)))
+    missing = [r["out"] for r in creep_rows if not (Path(r["out"]) / "summary.json").exists()]
+    if missing:
+        _say(t0, f"{len(missing)} creep rows did not finish (listed in the report): {missing}")
+
+    from ..analysis.report import analyze_study
+    report = analyze_study(out / "creep")
+    _say(t0, f"done. Report: {report}")
     return 0
+
+
+def _flat_overrides(files, overrides) -> dict:
+    """``--params`` files and ``section.key=value`` overrides as {path: value} columns of table rows."""
+    from ..params import _flatten, parse_override, read_toml
+    out = {}
+    for path in files:
+        out.update(_flatten(read_toml(path)))
+    for item in overrides:
+        key, value = parse_override(item) if isinstance(item, str) else item
+        out[key] = value
+    return out
+
+
+def _read(folder: Path) -> dict:
+    return json.loads((folder / "summary.json").read_text())
+
+
+def _creep_line(folder: Path) -> str:
+    s = _read(folder)
+    life = f"lifetime {s['lifetime_s']:.3g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.3g} s"
+    return f"creep {folder.name}: {s['stress_pa'] / 1e6:.0f} MPa, {life}, {s['n_events']} events"
