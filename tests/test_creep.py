@@ -51,7 +51,7 @@ def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
     out = tmp_path / "creep"
     res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "creep", "--width", "6e-3", "--height", "12e-3",
                           "--seed", "1", "--ratio", "0.9", "--ucs", str(small_ucs), "--clock", "event",
-                          "--set", "stress_corrosion.creep_time_limit=1e30", "--out", str(out)],
+                          "--set", "stress_corrosion.creep_time_limit=1e30", "--vtk-times", "0", "--out", str(out)],
                          capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 0, res.stderr
     s = json.loads((out / "summary.json").read_text())
@@ -64,6 +64,9 @@ def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
     assert np.all(np.diff(h["creep_time_s"]) >= 0)
     c = pd.read_csv(out / "cracks.csv")
     assert set(c["mode"]) <= {"tensile", "shear"} and len(c) == s["broken_total"]
+    assert sorted(p.name for p in (out / "vtk").iterdir()) == ["bonds_0000.vtk", "bonds_0001.vtk", "cells_0000.vtk",
+                                                               "cells_0001.vtk"]   # creep time 0 and the end
+    assert s["vtk_creep_times_s"] == [0.0, s["lifetime_s"]]
     for png in ("strain_time.png", "crack_map_t1.00.png"):
         assert (out / png).stat().st_size > 10_000
 
