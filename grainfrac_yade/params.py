@@ -123,6 +123,13 @@ class StressCorrosionParams:
     max_strength_loss_fraction: float = _spec("1", "unit_interval_open",
                                               "event clock: largest relative strength loss per interval")
     creep_time_limit: float = _spec("s", "positive", "creep time after which a run stops unfailed")
+    rate_form: str = _spec("", "choice", "beta: beta1/beta2 as given; physical: from Eq. 6 at temperature",
+                           ("beta", "physical"))
+    rate_prefactor: float = _spec("Pa/s", "nonnegative", "lambda_r v0 of paper Eq. 6 (rate_form physical)")
+    activation_energy: float = _spec("J/mol", "nonnegative",
+                                     "E + V_m gamma/rho of paper Eq. 6 (rate_form physical)")
+    activation_volume: float = _spec("m^3/mol", "nonnegative", "V of paper Eq. 6 (rate_form physical)")
+    temperature: float = _spec("K", "positive", "absolute temperature T of paper Eq. 6 (rate_form physical)")
 
 
 def unbalanced_threshold(sc: "StressCorrosionParams") -> float:
@@ -441,7 +448,22 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
         raise ParameterError(origins.get("stress_corrosion.dt_min", "parameters"), "stress_corrosion.dt_min",
                              f"dt_min = {sc.dt_min:g} s exceeds dt_max = {sc.dt_max:g} s",
                              "make dt_min <= dt_max")
+    typed["stress_corrosion"] = _rate_constants(sc, origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
+
+
+def _rate_constants(sc: StressCorrosionParams, origins: Mapping) -> StressCorrosionParams:
+    """With ``rate_form = "physical"``, beta1 and beta2 are computed from paper Eq. 6 at the temperature."""
+    if sc.rate_form == "beta":
+        return sc
+    from .arrhenius import betas_from_physical
+    for key, unit in (("rate_prefactor", "Pa/s"), ("activation_energy", "J/mol"), ("activation_volume", "m^3/mol")):
+        if getattr(sc, key) <= 0:
+            raise ParameterError(origins.get(f"stress_corrosion.{key}", "parameters"), f"stress_corrosion.{key}",
+                                 "must be > 0 with rate_form = physical (the paper gives only beta1, beta2 at 25 C)",
+                                 f"set it [{unit}] from your data, e.g. with arrhenius.physical_from_betas")
+    beta1, beta2 = betas_from_physical(sc.rate_prefactor, sc.activation_energy, sc.activation_volume, sc.temperature)
+    return dataclasses.replace(sc, beta1=beta1, beta2=beta2)
 
 
 def _composition(table: Mapping, origins: Mapping) -> dict:

@@ -1,5 +1,7 @@
 """Parameter loading: the shipped files, the averaging rule, and every kind of bad input."""
 import math
+
+import numpy as np
 import subprocess
 import sys
 
@@ -139,3 +141,27 @@ def test_cli_prints_one_line_no_traceback(tmp_path):
     assert len(lines) == 1 and "Traceback" not in res.stderr
     assert "composition" in lines[0] and "fix:" in lines[0]
     assert not (tmp_path / "x").exists()
+
+
+def test_temperature_form_reproduces_beta_at_25C_and_follows_eq6():
+    """Paper Eq. 6: beta2 = V/RT scales as 1/T; beta1 = A exp(-E/RT) (Arrhenius)."""
+    from grainfrac_yade.arrhenius import GAS_CONSTANT, physical_from_betas
+    p = load_parameters()
+    energy = 6.0e4   # J/mol: any positive value; the identities below hold for all
+    prefactor, volume = physical_from_betas(p.stress_corrosion.beta1, p.stress_corrosion.beta2, energy, 298.15)
+    form = [("stress_corrosion.rate_form", "physical"), ("stress_corrosion.rate_prefactor", prefactor),
+            ("stress_corrosion.activation_energy", energy), ("stress_corrosion.activation_volume", volume)]
+    at25 = load_parameters(overrides=form).stress_corrosion
+    assert at25.beta1 == pytest.approx(p.stress_corrosion.beta1, rel=1e-12)
+    assert at25.beta2 == pytest.approx(p.stress_corrosion.beta2, rel=1e-12)
+    at80 = load_parameters(overrides=form + [("stress_corrosion.temperature", 353.15)]).stress_corrosion
+    assert at80.beta2 == pytest.approx(p.stress_corrosion.beta2 * 298.15 / 353.15, rel=1e-12)
+    expected = p.stress_corrosion.beta1 * np.exp(-energy / GAS_CONSTANT * (1 / 353.15 - 1 / 298.15))
+    assert at80.beta1 == pytest.approx(expected, rel=1e-12) and at80.beta1 > at25.beta1
+
+
+def test_temperature_form_without_activation_energy_is_one_clear_error():
+    with pytest.raises(ParameterError, match="activation_energy.*fix:"):
+        load_parameters(overrides=[("stress_corrosion.rate_form", "physical"),
+                                   ("stress_corrosion.rate_prefactor", 1.0),
+                                   ("stress_corrosion.activation_volume", 1e-4)])
