@@ -1,4 +1,4 @@
-"""Collect run folders into one pandas DataFrame (one row per run; unfinished runs kept)."""
+"""Collect run folders into one pandas DataFrame (one row per run; unfinished and unreadable runs kept)."""
 from __future__ import annotations
 
 import json
@@ -21,25 +21,58 @@ def _get(tree: dict, dotted: str):
     return node
 
 
-def collect_runs(root) -> pd.DataFrame:
-    """One row per folder under ``root`` holding a run.json; ``status`` is finished or unfinished."""
-    rows = []
-    for run_json in sorted(Path(root).rglob("run.json")):
-        folder = run_json.parent
-        run = json.loads(run_json.read_text())
-        row = {"run": str(folder.relative_to(root)) if folder != Path(root) else ".",
-               "command": run.get("command"), "seed": run.get("seed")}
-        params_file = folder / "params.json"
-        if params_file.exists():
-            params = json.loads(params_file.read_text())
-            row.update({k: _get(params, k) for k in PARAM_COLUMNS})
-        summary_file = folder / "summary.json"
-        if summary_file.exists():
-            summary = json.loads(summary_file.read_text())
-            row.update({k: v for k, v in summary.items() if not isinstance(v, (dict, list))})
-            row["status"] = "finished"
+def flatten(tree: dict, prefix: str = "") -> dict:
+    """Nested dict -> {"section.key": value} (lists kept as tuples so that they compare and hash)."""
+    out = {}
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(flatten(value, name + "."))
         else:
-            row["status"] = "unfinished"
+            out[name] = tuple(value) if isinstance(value, list) else value
+    return out
+
+
+def _read_json(path: Path) -> dict:
+    """A JSON object from ``path``; ValueError with a short reason if it is not one."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{path.name}: {type(exc).__name__}: {exc}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{path.name}: not a JSON object")
+    return data
+
+
+def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
+    """One row per folder under ``root`` holding a run.json.
+
+    ``status`` is ``finished`` (summary.json present), ``unfinished`` (no summary.json yet) or
+    ``unreadable`` (a JSON file that cannot be parsed; ``problem`` says which). ``folder`` is the
+    run folder's path. With ``all_params`` every parameter of params.json becomes a column
+    (dotted name); otherwise only :data:`PARAM_COLUMNS`.
+    """
+    root = Path(root)
+    rows = []
+    for run_json in sorted(root.rglob("run.json")):
+        folder = run_json.parent
+        row = {"run": str(folder.relative_to(root)) if folder != root else ".", "folder": str(folder)}
+        try:
+            run = _read_json(run_json)
+            row.update({"command": run.get("command"), "seed": run.get("seed")})
+            params_file = folder / "params.json"
+            if params_file.exists():
+                params = _read_json(params_file)
+                row.update(flatten(params) if all_params else {k: _get(params, k) for k in PARAM_COLUMNS})
+            summary_file = folder / "summary.json"
+            if summary_file.exists():
+                summary = _read_json(summary_file)
+                row.update({k: v for k, v in summary.items() if not isinstance(v, (dict, list))})
+                row["status"] = "finished"
+            else:
+                row["status"] = "unfinished"
+        except ValueError as exc:
+            row.update(status="unreadable", problem=str(exc))
         rows.append(row)
     return pd.DataFrame(rows)
 

@@ -1,0 +1,99 @@
+"""Lifetimes of creep runs: which runs enter a fit, which are lower bounds; scatter per load level.
+
+Outcome of each run folder (column ``outcome``):
+
+- ``failed``: the specimen failed at creep time t_f > 0 (a point of the lifetime fit);
+- ``failed at load``: failed at creep time 0 (no creep life; ln 0 is undefined, so not in the fit);
+- ``not failed``: the run ended at ``creep_time_end_s`` without failure: a lower bound of the
+  lifetime, drawn but not fitted;
+- ``unfinished``: no summary.json yet (running, killed or crashed);
+- ``unreadable``: a JSON file that cannot be parsed, or a summary that contradicts itself;
+- ``not creep``: another command's run in the same folder (e.g. a UCS test), ignored.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from .fits import RATIO_DECIMALS
+
+#: Minimum number of failed runs at one ratio for a scatter statistic (issue 6: three seeds).
+MIN_SEEDS_FOR_STATS = 3
+
+
+def _num(value) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return float("nan")
+    return value
+
+
+def outcome(row) -> str:
+    """Outcome of one row of :func:`~grainfrac_yade.analysis.collect.collect_runs` (see module doc)."""
+    if row.get("status") == "unreadable":
+        return "unreadable"
+    if row.get("command") != "creep":
+        return "not creep"
+    if row.get("status") != "finished":
+        return "unfinished"
+    failed = row.get("failed")
+    if failed is True or failed == 1:
+        life = _num(row.get("lifetime_s"))
+        if not math.isfinite(life) or life < 0:
+            return "unreadable"
+        return "failed" if life > 0 else "failed at load"
+    if failed is False or failed == 0:
+        return "not failed" if math.isfinite(_num(row.get("creep_time_end_s"))) else "unreadable"
+    return "unreadable"
+
+
+def classify_runs(runs: pd.DataFrame) -> pd.DataFrame:
+    """Copy of ``runs`` with ``outcome`` and a load-level column ``ratio`` (rounded driving-stress ratio)."""
+    runs = runs.copy()
+    if runs.empty:
+        runs["outcome"] = pd.Series(dtype=object)
+        runs["ratio"] = pd.Series(dtype=float)
+        return runs
+    runs["outcome"] = [outcome(r) for r in runs.to_dict("records")]
+    ratio = runs["driving_stress_ratio"] if "driving_stress_ratio" in runs else pd.Series(np.nan, index=runs.index)
+    runs["ratio"] = pd.to_numeric(ratio, errors="coerce").round(RATIO_DECIMALS)
+    return runs
+
+
+def lifetime_stats(ratio, lifetime, min_count: int = MIN_SEEDS_FOR_STATS) -> pd.DataFrame:
+    """Scatter of lifetimes per ratio with at least ``min_count`` points.
+
+    Geometric mean 10^mean(log10 t), standard deviation of log10 t (sample, ddof 1), min, max and
+    the spread log10(max / min) in decades.
+    """
+    frame = pd.DataFrame({"ratio": np.round(np.asarray(ratio, float), RATIO_DECIMALS),
+                          "log10_t": np.log10(np.asarray(lifetime, float))})
+    rows = []
+    for r, g in frame.groupby("ratio"):
+        if len(g) < min_count:
+            continue
+        lg = g["log10_t"].to_numpy()
+        rows.append({"driving_stress_ratio": r, "n": len(lg), "geomean_lifetime_s": 10 ** lg.mean(),
+                     "sd_log10_lifetime": lg.std(ddof=1), "min_lifetime_s": 10 ** lg.min(),
+                     "max_lifetime_s": 10 ** lg.max(), "spread_decades": lg.max() - lg.min()})
+    columns = ["driving_stress_ratio", "n", "geomean_lifetime_s", "sd_log10_lifetime", "min_lifetime_s",
+               "max_lifetime_s", "spread_decades"]
+    return pd.DataFrame(rows, columns=columns)
+
+
+def representatives(runs: pd.DataFrame) -> pd.DataFrame:
+    """One run per (variant, ratio): the failed run with the median lifetime, else the longest
+    not-failed run, else the failed-at-load run with the lowest seed."""
+    keep = []
+    usable = runs[runs["outcome"].isin(["failed", "not failed", "failed at load"]) & runs["ratio"].notna()]
+    for _, g in usable.groupby(["variant", "ratio"], sort=True):
+        failed = g[g["outcome"] == "failed"].sort_values("lifetime_s")
+        if len(failed):
+            keep.append(failed.index[(len(failed) - 1) // 2])
+            continue
+        survived = g[g["outcome"] == "not failed"].sort_values("creep_time_end_s")
+        keep.append(survived.index[-1] if len(survived) else g.sort_values("seed").index[0])
+    return runs.loc[keep].sort_values(["variant", "ratio"])
