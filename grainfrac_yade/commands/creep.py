@@ -28,6 +28,15 @@ def register(sub, common):
     p.set_defaults(func=cmd_creep)
 
 
+def outcome(summary: dict) -> str:
+    """One phrase: lifetime, failure on loading, or not failed by the end."""
+    if summary.get("failed_on_loading"):
+        return "failed on loading (during the ramp)"
+    if summary["failed"]:
+        return f"lifetime {summary['lifetime_s']:.4g} s"
+    return f"not failed by {summary['creep_time_end_s']:.4g} s"
+
+
 def _times(text: str) -> list:
     """Comma-separated creep times [s] (argparse type)."""
     import argparse
@@ -67,8 +76,7 @@ def cmd_creep(args) -> int:
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
     s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
                             vtk_times=args.vtk_times)
-    life = f"lifetime {s['lifetime_s']:.4g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.4g} s"
-    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}), {s['clock']} clock: {life}, {s['n_events']} events, "
+    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
     return 0
 
@@ -104,6 +112,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     write_crack_list(out / "cracks.csv", run)
     summary = {
         "lifetime_s": lifetime, "failed": run.failed, "failure_reason": run.failure_reason,
+        "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
         "clock": params.stress_corrosion.clock, "mode": params.stress_corrosion.mode,
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
@@ -228,5 +237,4 @@ def run_creep_in_yade():
         return
     s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
                             overwrite=(out / "run.json").exists(), progress=print)
-    life = f"lifetime {s['lifetime_s']:.4g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.4g} s"
-    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {life} -> {out}")
+    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {outcome(s)} -> {out}")

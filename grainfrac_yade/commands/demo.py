@@ -107,6 +107,6 @@ def _read(folder: Path) -> dict:
 
 
 def _creep_line(folder: Path) -> str:
+    from .creep import outcome
     s = _read(folder)
-    life = f"lifetime {s['lifetime_s']:.3g} s" if s["failed"] else f"not failed by {s['creep_time_end_s']:.3g} s"
-    return f"creep {folder.name}: {s['stress_pa'] / 1e6:.0f} MPa, {life}, {s['n_events']} events"
+    return f"creep {folder.name}: {s['stress_pa'] / 1e6:.0f} MPa, {outcome(s)}, {s['n_events']} events"

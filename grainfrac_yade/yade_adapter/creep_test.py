@@ -57,6 +57,7 @@ class CreepRun:
         self._free_bodies = [self.scene.O.bodies[int(b)] for b in self.scene.cell_body[self.free]]
         self.rows, self.ramp_broken = [], 0
         self.failed, self.failure_reason = False, ""
+        self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
         self.corr = None
         self.n_events = 0
         self.initial_bond_stresses = None
@@ -128,6 +129,7 @@ class CreepRun:
                 break
             if self.platens.axial_strain() > cp.failure_strain or (peak > 0 and s < 0.7 * peak):
                 self.failed, self.failure_reason = True, "failed during the ramp: load above the specimen's strength"
+                self.failed_on_loading = True
                 break
         self.mark_breaks(0.0)
         self.ramp_broken = int(self.scene.broken.sum())
