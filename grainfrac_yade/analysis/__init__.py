@@ -1,2 +1,17 @@
-"""Analysis of run folders (no YADE): collect summaries into tables, draw the paper's figures."""
+"""Analysis of run folders (no YADE): collect summaries into tables, fit lifetimes, draw the paper's figures.
+
+Modules: :mod:`.collect` (run folders -> DataFrame), :mod:`.lifetimes` (run outcomes, scatter per
+ratio), :mod:`.fits` (static-fatigue laws), :mod:`.labdata` (lab CSV, paper reference values),
+:mod:`.figures` and :mod:`.crackmaps` (PNG), :mod:`.report` (markdown), :mod:`.study`
+(``analyze_study``: a study folder -> report.md; imports matplotlib).
+"""
 from .collect import collect_runs, group_stats  # noqa: F401
+from .fits import coefficient_table, fit_lifetimes, fit_line  # noqa: F401
+from .lifetimes import classify_runs, lifetime_stats  # noqa: F401
+
+
+def __getattr__(name):
+    if name == "analyze_study":   # lazily: pulls in matplotlib
+        from .study import analyze_study
+        return analyze_study
+    raise AttributeError(name)

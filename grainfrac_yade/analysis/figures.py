@@ -1,0 +1,251 @@
+"""Figures of a creep study (paper Fig. 4, 5, 6 and 9); each function writes one PNG and returns its path.
+
+Inputs are plain arrays and DataFrames (history.csv tables, lifetime sets); nothing here reads
+run folders. Strain is compression positive and drawn in %.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from ..plotting import plt
+from .fits import CONFIDENCE, LifetimeFit
+
+DPI = 130
+PERCENT = 100.0
+#: Fit lines extend this far beyond the data's ratio range (driving-stress ratio units).
+FIT_MARGIN = 0.02
+#: Padding of the strain axis around the creep before the collapse row (fraction of the range).
+STRAIN_PAD = 0.08
+STAGE_MARKERS = {"primary_end_s": ("o", "end of primary creep"), "tertiary_start_s": ("^", "start of tertiary creep")}
+
+
+@dataclass
+class LifetimeSet:
+    """Lifetimes of one data set: failed points (fitted), lower bounds (not failed; drawn only) and the fit."""
+    label: str
+    ratio: np.ndarray
+    lifetime_s: np.ndarray
+    fit: LifetimeFit | None = None
+    lower_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    lower_time_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sources: np.ndarray | None = None   # lab: one label per point
+    at_load_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))   # failed at t = 0 (not fitted)
+
+
+@dataclass
+class Curve:
+    """One run's history for the time plots; ``t_ref_s`` = lifetime (failed) or the run's end time."""
+    label: str
+    history: pd.DataFrame
+    failed: bool
+    t_ref_s: float
+    stages: dict = field(default_factory=dict)   # primary_end_s, tertiary_start_s (None if unknown)
+    broken_ramp: float = 0.0
+
+
+def _save(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
+
+
+def _fit_lines(ax, fit: LifetimeFit, ratios, colour, label):
+    lo, hi = max(np.min(ratios) - FIT_MARGIN, 1e-3), np.max(ratios) + FIT_MARGIN
+    grid = np.linspace(lo, hi, 200)
+    pct = f"{CONFIDENCE:.0%}"
+    ax.plot(grid, fit.lifetime_exponential(grid), color=colour, lw=1.4,
+            label=f"{label}: ln t = {fit.a:.3g} - {fit.b:.3g} r")
+    ax.plot(grid, fit.lifetime_power(grid), color=colour, lw=1.2, ls="--",
+            label=f"{label}: t = {np.exp(fit.ln_A):.3g} s r^-{fit.n:.3g}")
+    if fit.exponential.dof > 0:
+        ax.fill_between(grid, *fit.band_exponential(grid), color=colour, alpha=0.15, lw=0,
+                        label=f"{label}: {pct} band (mean line)")
+        ax.fill_between(grid, *fit.band_power(grid), color=colour, alpha=0.08, lw=0, hatch="//",
+                        label=f"{label}: {pct} band, power law (hatched)")
+
+
+def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=None):
+    """Lifetime vs driving-stress ratio, log time (paper Fig. 4): model points, lower bounds, both fits
+    with confidence bands; lab points and fits, or the paper's UDEC value and the 1986 bound."""
+    fig, ax = plt.subplots(figsize=(7.2, 5.2))
+    colours = plt.cm.tab10.colors
+    all_ratios = []
+    for k, s in enumerate(model_sets):
+        c = colours[k % 10]
+        if len(s.ratio):
+            ax.scatter(s.ratio, s.lifetime_s, s=22, color=c, edgecolors="k", linewidths=0.4, zorder=3,
+                       label=f"{s.label}: failed runs ({len(s.ratio)})")
+        if len(s.lower_ratio):
+            ax.scatter(s.lower_ratio, s.lower_time_s, s=30, facecolors="none", edgecolors=c, marker="o", zorder=3,
+                       label=f"{s.label}: not failed by end time (lower bound, not fitted; {len(s.lower_ratio)})")
+            for r, t in zip(s.lower_ratio, s.lower_time_s):
+                ax.annotate("", xy=(r, t * 4), xytext=(r, t), arrowprops=dict(arrowstyle="->", color=c, lw=0.8))
+        if s.fit is not None:
+            _fit_lines(ax, s.fit, s.ratio, c, s.label)
+        if len(s.at_load_ratio):
+            # ln 0 has no place on a log axis: drawn on the bottom edge (axes coordinates in y)
+            ax.scatter(s.at_load_ratio, np.full(len(s.at_load_ratio), 0.01), marker="x", color=c, s=30, zorder=3,
+                       transform=ax.get_xaxis_transform(), clip_on=False,
+                       label=f"{s.label}: failed at load, t = 0 (bottom edge; not fitted; {len(s.at_load_ratio)})")
+        all_ratios += list(s.ratio) + list(s.lower_ratio) + list(s.at_load_ratio)
+    if lab is not None:
+        sources = lab.sources if lab.sources is not None else np.array([lab.label] * len(lab.ratio))
+        for k, src in enumerate(pd.unique(sources)):
+            sel = sources == src
+            ax.scatter(lab.ratio[sel], lab.lifetime_s[sel], s=20, marker="sdv^<>"[k % 6], color="0.35",
+                       facecolors="none", zorder=2, label=f"lab: {src} ({int(sel.sum())})")
+        if lab.fit is not None:
+            _fit_lines(ax, lab.fit, lab.ratio, "0.2", "lab")
+        all_ratios += list(lab.ratio)
+    if reference is not None:
+        ax.scatter([reference.ratio], [reference.lifetime_s], marker="*", s=140, color="gold", edgecolors="k",
+                   zorder=4, label=f"paper (UDEC): {reference.stress_pa / 1e6:.0f} MPa, "
+                                   f"r = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s")
+        all_ratios += [reference.ratio, reference.long_term_strength_ratio]
+    lo = min(all_ratios) - 0.05 if all_ratios else 0.5
+    hi = max(all_ratios) + 0.05 if all_ratios else 1.0
+    ax.set_xlim(lo, hi)
+    if reference is not None:
+        lts = reference.long_term_strength_ratio
+        ax.axvspan(lo, lts, color="0.85", alpha=0.6, lw=0, zorder=0,
+                   label=f"Lajtai & Schmidtke 1986: long-term strength < {lts:.0%} of UCS (lies here)")
+        ax.axvline(lts, color="0.4", lw=1, ls=":")
+    ax.set_yscale("log")
+    ax.set_xlabel("driving-stress ratio sigma / sigma_c [-]")
+    ax.set_ylabel("lifetime (time to failure) [s]")
+    ax.set_title("Lifetime vs driving-stress ratio (paper Fig. 4)")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=6, loc="upper right", framealpha=0.85)
+    return _save(fig, path)
+
+
+def _pre_collapse(curve: Curve) -> pd.DataFrame:
+    """History rows before the collapse row of a failed run (the failure row would dominate the scale)."""
+    h = curve.history
+    return h.iloc[:-1] if curve.failed and len(h) > 2 else h
+
+
+def _strain_limits(curves, key="axial_strain"):
+    vals = np.concatenate([_pre_collapse(c)[key].to_numpy(float) for c in curves]) * PERCENT
+    vals = vals[np.isfinite(vals)]
+    if not len(vals):
+        return None
+    lo, hi = vals.min(), vals.max()
+    pad = STRAIN_PAD * max(hi - lo, 1e-6)
+    return lo - pad, hi + 3 * pad
+
+
+#: Part of the plasma colour map used for curves (its bright yellow end is hard to see on white).
+CMAP_TOP = 0.85
+
+
+def _ratio_colours(curves):
+    cmap = plt.cm.plasma
+    return [cmap(CMAP_TOP * k / max(len(curves) - 1, 1)) for k in range(len(curves))]
+
+
+def strain_time_figure(path, curves, normalised: bool = False):
+    """Axial strain vs creep time for several loads (paper Fig. 5), creep stages marked.
+
+    ``normalised``: time axis t / t_ref (lifetime or the run's end); else log creep time [s].
+    The collapse row of a failed run leaves the top of the axis (failure).
+    """
+    fig, ax = plt.subplots(figsize=(7, 4.6))
+    stage_labels = set()
+    for c, colour in zip(curves, _ratio_colours(curves)):
+        t = c.history["creep_time_s"].to_numpy(float)
+        eps = c.history["axial_strain"].to_numpy(float) * PERCENT
+        x = t / c.t_ref_s if normalised else t
+        sel = np.isfinite(x) & (np.ones_like(x, bool) if normalised else x > 0)
+        if not sel.any():
+            continue
+        ax.plot(x[sel], eps[sel], color=colour, lw=1.1, drawstyle="steps-post",
+                label=c.label + ("" if c.failed else " (not failed)"))
+        pre = _pre_collapse(c)
+        for key, (marker, text) in STAGE_MARKERS.items():
+            ts = c.stages.get(key)
+            if ts is None or not np.isfinite(ts) or ts <= 0:
+                continue
+            e = np.interp(ts, pre["creep_time_s"], pre["axial_strain"]) * PERCENT
+            ax.plot(ts / c.t_ref_s if normalised else ts, e, marker=marker, color=colour, mec="k", ms=6, ls="none",
+                    label=text if text not in stage_labels else None, zorder=4)
+            stage_labels.add(text)
+    limits = _strain_limits(curves)
+    if limits:
+        ax.set_ylim(*limits)
+    if normalised:
+        ax.set_xlabel("normalised creep time t / t_f [-] (t_f: lifetime, or end time if not failed)")
+        ax.set_xlim(0, 1.02)
+    else:
+        ax.set_xscale("log")
+        ax.set_xlabel("creep time [s]")
+    ax.set_ylabel("axial strain [%]")
+    ax.set_title("Axial strain vs creep time" + (" (normalised)" if normalised else "") + " (paper Fig. 5); "
+                 "failure leaves the top")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=6, loc="upper left")
+    return _save(fig, path)
+
+
+def broken_creep(curve: Curve) -> np.ndarray:
+    """Bonds broken since the start of creep: history column broken_creep, else broken_total - ramp breaks."""
+    h = curve.history
+    if "broken_creep" in h:
+        return h["broken_creep"].to_numpy(float)
+    return h["broken_total"].to_numpy(float) - curve.broken_ramp
+
+
+def bonds_strain_figure(path, curve: Curve, mark_times=()):
+    """Broken bonds (creep phase) and axial strain vs creep time at one load (paper Fig. 6), two y axes;
+    creep stages as vertical lines, ``mark_times`` [s] (crack-map times) as labelled ticks."""
+    h = curve.history
+    t = h["creep_time_s"].to_numpy(float)
+    fig, ax = plt.subplots(figsize=(7, 4.6))
+    ax.plot(t, h["axial_strain"].to_numpy(float) * PERCENT, color="tab:blue", drawstyle="steps-post",
+            label="axial strain")
+    limits = _strain_limits([curve])
+    if limits:
+        ax.set_ylim(*limits)
+    ax.set_xlabel("creep time [s]")
+    ax.set_ylabel("axial strain [%]", color="tab:blue")
+    ax2 = ax.twinx()
+    nb = broken_creep(curve)
+    ax2.plot(t, nb, color="tab:red", lw=1.0, drawstyle="steps-post", label="broken bonds (creep phase)")
+    ax2.set_ylabel("broken bonds since creep start [-]", color="tab:red")
+    for key, (marker, text) in STAGE_MARKERS.items():
+        ts = curve.stages.get(key)
+        if ts is not None and np.isfinite(ts):
+            ax.axvline(ts, color="grey", ls=":", lw=0.9)
+            ax.text(ts, ax.get_ylim()[0], " " + text, rotation=90, va="bottom", fontsize=7)
+    for k, tm in enumerate(mark_times):
+        ax.axvline(tm, color="tab:green", lw=0.6, alpha=0.7)
+        ax.text(tm, ax.get_ylim()[1], f"({chr(ord('a') + k)})", ha="center", va="bottom", fontsize=7,
+                color="tab:green")
+    state = f"lifetime {curve.t_ref_s:.4g} s" if curve.failed else f"not failed by {curve.t_ref_s:.4g} s"
+    ax.set_title(f"{curve.label}: {state} (paper Fig. 6)", fontsize=9, pad=14)
+    lines = ax.get_legend_handles_labels()
+    lines2 = ax2.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], fontsize=7, loc="center left")
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path)
+
+
+def damage_figure(path, curves):
+    """Damage index D_n = N(t) / N(t_f) (paper Eq. 9) vs normalised time t / t_f (paper Fig. 9)."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for c, colour in zip(curves, _ratio_colours(curves)):
+        h = c.history
+        d = h["damage_index"].to_numpy(float) if "damage_index" in h else broken_creep(c) / max(broken_creep(c)[-1], 1)
+        ax.plot(h["creep_time_s"].to_numpy(float) / c.t_ref_s, d, color=colour, drawstyle="steps-post", label=c.label)
+    ax.set_xlabel("normalised time t / t_f [-]")
+    ax.set_ylabel("damage index D_n = N(t) / N(t_f) [-]")
+    ax.set_xlim(0, 1.02)
+    ax.set_ylim(0, 1.05)
+    ax.set_title("Damage index (paper Eq. 9, Fig. 9)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    return _save(fig, path)

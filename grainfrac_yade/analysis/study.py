@@ -1,0 +1,334 @@
+"""A study folder -> the paper's figures and tables plus report.md (``analyze`` command).
+
+Reads run folders only (run.json, params.json, summary.json, history.csv, cracks.csv) and writes
+into the report folder only; run folders are never changed.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import GrainfracError
+from ..runio import write_csv
+from . import crackmaps, figures
+from .collect import collect_runs
+from .figures import Curve, LifetimeSet
+from .fits import coefficient_table, distinct_ratios, fit_lifetimes
+from .labdata import paper_reference, read_lab_csv
+from .lifetimes import classify_runs, lifetime_stats, representatives
+from .report import ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
+
+#: Fractions of the lifetime (or of the run's end time) at which crack maps are drawn (paper Fig. 7).
+MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
+#: Parameters that do not make a different model (a longer time limit is the same model).
+VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",)
+#: Outcomes of creep runs that belong to a model variant.
+CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "unfinished")
+#: Columns of runs.csv (those present).
+RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
+             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "failure_reason", "clock", "mode", "n_events",
+             "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
+             "tertiary_start_s", "dem_steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
+             "code_version", "problem")
+#: Decades of lifetime scatter that count as "orders of magnitude" when comparing with the lab.
+ORDER_OF_MAGNITUDE = 1.0
+
+
+def _fmt_value(v) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def variant_labels(runs: pd.DataFrame) -> pd.Series:
+    """Label per run naming the parameters that differ among the creep runs ("model" if none)."""
+    creep = runs["outcome"].isin(CREEP_OUTCOMES)
+    keys = [c for c in runs.columns if "." in c and c not in VARIANT_IGNORE
+            and runs.loc[creep, c].astype(str).nunique() > 1]
+    if not keys:
+        return pd.Series(np.where(creep, "model", ""), index=runs.index)
+    short = {k: k.split(".")[-1] for k in keys}
+    if len(set(short.values())) < len(keys):
+        short = {k: k for k in keys}
+    labels = [", ".join(f"{short[k]}={_fmt_value(r[k])}" for k in keys) if ok else ""
+              for ok, r in zip(creep, runs.to_dict("records"))]
+    return pd.Series(labels, index=runs.index)
+
+
+def load_study(folder) -> pd.DataFrame:
+    """All run folders of a study with ``outcome``, ``ratio`` and ``variant`` (see lifetimes module)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise GrainfracError(f"{folder}: study folder not found; fix: give a folder holding run folders "
+                             "(e.g. results/lifetime_small)")
+    runs = collect_runs(folder, all_params=True)
+    if runs.empty:
+        raise GrainfracError(f"{folder}: no run folders (no run.json below it); fix: run the study first "
+                             "(python3 -m grainfrac_yade creep ... or yade-batch)")
+    runs = classify_runs(runs)
+    if not runs["outcome"].isin(CREEP_OUTCOMES).any():
+        raise GrainfracError(f"{folder}: no creep runs among {len(runs)} run folder(s); fix: analyze a creep study "
+                             "(UCS studies: python3 -m grainfrac_yade analyze-ucs)")
+    runs["variant"] = variant_labels(runs)
+    for col in ("problem", "lifetime_s", "creep_time_end_s", "driving_stress_ratio"):
+        if col not in runs:
+            runs[col] = np.nan if col != "problem" else None
+    for i in runs.index[runs["outcome"] == "unfinished"]:
+        hist = read_history(runs.at[i, "folder"])
+        reach = f"; history.csv reaches t = {hist['creep_time_s'].iloc[-1]:.4g} s" if hist is not None and len(hist) \
+            else ""
+        runs.at[i, "problem"] = "no summary.json (running, stopped or crashed)" + reach
+    return runs
+
+
+def _read_csv(path: Path, required) -> pd.DataFrame | None:
+    """A run's CSV, or None if missing, unreadable or lacking ``required`` columns (never raises)."""
+    try:
+        frame = pd.read_csv(path)
+    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError):
+        return None
+    return frame if all(c in frame for c in required) else None
+
+
+def read_history(folder) -> pd.DataFrame | None:
+    return _read_csv(Path(folder) / "history.csv", ("creep_time_s", "axial_strain"))
+
+
+def read_cracks(folder) -> pd.DataFrame | None:
+    return _read_csv(Path(folder) / "cracks.csv", ("creep_time_s", "mode", "kind", "x_m", "y_m",
+                                                   "face_normal_angle_deg"))
+
+
+def lifetime_sets(runs: pd.DataFrame) -> list:
+    """One :class:`LifetimeSet` per model variant: failed points (t > 0, fitted) and lower bounds."""
+    sets = []
+    for variant, g in runs[runs["outcome"].isin(CREEP_OUTCOMES)].groupby("variant", sort=True):
+        failed = g[(g["outcome"] == "failed") & g["ratio"].notna()]
+        lower = g[(g["outcome"] == "not failed") & g["ratio"].notna()]
+        ratio, life = failed["driving_stress_ratio"].to_numpy(float), failed["lifetime_s"].to_numpy(float)
+        fit = fit_lifetimes(ratio, life, source=f"{variant} runs") if len(ratio) else None
+        end = lower["creep_time_end_s"].to_numpy(float)
+        pos = end > 0   # a run that ended at t = 0 gives no bound on a log axis
+        at_load = g[(g["outcome"] == "failed at load") & g["ratio"].notna()]
+        sets.append(LifetimeSet(label=variant, ratio=ratio, lifetime_s=life, fit=fit,
+                                lower_ratio=lower["driving_stress_ratio"].to_numpy(float)[pos],
+                                lower_time_s=end[pos],
+                                at_load_ratio=at_load["driving_stress_ratio"].to_numpy(float)))
+    return sets
+
+
+def _num(v) -> float:
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return float("nan")
+    return v
+
+
+def curve_label(row: dict, with_variant: bool) -> str:
+    stress = _num(row.get("stress_pa")) / 1e6
+    text = f"r = {row['driving_stress_ratio']:.3f}" + (f" ({stress:.0f} MPa)" if math.isfinite(stress) else "") + \
+        f", seed {row.get('seed')}"
+    return f"{row['variant']}: {text}" if with_variant else text
+
+
+def make_curve(row: dict, with_variant: bool) -> Curve | None:
+    """Curve of a finished run, or None without a usable history or a positive reference time."""
+    hist = read_history(row["folder"])
+    failed = row["outcome"] in ("failed", "failed at load")
+    t_ref = _num(row.get("lifetime_s") if failed else row.get("creep_time_end_s"))
+    if hist is None or len(hist) < 2 or not (t_ref > 0):
+        return None
+    stages = {k: _num(row.get(k)) for k in figures.STAGE_MARKERS}
+    return Curve(curve_label(row, with_variant), hist, failed, t_ref, stages, _num(row.get("broken_ramp")) or 0.0)
+
+
+def choose_focus(reps: pd.DataFrame, ratio: float | None):
+    """The representative run nearest ``ratio`` (failed runs first); None if there is none."""
+    for outcomes in (("failed",), ("not failed",)):
+        cand = reps[reps["outcome"].isin(outcomes)]
+        if len(cand):
+            target = ratio if ratio is not None else float(cand["ratio"].median())
+            return cand.loc[(cand["ratio"] - target).abs().idxmin()]
+    return None
+
+
+def _check_out(out: Path, study: Path):
+    for p in (out, *out.parents):
+        if (p / "run.json").exists():
+            raise GrainfracError(f"{out}: is inside the run folder {p}; fix: choose an --out outside run folders "
+                                 f"(default {study / 'report'})")
+    if out.exists() and not out.is_dir():
+        raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
+
+
+def _spread_text(stats: pd.DataFrame, lab_stats: pd.DataFrame | None, reference) -> list:
+    text = []
+    if len(stats):
+        top = stats.loc[stats["spread_decades"].idxmax()]
+        size = ("less than one decade, narrower than" if top["spread_decades"] < ORDER_OF_MAGNITUDE
+                else "one decade or more, comparable with")
+        text.append(f"Model: largest scatter {top['spread_decades']:.2f} decades (max/min) at r = "
+                    f"{top['driving_stress_ratio']:.4g} ({top['dataset']}, {int(top['n'])} seeds): {size} the lab's "
+                    "scatter of orders of magnitude at one ratio.")
+    if lab_stats is not None and len(lab_stats):
+        top = lab_stats.loc[lab_stats["spread_decades"].idxmax()]
+        text.append(f"Lab file: largest scatter {top['spread_decades']:.2f} decades at r = "
+                    f"{top['driving_stress_ratio']:.4g} ({int(top['n'])} specimens).")
+    elif lab_stats is not None:
+        text.append("Lab file: no ratio with three or more specimens: no lab scatter statistics.")
+    if reference is not None:
+        n = reference.lab_specimens
+        text.append(f"Known from {reference.readme_file.name}: Schmidtke & Lajtai's lab lifetimes "
+                    f"({n:.0f} specimens per {reference.values_file.name}) scatter by orders of magnitude at one "
+                    "driving-stress ratio (rock heterogeneity); the individual points are not available.")
+    return text
+
+
+def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=None,
+                  map_fractions=MAP_FRACTIONS) -> Path:
+    """Write figures, tables and report.md for the study in ``folder``; return the report's path.
+
+    ``lab``: CSV of lab lifetimes (driving_stress_ratio, lifetime_s[, source]); without it the
+    paper's UDEC value and the Lajtai & Schmidtke (1986) bound from ``reference_dir`` are drawn.
+    ``focus_ratio``: ratio of the run shown in the one-load figures (default: the paper's 160 MPa
+    point's ratio, else the median).
+    """
+    folder = Path(folder)
+    runs = load_study(folder)
+    out = Path(out) if out is not None else folder / "report"
+    _check_out(out.resolve(), folder)
+    lab_frame = read_lab_csv(lab) if lab is not None else None   # bad lab input fails before anything is written
+    if lab is None:
+        reference = paper_reference(reference_dir)
+    else:
+        try:
+            reference = paper_reference(reference_dir)
+        except GrainfracError:
+            reference = None   # only used to choose the focus run when a lab file is given
+    out.mkdir(parents=True, exist_ok=True)
+    content = ReportContent(study=folder.resolve(), out=out.resolve(), runs=runs, coefficients=pd.DataFrame())
+
+    # lifetimes: model sets, lab set, fits, coefficient table
+    sets = lifetime_sets(runs)
+    multi = len(sets) > 1
+    for s in sets:
+        g = runs[runs["variant"] == s.label]
+        k = distinct_ratios(s.ratio) if len(s.ratio) else 0
+        n_load = int((g["outcome"] == "failed at load").sum())
+        note = (f"{s.label}: {len(s.ratio)} failed run(s) at {k} distinct ratio(s)"
+                + (" fitted" if s.fit is not None else ": fit skipped (needs failed runs at 2 or more ratios)"))
+        note += f"; {int((g['outcome'] == 'not failed').sum())} run(s) did not fail (lower bounds, drawn, not fitted)"
+        note += f"; {n_load} failed at load (t = 0, not in the log fit)" if n_load else ""
+        note += f"; {int((g['outcome'] == 'unfinished').sum())} unfinished (not used)."
+        content.fit_notes.append(note)
+    lab_set = None
+    if lab_frame is not None:
+        lab_fit = fit_lifetimes(lab_frame["driving_stress_ratio"], lab_frame["lifetime_s"], source=str(lab))
+        lab_set = LifetimeSet("lab", lab_frame["driving_stress_ratio"].to_numpy(float),
+                              lab_frame["lifetime_s"].to_numpy(float), lab_fit,
+                              sources=lab_frame["source"].to_numpy(str))
+        srcs = ", ".join(pd.unique(lab_frame["source"]))
+        content.lab_text.append(f"Lab file `{Path(lab).resolve()}`: {len(lab_frame)} specimen(s) "
+                                f"({srcs}) at {distinct_ratios(lab_set.ratio)} ratio(s), fitted with the same laws"
+                                + ("." if lab_fit is not None else "; fewer than 2 distinct ratios: no lab fit."))
+    else:
+        content.lab_text += [
+            f"No lab file given (--lab). The individual lab lifetimes of Schmidtke & Lajtai "
+            f"({reference.lab_specimens:.0f} specimens, paper Fig. 4) are not available "
+            f"(`{reference.readme_file}`); none are drawn or invented.",
+            f"Drawn instead: the paper's UDEC lifetime {reference.lifetime_s:.6g} s at "
+            f"{reference.stress_pa / 1e6:.0f} MPa, ratio {reference.stress_pa / 1e6:.0f} / "
+            f"{reference.ucs_simulated_pa / 1e6:.1f} MPa = {reference.ratio:.4f} (`{reference.values_file}`), and "
+            f"the Lajtai & Schmidtke (1986) bound: the long-term strength of humid LdB granite lies below "
+            f"{reference.long_term_strength_ratio:.0%} of its short-term UCS (shaded ratio < "
+            f"{reference.long_term_strength_ratio:g}).",
+        ]
+    fits = {s.label: s.fit for s in sets}
+    if lab_set is not None:
+        fits["lab"] = lab_set.fit
+    content.coefficients = coefficient_table(fits)
+    write_csv(out / "lifetime_fits.csv", content.coefficients)
+    (out / "lifetime_fits.md").write_text(coefficients_markdown(content.coefficients) + "\n")
+    figures.lifetime_figure(out / "lifetime.png", sets, lab=lab_set, reference=None if lab_set else reference)
+    content.figures.append(("lifetime.png", "Lifetime vs driving-stress ratio with static-fatigue fits (Fig. 4)"))
+
+    # scatter per ratio
+    stats = [lifetime_stats(s.ratio, s.lifetime_s).assign(dataset=s.label) for s in sets]
+    lab_stats = None
+    if lab_set is not None:
+        lab_stats = lifetime_stats(lab_set.ratio, lab_set.lifetime_s).assign(dataset="lab")
+        stats.append(lab_stats)
+    content.stats = pd.concat(stats, ignore_index=True)
+    content.spread_text = _spread_text(content.stats[content.stats["dataset"] != "lab"], lab_stats,
+                                       reference if lab_set is None else None)
+    write_csv(out / "lifetime_stats.csv", content.stats[list(STATS_COLUMNS)])
+    (out / "lifetime_stats.md").write_text(markdown_table(content.stats, STATS_COLUMNS) + "\n")
+
+    # time histories of one run per (variant, ratio)
+    reps = representatives(runs)
+    curves = [(r, make_curve(r, multi)) for r in reps.to_dict("records")]
+    curves = [(r, c) for r, c in curves if c is not None]
+    if curves:
+        cs = [c for _, c in curves]
+        figures.strain_time_figure(out / "strain_time.png", cs)
+        figures.strain_time_figure(out / "strain_time_normalised.png", cs, normalised=True)
+        content.figures += [("strain_time.png", "Axial strain vs creep time, one run per load (Fig. 5)"),
+                            ("strain_time_normalised.png", "Axial strain vs normalised time t / t_f (Fig. 5)")]
+    else:
+        for name in ("strain_time.png", "strain_time_normalised.png"):
+            content.skipped.append((name, "no finished run with a history.csv and a positive end time"))
+    failed_curves = [(r, c) for r, c in curves if r["outcome"] == "failed"]
+    if failed_curves:
+        pick = [failed_curves[0]] if len(failed_curves) == 1 else \
+            [min(failed_curves, key=lambda rc: rc[0]["ratio"]), max(failed_curves, key=lambda rc: rc[0]["ratio"])]
+        figures.damage_figure(out / "damage_index.png", [c for _, c in pick])
+        content.figures.append(("damage_index.png", "Damage index vs normalised time, low and high load (Fig. 9)"))
+    else:
+        content.skipped.append(("damage_index.png", "no failed run with lifetime > 0 and a history.csv"))
+
+    # one load: bonds and strain, crack maps
+    target = focus_ratio if focus_ratio is not None else (reference.ratio if reference is not None else None)
+    curve_by_folder = {r["folder"]: c for r, c in curves}
+    focus = choose_focus(reps[reps["folder"].isin(curve_by_folder)], target)
+    if focus is None:
+        for name in ("bonds_strain.png", "crack_maps_mode.png", "crack_maps_kind.png"):
+            content.skipped.append((name, "no finished run with a usable history.csv"))
+    else:
+        curve = curve_by_folder[focus["folder"]]
+        fracs = sorted(set(float(f) for f in map_fractions))
+        times = [f * curve.t_ref_s for f in fracs]
+        word = "t_f" if curve.failed else "t_end"
+        labels = [f"({chr(ord('a') + k)}) {f:.2f} {word} = {t:.3g} s" for k, (f, t) in enumerate(zip(fracs, times))]
+        figures.bonds_strain_figure(out / "bonds_strain.png", curve, mark_times=times)
+        content.figures.append(("bonds_strain.png", f"Broken bonds and axial strain vs creep time at one load, "
+                                                    f"{curve.label} (Fig. 6; (a)-(d): crack-map times)"))
+        cracks = read_cracks(focus["folder"])
+        dims = [_num(focus.get(k)) for k in ("specimen.width", "specimen.height", "specimen.grain_size")]
+        if cracks is None:
+            reason = "cracks.csv missing or lacking columns in " + str(focus["folder"])
+        elif not all(math.isfinite(d) and d > 0 for d in dims):
+            reason = "params.json lacks specimen.width/height/grain_size in " + str(focus["folder"])
+        else:
+            reason = None
+            for by in ("mode", "kind"):
+                name = f"crack_maps_{by}.png"
+                crackmaps.crack_maps_figure(out / name, cracks, times, labels, *dims, colour_by=by, title=curve.label)
+                content.figures.append((name, f"Crack maps at fractions of the lifetime, coloured by "
+                                              f"{crackmaps.TITLES[by]} (Fig. 7/8)"))
+        if reason:
+            content.skipped += [(f"crack_maps_{by}.png", reason) for by in ("mode", "kind")]
+
+    if multi:
+        content.notes.append("The creep runs differ in parameters (see column variant): each variant is fitted "
+                             "and drawn separately.")
+    other = int((runs["outcome"] == "not creep").sum())
+    if other:
+        content.notes.append(f"{other} run folder(s) of other commands (e.g. UCS) are listed but not analysed here.")
+    table = runs[[c for c in RUN_TABLE if c in runs]]
+    write_csv(out / "runs.csv", table)
+    content.tables = ["runs.csv", "lifetime_fits.csv", "lifetime_fits.md", "lifetime_stats.csv", "lifetime_stats.md"]
+    report = out / "report.md"
+    report.write_text(render_report(content))
+    return report

@@ -1,0 +1,42 @@
+"""``analyze``: a creep study folder -> the paper's figures, lifetime fits and report.md."""
+from __future__ import annotations
+
+import argparse
+import math
+
+
+def _fractions(text: str) -> list:
+    """Comma-separated fractions of the lifetime in [0, 1] (argparse type)."""
+    try:
+        values = [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers (e.g. 0.1,0.5,0.9,1)")
+    if not values or any(not math.isfinite(v) or not 0 <= v <= 1 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: fractions of the lifetime must lie in [0, 1]")
+    return values
+
+
+def register(sub, common):
+    p = sub.add_parser("analyze", help="creep study: lifetime fits, strain/crack/damage figures and report.md",
+                       description="Turn a study folder of creep runs into the paper's figures (Fig. 4-9), "
+                                   "lifetime fits and a markdown report (default folder: FOLDER/report).")
+    p.add_argument("folder", help="study folder holding run folders (e.g. results/lifetime_small)")
+    p.add_argument("--lab", metavar="CSV", help="lab lifetimes: columns driving_stress_ratio,lifetime_s[,source]; "
+                                                "without it the paper's UDEC value and the 1986 bound are drawn")
+    p.add_argument("--out", help="report folder (default FOLDER/report)")
+    p.add_argument("--reference", metavar="DIR", help="folder of paper_values.csv and lab_lifetimes_README.md "
+                                                      "(default: shared/reference next to the repository)")
+    p.add_argument("--focus-ratio", type=float, metavar="R",
+                   help="driving-stress ratio of the run shown in the one-load figures (default: the paper's "
+                        "160 MPa point's ratio)")
+    p.add_argument("--map-fractions", type=_fractions, metavar="F1,F2,...",
+                   help="fractions of the lifetime for the crack maps (default 0.1,0.5,0.9,1)")
+    p.set_defaults(func=cmd_analyze)
+
+
+def cmd_analyze(args) -> int:
+    from ..analysis.study import MAP_FRACTIONS, analyze_study
+    report = analyze_study(args.folder, lab=args.lab, out=args.out, reference_dir=args.reference,
+                           focus_ratio=args.focus_ratio, map_fractions=args.map_fractions or MAP_FRACTIONS)
+    print(report)
+    return 0

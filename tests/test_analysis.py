@@ -1,0 +1,302 @@
+"""Study analysis (issue 6 item 2): lifetime fits, run outcomes, figures and report, the analyze CLI.
+
+All on synthetic run folders written here (no YADE): lifetimes follow ln t = a - b r exactly
+(or with seeded noise), so the fits must return the generating coefficients.
+"""
+import hashlib
+import json
+import subprocess
+
+import numpy as np
+import pandas as pd
+import pytest
+from conftest import ROOT
+
+from grainfrac_yade.analysis import classify_runs, collect_runs, fit_lifetimes, fit_line, lifetime_stats
+from grainfrac_yade.analysis.crackmaps import crack_segments, cracks_at
+from grainfrac_yade.analysis.labdata import paper_reference, read_lab_csv
+from grainfrac_yade.errors import GrainfracError
+
+PYTHON = "/usr/bin/python3"
+A_TRUE, B_TRUE = 32.0, 28.0          # ln t = a - b r of the synthetic model runs
+RATIOS = (0.6, 0.7, 0.8, 0.9)
+WIDTH, HEIGHT, GRAIN = 10e-3, 20e-3, 1e-3
+FIGURES = ("lifetime.png", "strain_time.png", "strain_time_normalised.png", "bonds_strain.png",
+           "crack_maps_mode.png", "crack_maps_kind.png", "damage_index.png")
+MIN_PNG_BYTES = 10_000
+
+
+def true_lifetime(r):
+    return float(np.exp(A_TRUE - B_TRUE * r))
+
+
+def write_run(root, name, ratio, seed=1, lifetime=None, failed=True, finished=True, end=None, segments=True):
+    """A creep run folder as run_creep_to_folder writes it (small history and crack list)."""
+    d = root / name
+    d.mkdir(parents=True)
+    (d / "run.json").write_text(json.dumps({"command": "creep", "seed": seed}))
+    params = {"specimen": {"width": WIDTH, "height": HEIGHT, "grain_size": GRAIN},
+              "stress_corrosion": {"clock": "event", "mode": "strength"}}
+    (d / "params.json").write_text(json.dumps(params))
+    t_end = lifetime if failed else end
+    rng = np.random.default_rng(seed)
+    n = 12
+    t = np.linspace(0.0, t_end, n)
+    strain = 2e-3 + 1e-4 * (t / t_end) + 3e-4 * (t / t_end) ** 6
+    broken = np.round(60 * (t / t_end) ** 3).astype(int)
+    if failed:
+        strain[-1], broken[-1] = 1e-2, 200   # collapse row
+    pd.DataFrame({"creep_time_s": t, "axial_strain": strain, "lateral_strain": -0.25 * strain,
+                  "axial_stress_pa": ratio * 250e6, "broken_total": 100 + broken, "broken_creep": broken,
+                  "damage_index": broken / broken[-1], "macrocracks": broken // 2}).to_csv(d / "history.csv", index=False)
+    c = 40
+    x, y = rng.uniform(0, WIDTH, c), rng.uniform(0, HEIGHT, c)
+    ang = rng.uniform(0, 180, c)
+    times = np.where(rng.random(c) < 0.2, -1.0, rng.uniform(0, t_end, c))
+    cracks = pd.DataFrame({"bond": np.arange(c), "creep_time_s": times,
+                           "mode": np.where(rng.random(c) < 0.7, "tensile", "shear"),
+                           "kind": np.where(rng.random(c) < 0.6, "inter", "intra"),
+                           "x_m": x, "y_m": y, "face_normal_angle_deg": ang})
+    if segments:
+        along = np.radians(ang + 90)
+        h = 0.3e-3
+        cracks = cracks.assign(x0_m=x - h * np.cos(along), y0_m=y - h * np.sin(along),
+                               x1_m=x + h * np.cos(along), y1_m=y + h * np.sin(along),
+                               macro_time_s=np.where(rng.random(c) < 0.5, times + 0.01 * t_end, np.nan))
+    cracks.to_csv(d / "cracks.csv", index=False)
+    if finished:
+        summary = {"lifetime_s": lifetime if failed else None, "failed": failed,
+                   "failure_reason": "strain runs away" if failed else None, "creep_time_end_s": t_end,
+                   "stress_pa": ratio * 250e6, "driving_stress_ratio": ratio, "ucs_pa": 250e6, "clock": "event",
+                   "mode": "strength", "n_events": 10, "broken_ramp": 100, "broken_creep": int(broken[-1]),
+                   "broken_total": int(100 + broken[-1]), "macrocracks": int(broken[-1] // 2), "n_bonds": 700,
+                   "dem_steps": 1000, "wall_s": 1.0, "primary_end_s": 0.2 * t_end if failed else None,
+                   "tertiary_start_s": 0.8 * t_end if failed else None, "seed": seed, "params": params}
+        (d / "summary.json").write_text(json.dumps(summary))
+    return d
+
+
+def make_study(root, seeds=(1,), ratios=RATIOS, extra=True, segments=True):
+    """Failed runs with t = exp(a - b r) (one per ratio and seed), plus an unfinished run, a run
+    that did not fail and a run with a broken summary.json."""
+    for r in ratios:
+        for s in seeds:
+            write_run(root, f"ratio{r}_seed{s}", r, s, lifetime=true_lifetime(r), segments=segments)
+    if extra:
+        write_run(root, "unfinished_run", 0.65, 1, lifetime=1e7, finished=False)
+        write_run(root, "survivor_run", 0.55, 1, failed=False, end=3e8)
+        broken = write_run(root, "broken_json_run", 0.75, 1, lifetime=1e6)
+        (broken / "summary.json").write_text('{"lifetime_s": 1e6, "fail')
+    return root
+
+
+def folder_digest(root):
+    """Hash of every file under ``root`` except the report folder (run folders must stay unchanged)."""
+    h = hashlib.sha256()
+    for p in sorted(root.rglob("*")):
+        if p.is_file() and "report" not in p.relative_to(root).parts:
+            h.update(str(p.relative_to(root)).encode() + p.read_bytes())
+    return h.hexdigest()
+
+
+def run_cli(*args):
+    return subprocess.run([PYTHON, "-m", "grainfrac_yade", "analyze", *map(str, args)],
+                          capture_output=True, text=True, cwd=ROOT)
+
+
+# ---------------------------------------------------------------- fits
+
+def test_exponential_and_power_law_recover_noiseless_coefficients():
+    r = np.repeat([0.55, 0.65, 0.75, 0.85, 0.95], 2)
+    f = fit_lifetimes(r, np.exp(A_TRUE - B_TRUE * r))
+    assert f.a == pytest.approx(A_TRUE, abs=1e-9) and f.b == pytest.approx(B_TRUE, abs=1e-9)
+    assert f.exponential.r2 == pytest.approx(1.0, abs=1e-12)
+    assert f.exponential.slope_se == pytest.approx(0.0, abs=1e-6)
+    n_true, ln_a = 17.0, 9.5
+    p = fit_lifetimes(r, np.exp(ln_a - n_true * np.log(r)))
+    assert p.n == pytest.approx(n_true, abs=1e-9) and p.ln_A == pytest.approx(ln_a, abs=1e-9)
+    assert p.lifetime_power(0.7) == pytest.approx(np.exp(ln_a) * 0.7 ** -n_true, rel=1e-9)
+
+
+def test_noisy_fit_contains_truth_in_reported_interval_and_band():
+    rng = np.random.default_rng(2024)
+    r = np.repeat([0.6, 0.7, 0.8, 0.9, 0.95], 4)
+    life = np.exp(A_TRUE - B_TRUE * r + rng.normal(0, 0.8, len(r)))
+    f = fit_lifetimes(r, life)
+    t = f.exponential.t_quantile()
+    assert t == pytest.approx(2.1009, abs=1e-3)   # Student t, 95 %, 18 dof
+    assert 0 < f.exponential.intercept_se and abs(f.a - A_TRUE) <= t * f.exponential.intercept_se
+    assert abs(f.b - B_TRUE) <= t * f.exponential.slope_se
+    assert abs(f.a - A_TRUE) > 1e-3   # the noise did move the estimate
+    lo, hi = f.band_exponential(np.array([0.6, 0.78, 0.95]))
+    truth = np.exp(A_TRUE - B_TRUE * np.array([0.6, 0.78, 0.95]))
+    assert np.all(lo < truth) and np.all(truth < hi)
+    width = np.log(hi / lo)
+    assert width[1] < width[0] and width[1] < width[2]   # narrowest near the mean ratio
+    n_true = 15.0
+    p = fit_lifetimes(r, np.exp(8.0 - n_true * np.log(r) + rng.normal(0, 0.5, len(r))))
+    assert abs(p.n - n_true) <= p.power.t_quantile() * p.power.slope_se
+
+
+def test_line_fit_by_hand_and_two_point_limits():
+    f = fit_line([0, 1, 2, 3], [1, 3, 2, 4])   # slope 0.8, intercept 1.3, SSR 1.8
+    assert (f.intercept, f.slope) == pytest.approx((1.3, 0.8))
+    assert f.slope_se == pytest.approx(np.sqrt(1.8 / 2 / 5.0))
+    two = fit_line([0.6, 0.8], [10.0, 5.0])
+    assert two.slope == pytest.approx(-25.0) and np.isnan(two.slope_se)
+    assert fit_lifetimes([0.7, 0.7, 0.7], [1e3, 1e4, 1e5]) is None   # one ratio: no fit
+
+
+@pytest.mark.parametrize("life", [np.nan, 0.0, -5.0])
+def test_bad_lifetime_raises_one_line(life):
+    with pytest.raises(GrainfracError, match="lifetime_s") as err:
+        fit_lifetimes([0.6, 0.7, 0.8], [1e6, life, 1e4], source="my.csv")
+    assert "my.csv" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_lifetime_stats_geometric_mean_and_spread():
+    s = lifetime_stats([0.7, 0.7, 0.7, 0.8, 0.8], [1e2, 1e3, 1e4, 5.0, 6.0])
+    assert list(s["driving_stress_ratio"]) == [0.7]   # 0.8 has only 2 points
+    row = s.iloc[0]
+    assert row["geomean_lifetime_s"] == pytest.approx(1e3) and row["spread_decades"] == pytest.approx(2.0)
+    assert row["sd_log10_lifetime"] == pytest.approx(1.0) and row["n"] == 3
+
+
+# ---------------------------------------------------------------- inputs
+
+def test_lab_csv_reader_and_paper_reference(tmp_path):
+    lab = tmp_path / "lab.csv"
+    lab.write_text("# comment\ndriving_stress_ratio,lifetime_s\n0.8,100\n0.9,10\n")
+    frame = read_lab_csv(lab)
+    assert list(frame["source"]) == ["lab.csv", "lab.csv"] and frame["lifetime_s"].tolist() == [100, 10]
+    bad = tmp_path / "bad.csv"
+    bad.write_text("driving_stress_ratio,lifetime_s\n0.8,-3\n")
+    with pytest.raises(GrainfracError, match="bad.csv.*lifetime_s"):
+        read_lab_csv(bad)
+    ref = paper_reference()
+    values = pd.read_csv(ref.values_file).set_index("quantity")["value"]
+    assert ref.lifetime_s == float(values["lifetime_at_160mpa"])
+    assert ref.ratio == pytest.approx(160e6 / float(values["ucs_simulated"]))
+    with pytest.raises(GrainfracError, match="paper_values.csv"):
+        paper_reference(tmp_path)
+
+
+def test_crack_segments_fallback_and_times():
+    cracks = pd.DataFrame({"creep_time_s": [-1.0, 5.0, 20.0], "x_m": [1e-3, 2e-3, 3e-3], "y_m": [1e-3, 1e-3, 1e-3],
+                           "face_normal_angle_deg": [0.0, 90.0, 45.0], "macro_time_s": [np.nan, 6.0, -1.0]})
+    seg = crack_segments(cracks, grain_size=1e-3)
+    assert np.linalg.norm(seg[:, 1] - seg[:, 0], axis=1) == pytest.approx([1e-3] * 3)
+    assert seg[0, :, 0] == pytest.approx([1e-3, 1e-3])          # normal along x -> face along y
+    assert np.mean(seg, axis=1) == pytest.approx(cracks[["x_m", "y_m"]].to_numpy())
+    micro, macro = cracks_at(cracks, 5.5)
+    assert micro.tolist() == [True, True, False] and macro.tolist() == [False, False, False]
+    micro, macro = cracks_at(cracks, 30.0)
+    assert macro.tolist() == [False, True, True]
+
+
+# ---------------------------------------------------------------- study
+
+def test_unfinished_not_failed_and_unreadable_runs_are_listed_not_fitted(tmp_path):
+    from grainfrac_yade.analysis.study import analyze_study
+    study = make_study(tmp_path / "study")
+    runs = classify_runs(collect_runs(study))
+    outcome = dict(zip(runs["run"], runs["outcome"]))
+    assert outcome["unfinished_run"] == "unfinished" and outcome["survivor_run"] == "not failed"
+    assert outcome["broken_json_run"] == "unreadable" and outcome["ratio0.6_seed1"] == "failed"
+    assert runs.set_index("run").loc["broken_json_run", "status"] == "unreadable"
+    before = folder_digest(study)
+    report = analyze_study(study, map_fractions=(0.5, 1.0))
+    assert folder_digest(study) == before
+    text = report.read_text()
+    for name, state in (("unfinished_run", "unfinished"), ("survivor_run", "not failed"),
+                        ("broken_json_run", "unreadable")):
+        line = next(line for line in text.splitlines() if f"[{name}]" in line)
+        assert f"| {state} |" in line
+    assert "lower bound" in text and "not used in the fit" in text
+    coef = pd.read_csv(report.parent / "lifetime_fits.csv")
+    row = coef.set_index("dataset").loc["model"]
+    assert row["n_points"] == len(RATIOS)   # only the failed runs
+    assert row["a_ln_s"] == pytest.approx(A_TRUE, abs=1e-9) and row["b"] == pytest.approx(B_TRUE, abs=1e-9)
+    listed = pd.read_csv(report.parent / "runs.csv")
+    assert len(listed) == len(RATIOS) + 3
+
+
+def test_one_ratio_skips_fit_but_gives_scatter(tmp_path):
+    from grainfrac_yade.analysis.study import analyze_study
+    study = make_study(tmp_path / "one", seeds=(1, 2, 3), ratios=(0.7,), extra=False, segments=False)
+    for s, t in ((1, 1e4), (2, 1e5), (3, 1e7)):   # scatter of three decades
+        f = study / f"ratio0.7_seed{s}" / "summary.json"
+        f.write_text(f.read_text().replace(f'"lifetime_s": {true_lifetime(0.7)!r}', f'"lifetime_s": {t!r}'))
+    report = analyze_study(study, map_fractions=(1.0,))
+    text = report.read_text()
+    assert "fit skipped" in text and "No data set had lifetimes at two or more distinct ratios" in text
+    stats = pd.read_csv(report.parent / "lifetime_stats.csv")
+    assert stats["n"].tolist() == [3] and stats["spread_decades"].iloc[0] == pytest.approx(3.0)
+    assert "comparable with the lab's scatter" in text
+
+
+def test_report_folder_inside_a_run_folder_is_refused(tmp_path):
+    from grainfrac_yade.analysis.study import analyze_study
+    study = make_study(tmp_path / "s", ratios=(0.7, 0.8), extra=False)
+    with pytest.raises(GrainfracError, match="inside the run folder"):
+        analyze_study(study, out=study / "ratio0.7_seed1" / "rep")
+
+
+# ---------------------------------------------------------------- CLI
+
+def _check_png(path):
+    import matplotlib.image as mpimg
+    assert path.stat().st_size > MIN_PNG_BYTES, path
+    img = mpimg.imread(path)
+    assert img.ndim == 3 and float(img[..., :3].std()) > 0.01, path
+
+
+def test_cli_analyze_writes_report_and_all_figures(tmp_path):
+    study = make_study(tmp_path / "study", seeds=(1, 2, 3))
+    before = folder_digest(study)
+    res = run_cli(study)
+    assert res.returncode == 0, res.stderr
+    report = study / "report" / "report.md"
+    assert res.stdout.strip().endswith(str(report)) and report.exists()
+    text = report.read_text()
+    for name in FIGURES:
+        _check_png(study / "report" / name)
+        assert f"]({name})" in text
+    assert "paper_values.csv" in text and "Lajtai & Schmidtke (1986)" in text and "none are drawn or invented" in text
+    assert folder_digest(study) == before
+
+
+def test_cli_lab_file_is_fitted_into_the_coefficient_table(tmp_path):
+    study = make_study(tmp_path / "study", ratios=(0.6, 0.8), extra=False, segments=False)
+    a_lab, b_lab = 40.0, 36.0
+    r = np.array([0.7, 0.7, 0.8, 0.9])
+    lab = tmp_path / "lab.csv"
+    pd.DataFrame({"driving_stress_ratio": r, "lifetime_s": np.exp(a_lab - b_lab * r),
+                  "source": ["test lab A", "test lab A", "test lab B", "test lab B"]}).to_csv(lab, index=False)
+    res = run_cli(study, "--lab", lab, "--out", tmp_path / "rep")
+    assert res.returncode == 0, res.stderr
+    coef = pd.read_csv(tmp_path / "rep" / "lifetime_fits.csv").set_index("dataset")
+    assert coef.loc["lab", "a_ln_s"] == pytest.approx(a_lab, abs=1e-6)
+    assert coef.loc["lab", "b"] == pytest.approx(b_lab, abs=1e-6) and coef.loc["lab", "n_points"] == 4
+    assert coef.loc["model", "b"] == pytest.approx(B_TRUE, abs=1e-9)
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert str(lab) in text and "| quantity | model | lab |" in text
+    _check_png(tmp_path / "rep" / "lifetime.png")
+
+
+def test_cli_lab_file_missing_column_exits_2_with_one_line(tmp_path):
+    study = make_study(tmp_path / "study", ratios=(0.6, 0.8), extra=False)
+    lab = tmp_path / "lab_no_life.csv"
+    lab.write_text("driving_stress_ratio,time\n0.8,100\n")
+    res = run_cli(study, "--lab", lab)
+    assert res.returncode == 2
+    err = res.stderr.strip()
+    assert len(err.splitlines()) == 1 and "lab_no_life.csv" in err and "lifetime_s" in err
+    assert not (study / "report").exists()
+
+
+def test_cli_missing_study_and_empty_study_exit_2(tmp_path):
+    from grainfrac_yade.cli import main
+    assert main(["analyze", str(tmp_path / "nope")]) == 2
+    (tmp_path / "empty").mkdir()
+    assert main(["analyze", str(tmp_path / "empty")]) == 2
