@@ -48,7 +48,8 @@ def write_run(root, name, ratio, seed=1, lifetime=None, failed=True, finished=Tr
         strain[-1], broken[-1] = 1e-2, 200   # collapse row
     pd.DataFrame({"creep_time_s": t, "axial_strain": strain, "lateral_strain": -0.25 * strain,
                   "axial_stress_pa": ratio * 250e6, "broken_total": 100 + broken, "broken_creep": broken,
-                  "damage_index": broken / broken[-1], "macrocracks": broken // 2}).to_csv(d / "history.csv", index=False)
+                  "damage_index": broken / broken[-1], "macrocracks": broken // 2}
+                 ).to_csv(d / "history.csv", index=False)
     c = 40
     x, y = rng.uniform(0, WIDTH, c), rng.uniform(0, HEIGHT, c)
     ang = rng.uniform(0, 180, c)

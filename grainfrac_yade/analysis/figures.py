@@ -5,6 +5,7 @@ run folders. Strain is compression positive and drawn in %.
 """
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -14,11 +15,14 @@ from ..plotting import plt
 from .fits import CONFIDENCE, LifetimeFit
 
 DPI = 130
+TITLE_CHARS = 90   # wrap long titles (variant labels) at this many characters
 PERCENT = 100.0
 #: Fit lines extend this far beyond the data's ratio range (driving-stress ratio units).
 FIT_MARGIN = 0.02
 #: Padding of the strain axis around the creep before the collapse row (fraction of the range).
 STRAIN_PAD = 0.08
+#: Upward arrows of lower bounds (runs that did not fail) reach this factor times the end time.
+LOWER_BOUND_ARROW = 5.0
 STAGE_MARKERS = {"primary_end_s": ("o", "end of primary creep"), "tertiary_start_s": ("^", "start of tertiary creep")}
 
 
@@ -82,8 +86,9 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
         if len(s.lower_ratio):
             ax.scatter(s.lower_ratio, s.lower_time_s, s=30, facecolors="none", edgecolors=c, marker="o", zorder=3,
                        label=f"{s.label}: not failed by end time (lower bound, not fitted; {len(s.lower_ratio)})")
-            for r, t in zip(s.lower_ratio, s.lower_time_s):
-                ax.annotate("", xy=(r, t * 4), xytext=(r, t), arrowprops=dict(arrowstyle="->", color=c, lw=0.8))
+            ax.errorbar(s.lower_ratio, s.lower_time_s, yerr=[np.zeros(len(s.lower_time_s)),
+                                                             (LOWER_BOUND_ARROW - 1) * s.lower_time_s],
+                        lolims=True, fmt="none", ecolor=c, elinewidth=0.8, capsize=0)
         if s.fit is not None:
             _fit_lines(ax, s.fit, s.ratio, c, s.label)
         if len(s.at_load_ratio):
@@ -119,7 +124,7 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
     ax.set_ylabel("lifetime (time to failure) [s]")
     ax.set_title("Lifetime vs driving-stress ratio (paper Fig. 4)")
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=6, loc="upper right", framealpha=0.85)
+    ax.legend(fontsize=6, loc="best", framealpha=0.85)
     return _save(fig, path)
 
 
@@ -226,7 +231,7 @@ def bonds_strain_figure(path, curve: Curve, mark_times=()):
         ax.text(tm, ax.get_ylim()[1], f"({chr(ord('a') + k)})", ha="center", va="bottom", fontsize=7,
                 color="tab:green")
     state = f"lifetime {curve.t_ref_s:.4g} s" if curve.failed else f"not failed by {curve.t_ref_s:.4g} s"
-    ax.set_title(f"{curve.label}: {state} (paper Fig. 6)", fontsize=9, pad=14)
+    ax.set_title(textwrap.fill(f"{curve.label}: {state} (paper Fig. 6)", TITLE_CHARS), fontsize=9, pad=14)
     lines = ax.get_legend_handles_labels()
     lines2 = ax2.get_legend_handles_labels()
     ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], fontsize=7, loc="center left")

@@ -63,7 +63,8 @@ RUN_COLUMNS = {
 
 STATS_COLUMNS = {
     "dataset": ("data set", ""), "driving_stress_ratio": ("ratio", ".4f"), "n": ("n", "d"),
-    "geomean_lifetime_s": ("geometric mean lifetime [s]", ".4g"), "sd_log10_lifetime": ("sd of log10 t [decades]", ".3f"),
+    "geomean_lifetime_s": ("geometric mean lifetime [s]", ".4g"),
+    "sd_log10_lifetime": ("sd of log10 t [decades]", ".3f"),
     "min_lifetime_s": ("min [s]", ".4g"), "max_lifetime_s": ("max [s]", ".4g"),
     "spread_decades": ("max/min [decades]", ".2f"),
 }
@@ -105,7 +106,8 @@ def render_report(c: ReportContent) -> str:
              "fitted), *failed at load* (failed at creep time 0: no creep life, not in the log fit), "
              "*not failed* (the run ended without failure: its end time is a lower bound of the lifetime, drawn "
              "as an open marker with an arrow and **not used in the fit**), *unfinished* (no summary.json: "
-             "running, stopped or crashed), *unreadable* (a JSON file that cannot be parsed).", "",
+             "running, stopped or crashed), *unreadable* (a JSON file that cannot be parsed, or a failed run without a "
+             "valid lifetime).", "",
              markdown_table(_runs_for_table(c), RUN_COLUMNS), ""]
     lines += ["## Lifetime vs driving-stress ratio (paper Fig. 4)", "",
               "Fitted by least squares in ln t: the static-fatigue line ln t_f = a - b r and the power law "

@@ -157,8 +157,8 @@ def choose_focus(reps: pd.DataFrame, ratio: float | None):
 def _check_out(out: Path, study: Path):
     for p in (out, *out.parents):
         if (p / "run.json").exists():
-            raise GrainfracError(f"{out}: is inside the run folder {p}; fix: choose an --out outside run folders "
-                                 f"(default {study / 'report'})")
+            raise GrainfracError(f"{out}: is inside the run folder {p} (the report never writes into run "
+                                 "folders); fix: give --out DIR outside run folders")
     if out.exists() and not out.is_dir():
         raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
 
@@ -233,6 +233,8 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         content.lab_text.append(f"Lab file `{Path(lab).resolve()}`: {len(lab_frame)} specimen(s) "
                                 f"({srcs}) at {distinct_ratios(lab_set.ratio)} ratio(s), fitted with the same laws"
                                 + ("." if lab_fit is not None else "; fewer than 2 distinct ratios: no lab fit."))
+        content.lab_text.append("With a lab file the paper's UDEC value and the Lajtai & Schmidtke (1986) bound are "
+                                "not drawn (run without --lab to see them).")
     else:
         content.lab_text += [
             f"No lab file given (--lab). The individual lab lifetimes of Schmidtke & Lajtai "
@@ -262,7 +264,7 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         stats.append(lab_stats)
     content.stats = pd.concat(stats, ignore_index=True)
     content.spread_text = _spread_text(content.stats[content.stats["dataset"] != "lab"], lab_stats,
-                                       reference if lab_set is None else None)
+                                       reference)
     write_csv(out / "lifetime_stats.csv", content.stats[list(STATS_COLUMNS)])
     (out / "lifetime_stats.md").write_text(markdown_table(content.stats, STATS_COLUMNS) + "\n")
 
