@@ -84,7 +84,7 @@ def cmd_demo(args) -> int:
     if missing:
         _say(t0, f"{len(missing)} creep rows did not finish (listed in the report): {missing}")
 
-    from ..analysis.report import analyze_study
+    from ..analysis.study import analyze_study
     report = analyze_study(out / "creep")
     _say(t0, f"done. Report: {report}")
     return 0
