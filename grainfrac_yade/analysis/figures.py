@@ -15,7 +15,6 @@ from ..plotting import plt
 from .fits import CONFIDENCE, LifetimeFit
 
 DPI = 130
-TITLE_CHARS = 90   # wrap long titles (variant labels) at this many characters
 PERCENT = 100.0
 #: Fit lines extend this far beyond the data's ratio range (driving-stress ratio units).
 FIT_MARGIN = 0.02
@@ -51,10 +50,17 @@ class Curve:
 
 
 def _save(fig, path):
+    """tight_layout, then a tight bounding box so no title, label or legend is cut at the edges."""
     fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
+    fig.savefig(path, dpi=DPI, bbox_inches="tight", pad_inches=0.08)
     plt.close(fig)
     return path
+
+
+def _title(ax, text: str, fig_width_in: float, fontsize: float = 10, **kw):
+    """Title wrapped to the axes width (about 0.55 character widths per point of font size)."""
+    chars = max(30, int(fig_width_in * 72 * 0.85 / (0.55 * fontsize)))
+    ax.set_title(textwrap.fill(text, chars), fontsize=fontsize, **kw)
 
 
 def _fit_lines(ax, fit: LifetimeFit, ratios, colour, label):
@@ -72,9 +78,10 @@ def _fit_lines(ax, fit: LifetimeFit, ratios, colour, label):
                         label=f"{label}: {pct} band, power law (hatched)")
 
 
-def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=None):
+def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=None, time_note: str | None = None):
     """Lifetime vs driving-stress ratio, log time (paper Fig. 4): model points, lower bounds, both fits
-    with confidence bands; lab points and fits, or the paper's UDEC value and the 1986 bound."""
+    with confidence bands; lab points and fits, or the paper's UDEC value and the 1986 bound.
+    ``time_note`` (e.g. rescaled times) goes into the title and the legend's title."""
     fig, ax = plt.subplots(figsize=(7.2, 5.2))
     colours = plt.cm.tab10.colors
     all_ratios = []
@@ -107,9 +114,11 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
             _fit_lines(ax, lab.fit, lab.ratio, "0.2", "lab")
         all_ratios += list(lab.ratio)
     if reference is not None:
+        as_published = (f", as published (beta1 = {reference.beta1_pa_s:g} Pa/s, not rescaled)"
+                        if time_note and np.isfinite(getattr(reference, "beta1_pa_s", np.nan)) else "")
         ax.scatter([reference.ratio], [reference.lifetime_s], marker="*", s=140, color="gold", edgecolors="k",
                    zorder=4, label=f"paper (UDEC): {reference.stress_pa / 1e6:.0f} MPa, "
-                                   f"r = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s")
+                                   f"r = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s{as_published}")
         all_ratios += [reference.ratio, reference.long_term_strength_ratio]
     lo = min(all_ratios) - 0.05 if all_ratios else 0.5
     hi = max(all_ratios) + 0.05 if all_ratios else 1.0
@@ -121,10 +130,13 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
         ax.axvline(lts, color="0.4", lw=1, ls=":")
     ax.set_yscale("log")
     ax.set_xlabel("driving-stress ratio sigma / sigma_c [-]")
-    ax.set_ylabel("lifetime (time to failure) [s]")
-    ax.set_title("Lifetime vs driving-stress ratio (paper Fig. 4)")
+    ax.set_ylabel("lifetime (time to failure) [s]" + ("\n" + time_note if time_note else ""))
+    _title(ax, "Lifetime vs driving-stress ratio (paper Fig. 4)" + (f" - {time_note}" if time_note else ""),
+           fig.get_figwidth())
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=6, loc="best", framealpha=0.85)
+    leg = ax.legend(fontsize=6, loc="best", framealpha=0.85, title=time_note, title_fontsize=6.5)
+    if time_note:
+        leg.get_title().set_fontweight("bold")
     return _save(fig, path)
 
 
@@ -153,7 +165,7 @@ def _ratio_colours(curves):
     return [cmap(CMAP_TOP * k / max(len(curves) - 1, 1)) for k in range(len(curves))]
 
 
-def strain_time_figure(path, curves, normalised: bool = False):
+def strain_time_figure(path, curves, normalised: bool = False, time_note: str | None = None):
     """Axial strain vs creep time for several loads (paper Fig. 5), creep stages marked.
 
     ``normalised``: time axis t / t_ref (lifetime or the run's end); else log creep time [s].
@@ -187,10 +199,10 @@ def strain_time_figure(path, curves, normalised: bool = False):
         ax.set_xlim(0, 1.02)
     else:
         ax.set_xscale("log")
-        ax.set_xlabel("creep time [s]")
+        ax.set_xlabel("creep time [s]" + (f" ({time_note})" if time_note else ""))
     ax.set_ylabel("axial strain [%]")
-    ax.set_title("Axial strain vs creep time" + (" (normalised)" if normalised else "") + " (paper Fig. 5); "
-                 "failure leaves the top")
+    _title(ax, "Axial strain vs creep time" + (" (normalised)" if normalised else "") + " (paper Fig. 5); "
+           "failure leaves the top", fig.get_figwidth())
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=6, loc="upper left")
     return _save(fig, path)
@@ -204,7 +216,7 @@ def broken_creep(curve: Curve) -> np.ndarray:
     return h["broken_total"].to_numpy(float) - curve.broken_ramp
 
 
-def bonds_strain_figure(path, curve: Curve, mark_times=()):
+def bonds_strain_figure(path, curve: Curve, mark_times=(), time_note: str | None = None):
     """Broken bonds (creep phase) and axial strain vs creep time at one load (paper Fig. 6), two y axes;
     creep stages as vertical lines, ``mark_times`` [s] (crack-map times) as labelled ticks."""
     h = curve.history
@@ -215,7 +227,7 @@ def bonds_strain_figure(path, curve: Curve, mark_times=()):
     limits = _strain_limits([curve])
     if limits:
         ax.set_ylim(*limits)
-    ax.set_xlabel("creep time [s]")
+    ax.set_xlabel("creep time [s]" + (f" ({time_note})" if time_note else ""))
     ax.set_ylabel("axial strain [%]", color="tab:blue")
     ax2 = ax.twinx()
     nb = broken_creep(curve)
@@ -231,7 +243,7 @@ def bonds_strain_figure(path, curve: Curve, mark_times=()):
         ax.text(tm, ax.get_ylim()[1], f"({chr(ord('a') + k)})", ha="center", va="bottom", fontsize=7,
                 color="tab:green")
     state = f"lifetime {curve.t_ref_s:.4g} s" if curve.failed else f"not failed by {curve.t_ref_s:.4g} s"
-    ax.set_title(textwrap.fill(f"{curve.label}: {state} (paper Fig. 6)", TITLE_CHARS), fontsize=9, pad=14)
+    _title(ax, f"{curve.label}: {state} (paper Fig. 6)", fig.get_figwidth(), fontsize=9, pad=14)
     lines = ax.get_legend_handles_labels()
     lines2 = ax2.get_legend_handles_labels()
     ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], fontsize=7, loc="center left")
@@ -250,7 +262,7 @@ def damage_figure(path, curves):
     ax.set_ylabel("damage index D_n = N(t) / N(t_f) [-]")
     ax.set_xlim(0, 1.02)
     ax.set_ylim(0, 1.05)
-    ax.set_title("Damage index (paper Eq. 9, Fig. 9)")
+    _title(ax, "Damage index (paper Eq. 9, Fig. 9)", fig.get_figwidth())
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)

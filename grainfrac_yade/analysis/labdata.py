@@ -87,6 +87,7 @@ class PaperReference:
     long_term_strength_ratio: float
     values_file: Path
     readme_file: Path
+    beta1_pa_s: float = float("nan")   # the paper's stress-corrosion rate (section 4.1)
 
     @property
     def ratio(self) -> float:
@@ -109,4 +110,4 @@ def paper_reference(reference_dir=None) -> PaperReference:
                           ucs_simulated_pa=values["ucs_simulated"][0],
                           lab_specimens=values.get("lab_creep_specimens", (np.nan, ""))[0],
                           long_term_strength_ratio=LONG_TERM_STRENGTH_RATIO, values_file=values_file,
-                          readme_file=folder / LAB_README)
+                          readme_file=folder / LAB_README, beta1_pa_s=values.get("beta1", (np.nan, ""))[0])

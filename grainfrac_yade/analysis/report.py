@@ -85,6 +85,8 @@ class ReportContent:
     skipped: list = field(default_factory=list)      # (file name, reason)
     tables: list = field(default_factory=list)       # file names of CSV/markdown tables
     notes: list = field(default_factory=list)
+    studies: list = field(default_factory=list)      # all study folders (several: shown together)
+    banner: list = field(default_factory=list)       # shown first, prominently (e.g. rescaled times)
 
 
 def _runs_for_table(content: ReportContent) -> pd.DataFrame:
@@ -98,10 +100,21 @@ def _runs_for_table(content: ReportContent) -> pd.DataFrame:
 
 def render_report(c: ReportContent) -> str:
     counts = c.runs["outcome"].value_counts()
-    lines = [f"# Creep study report: {c.study.name}", "",
-             f"Study folder: `{c.study}`. {len(c.runs)} run folder(s): "
-             + ", ".join(f"{n} {k}" for k, n in counts.items()) + ".", "",
-             "## Runs", "",
+    studies = c.studies or [c.study]
+    if len(studies) == 1:
+        lines = [f"# Creep study report: {c.study.name}", "", f"Study folder: `{c.study}`. "]
+    else:
+        names = sorted(set(c.runs["study"])) if "study" in c.runs else [s.name for s in studies]
+        lines = [f"# Creep study report: {' + '.join(names)}", "",
+                 f"{len(studies)} study folders, each labelled by its name and fitted separately: "
+                 + ", ".join(f"`{s}`" for s in studies) + ". "]
+    lines[-1] += f"{len(c.runs)} run folder(s): " + ", ".join(f"{n} {k}" for k, n in counts.items()) + "."
+    lines.append("")
+    if c.banner:   # a block quote: paragraphs separated by ">" lines
+        for k, t in enumerate(c.banner):
+            lines += ([">"] if k else []) + [f"> {t}"]
+        lines.append("")
+    lines += ["## Runs", "",
              "Every folder holding a run.json is listed. Outcomes: *failed* (lifetime = creep time at failure, "
              "fitted), *failed at load* (failed at creep time 0: no creep life, not in the log fit), "
              "*not failed* (the run ended without failure: its end time is a lower bound of the lifetime, drawn "

@@ -1,7 +1,9 @@
 """A study folder -> the paper's figures and tables plus report.md (``analyze`` command).
 
 Reads run folders only (run.json, params.json, summary.json, history.csv, cracks.csv) and writes
-into the report folder only; run folders are never changed.
+into the report folder only; run folders are never changed. Several study folders can be shown
+together (each labelled by its folder name and fitted separately); with ``beta1`` every creep
+time is rescaled exactly to another stress-corrosion rate (see :mod:`.rescale`).
 """
 from __future__ import annotations
 
@@ -13,13 +15,14 @@ import pandas as pd
 
 from ..errors import GrainfracError
 from ..runio import write_csv
-from . import crackmaps, figures
-from .collect import collect_runs
+from . import crackmaps, figures, rescale
+from .collect import collect_runs, flatten
 from .figures import Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
 from .lifetimes import classify_runs, lifetime_stats, representatives
 from .report import ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
+from .runparams import default_tree, rebuild_specimen
 
 #: Fractions of the lifetime (or of the run's end time) at which crack maps are drawn (paper Fig. 7).
 MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
@@ -32,7 +35,7 @@ RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome",
              "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "failure_reason", "clock", "mode", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
              "tertiary_start_s", "dem_steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
-             "code_version", "problem")
+             "study", "beta1_run", "time_factor", "code_version", "problem")
 #: Decades of lifetime scatter that count as "orders of magnitude" when comparing with the lab.
 ORDER_OF_MAGNITUDE = 1.0
 
@@ -56,8 +59,35 @@ def variant_labels(runs: pd.DataFrame) -> pd.Series:
     return pd.Series(labels, index=runs.index)
 
 
-def load_study(folder) -> pd.DataFrame:
-    """All run folders of a study with ``outcome``, ``ratio`` and ``variant`` (see lifetimes module)."""
+def fill_missing_params(runs: pd.DataFrame) -> tuple:
+    """Parameter columns that some runs lack (params.json written before the key existed) filled
+    with the shipped default, so that an older file does not look like another model.
+    Returns (runs, {key: number of runs filled})."""
+    try:
+        defaults = flatten(default_tree())
+    except GrainfracError:
+        return runs, {}
+    runs = runs.copy()
+    has_params = runs["specimen.width"].notna() if "specimen.width" in runs else pd.Series(False, index=runs.index)
+    filled = {}
+    for key, value in defaults.items():
+        if key not in runs or key.split(".")[0] in ("sources", "composition", "grains", "contacts"):
+            continue   # no run has the key (all alike), or a material table (never assumed)
+        missing = has_params & runs[key].isna()
+        if missing.any() and (has_params & runs[key].notna()).any():
+            runs[key] = runs[key].astype(object)
+            for i in runs.index[missing]:
+                runs.at[i, key] = value
+            filled[key] = int(missing.sum())
+    return runs, filled
+
+
+def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
+    """All run folders of a study with ``outcome``, ``ratio`` and ``variant`` (see lifetimes module).
+
+    ``beta1``: every creep time rescaled to this rate (:func:`.rescale.rescale_runs`; GrainfracError
+    if a creep run is not rescalable). ``runs.attrs["filled"]``: parameter keys filled with defaults.
+    """
     folder = Path(folder)
     if not folder.is_dir():
         raise GrainfracError(f"{folder}: study folder not found; fix: give a folder holding run folders "
@@ -70,15 +100,57 @@ def load_study(folder) -> pd.DataFrame:
     if not runs["outcome"].isin(CREEP_OUTCOMES).any():
         raise GrainfracError(f"{folder}: no creep runs among {len(runs)} run folder(s); fix: analyze a creep study "
                              "(UCS studies: python3 -m grainfrac_yade analyze-ucs)")
+    if beta1 is not None:
+        runs = rescale.rescale_runs(runs, beta1, CREEP_OUTCOMES)   # before defaults are filled in
+    else:
+        runs["time_factor"] = 1.0
+    runs, filled = fill_missing_params(runs)
     runs["variant"] = variant_labels(runs)
     for col in ("problem", "lifetime_s", "creep_time_end_s", "driving_stress_ratio"):
         if col not in runs:
             runs[col] = np.nan if col != "problem" else None
+    runs["problem"] = runs["problem"].astype(object)
     for i in runs.index[runs["outcome"] == "unfinished"]:
-        hist = read_history(runs.at[i, "folder"])
+        hist = read_history(runs.at[i, "folder"], runs.at[i, "time_factor"])
         reach = f"; history.csv reaches t = {hist['creep_time_s'].iloc[-1]:.4g} s" if hist is not None and len(hist) \
             else ""
         runs.at[i, "problem"] = "no summary.json (running, stopped or crashed)" + reach
+    runs.attrs["filled"] = filled
+    return runs
+
+
+def study_names(folders) -> list:
+    """Short distinct labels of study folders: the folder name, with parents added where names repeat."""
+    paths = [Path(f).resolve() for f in folders]
+    depth = 1
+    while True:
+        names = ["/".join(p.parts[-depth:]) for p in paths]
+        if len(set(names)) == len(names) or depth >= max(len(p.parts) for p in paths):
+            return names
+        depth += 1
+
+
+def load_studies(folders, beta1: float | None = None) -> pd.DataFrame:
+    """Runs of one or several studies. With several, runs are labelled by study (column ``study``,
+    ``run`` = study/run) and each study's variants become "study" or "study: variant"."""
+    folders = [Path(f) for f in folders]
+    if len(folders) == 1:
+        runs = load_study(folders[0], beta1)
+        runs["study"] = study_names(folders)[0]
+        return runs
+    frames, filled = [], {}
+    for folder, name in zip(folders, study_names(folders)):
+        runs = load_study(folder, beta1)
+        for k, n in runs.attrs.get("filled", {}).items():
+            filled[k] = filled.get(k, 0) + n
+        runs["study"] = name
+        runs["run"] = [f"{name}/{r}" for r in runs["run"]]
+        creep = runs["outcome"].isin(CREEP_OUTCOMES)
+        several = runs.loc[creep, "variant"].nunique() > 1
+        runs["variant"] = [(f"{name}: {v}" if several else name) if c else "" for v, c in zip(runs["variant"], creep)]
+        frames.append(runs)
+    runs = pd.concat(frames, ignore_index=True)
+    runs.attrs["filled"] = filled
     return runs
 
 
@@ -91,13 +163,17 @@ def _read_csv(path: Path, required) -> pd.DataFrame | None:
     return frame if all(c in frame for c in required) else None
 
 
-def read_history(folder) -> pd.DataFrame | None:
-    return _read_csv(Path(folder) / "history.csv", ("creep_time_s", "axial_strain"))
+def read_history(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
+    """history.csv of a run (creep times multiplied by ``time_factor``), or None."""
+    hist = _read_csv(Path(folder) / "history.csv", ("creep_time_s", "axial_strain"))
+    return rescale.scale_times(hist, time_factor, rescale.HISTORY_TIME_COLUMNS)
 
 
-def read_cracks(folder) -> pd.DataFrame | None:
-    return _read_csv(Path(folder) / "cracks.csv", ("creep_time_s", "mode", "kind", "x_m", "y_m",
-                                                   "face_normal_angle_deg"))
+def read_cracks(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
+    """cracks.csv of a run (creep times >= 0 multiplied by ``time_factor``; -1 = ramp stays), or None."""
+    cracks = _read_csv(Path(folder) / "cracks.csv", ("creep_time_s", "mode", "kind", "x_m", "y_m",
+                                                     "face_normal_angle_deg"))
+    return rescale.scale_times(cracks, time_factor, rescale.CRACK_TIME_COLUMNS)
 
 
 def lifetime_sets(runs: pd.DataFrame) -> list:
@@ -126,6 +202,11 @@ def _num(v) -> float:
     return v
 
 
+def _factor(row: dict) -> float:
+    f = _num(row.get("time_factor", 1.0))
+    return f if math.isfinite(f) and f > 0 else 1.0
+
+
 def curve_label(row: dict, with_variant: bool) -> str:
     stress = _num(row.get("stress_pa")) / 1e6
     text = f"r = {row['driving_stress_ratio']:.3f}" + (f" ({stress:.0f} MPa)" if math.isfinite(stress) else "") + \
@@ -135,7 +216,7 @@ def curve_label(row: dict, with_variant: bool) -> str:
 
 def make_curve(row: dict, with_variant: bool) -> Curve | None:
     """Curve of a finished run, or None without a usable history or a positive reference time."""
-    hist = read_history(row["folder"])
+    hist = read_history(row["folder"], _factor(row))
     failed = row["outcome"] in ("failed", "failed at load")
     t_ref = _num(row.get("lifetime_s") if failed else row.get("creep_time_end_s"))
     if hist is None or len(hist) < 2 or not (t_ref > 0):
@@ -186,19 +267,64 @@ def _spread_text(stats: pd.DataFrame, lab_stats: pd.DataFrame | None, reference)
     return text
 
 
+def _rescale_text(runs: pd.DataFrame, beta1: float, source: str, reference) -> list:
+    creep = runs[runs["outcome"].isin(CREEP_OUTCOMES)]
+    b_run = sorted(set(pd.to_numeric(creep["beta1_run"], errors="coerce").dropna()))
+    factors = sorted(set(pd.to_numeric(creep["time_factor"], errors="coerce").dropna()))
+    text = [f"**All creep times in this report are rescaled** from the runs' beta1 = "
+            f"{', '.join(f'{b:g}' for b in b_run)} Pa/s to beta1 = {beta1:g} Pa/s ({source}): "
+            f"t' = t x beta1_run / beta1 = t x {', '.join(f'{f:.6g}' for f in factors)} (lifetimes, end times, "
+            "creep stages, history and crack times, lower bounds; the fitted a shifts by ln(factor), b and n are "
+            "unchanged).",
+            f"Why this is exact: {rescale.WHY_EXACT}. Every creep run here was checked: event clock, strength "
+            "mode, rate_form beta (paper-clock, area-mode or physical-rate runs are refused).",
+            "Not rescaled: wall-clock times, DEM steps, driving-stress ratios, strains and crack counts (they do "
+            "not depend on beta1)."]
+    if reference is not None and math.isfinite(reference.beta1_pa_s):
+        text.append(f"The paper's UDEC point is drawn as published (beta1 = {reference.beta1_pa_s:g} Pa/s, "
+                    "paper clock): it is not rescaled.")
+    return text
+
+
+def _grains(focus, cracks) -> tuple:
+    """(specimen or None, report line): the focus run's specimen rebuilt and verified, else why not."""
+    try:
+        rebuilt = rebuild_specimen(focus["folder"], focus.get("seed"), n_bonds=_num(focus.get("n_bonds")),
+                                   cracks=cracks)
+    except GrainfracError as exc:
+        return None, f"Crack maps: grains not drawn, specimen outline only: {exc}"
+    except Exception as exc:   # a tessellation failure must not stop the report
+        return None, (f"Crack maps: grains not drawn, specimen outline only: rebuilding the specimen of "
+                      f"{focus['folder']} failed ({type(exc).__name__}: {exc})")
+    return rebuilt.specimen, f"Crack maps drawn on the run's grains (cells coloured by mineral): {rebuilt.note}."
+
+
 def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=None,
-                  map_fractions=MAP_FRACTIONS) -> Path:
+                  map_fractions=MAP_FRACTIONS, beta1=None, beta1_source=None, grains=True) -> Path:
     """Write figures, tables and report.md for the study in ``folder``; return the report's path.
 
-    ``lab``: CSV of lab lifetimes (driving_stress_ratio, lifetime_s[, source]); without it the
-    paper's UDEC value and the Lajtai & Schmidtke (1986) bound from ``reference_dir`` are drawn.
-    ``focus_ratio``: ratio of the run shown in the one-load figures (default: the paper's 160 MPa
-    point's ratio, else the median).
+    ``folder``: a study folder, or a list of them (shown together, each fitted separately;
+    ``out`` is then required). ``lab``: CSV of lab lifetimes (driving_stress_ratio,
+    lifetime_s[, source]); without it the paper's UDEC value and the Lajtai & Schmidtke (1986)
+    bound from ``reference_dir`` are drawn. ``focus_ratio``: ratio of the run shown in the
+    one-load figures (default: the paper's 160 MPa point's ratio, else the median).
+    ``beta1`` [Pa/s]: show every creep time at this rate (exact for event-clock strength-mode
+    runs, others refused; ``beta1_source`` names where the value came from). ``grains``: draw
+    the run's grains under the crack maps (specimen rebuilt from params.json and the seed).
     """
-    folder = Path(folder)
-    runs = load_study(folder)
+    folders = [Path(f) for f in folder] if isinstance(folder, (list, tuple)) else [Path(folder)]
+    if not folders:
+        raise GrainfracError("no study folder given; fix: name one or more study folders")
+    if len(folders) > 1 and out is None:
+        raise GrainfracError(f"{len(folders)} study folders given but no report folder; fix: add --out DIR "
+                             "(the report of several studies belongs to none of them)")
+    if beta1 is not None:
+        beta1 = rescale.check_beta1(beta1, beta1_source or "--beta1")
+    runs = load_studies(folders, beta1)
+    folder = folders[0]
     out = Path(out) if out is not None else folder / "report"
-    _check_out(out.resolve(), folder)
+    for f in folders:
+        _check_out(out.resolve(), f)
     lab_frame = read_lab_csv(lab) if lab is not None else None   # bad lab input fails before anything is written
     if lab is None:
         reference = paper_reference(reference_dir)
@@ -208,7 +334,17 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         except GrainfracError:
             reference = None   # only used to choose the focus run when a lab file is given
     out.mkdir(parents=True, exist_ok=True)
-    content = ReportContent(study=folder.resolve(), out=out.resolve(), runs=runs, coefficients=pd.DataFrame())
+    content = ReportContent(study=folder.resolve(), out=out.resolve(), runs=runs, coefficients=pd.DataFrame(),
+                            studies=[f.resolve() for f in folders])
+    time_note = None
+    if beta1 is not None:
+        content.banner = _rescale_text(runs, beta1, beta1_source or "--beta1", reference)
+        time_note = f"times rescaled to beta1 = {beta1:g} Pa/s (exact, event clock)"
+    filled = runs.attrs.get("filled", {})
+    if filled:
+        content.notes.append("Keys missing from older params.json files, taken as the shipped defaults when "
+                             "comparing runs (variants): " + ", ".join(f"{k} ({n} run(s))" for k, n in filled.items())
+                             + ".")
 
     # lifetimes: model sets, lab set, fits, coefficient table
     sets = lifetime_sets(runs)
@@ -253,7 +389,8 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     content.coefficients = coefficient_table(fits)
     write_csv(out / "lifetime_fits.csv", content.coefficients)
     (out / "lifetime_fits.md").write_text(coefficients_markdown(content.coefficients) + "\n")
-    figures.lifetime_figure(out / "lifetime.png", sets, lab=lab_set, reference=None if lab_set else reference)
+    figures.lifetime_figure(out / "lifetime.png", sets, lab=lab_set, reference=None if lab_set else reference,
+                            time_note=time_note)
     content.figures.append(("lifetime.png", "Lifetime vs driving-stress ratio with static-fatigue fits (Fig. 4)"))
 
     # scatter per ratio
@@ -274,7 +411,7 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     curves = [(r, c) for r, c in curves if c is not None]
     if curves:
         cs = [c for _, c in curves]
-        figures.strain_time_figure(out / "strain_time.png", cs)
+        figures.strain_time_figure(out / "strain_time.png", cs, time_note=time_note)
         figures.strain_time_figure(out / "strain_time_normalised.png", cs, normalised=True)
         content.figures += [("strain_time.png", "Axial strain vs creep time, one run per load (Fig. 5)"),
                             ("strain_time_normalised.png", "Axial strain vs normalised time t / t_f (Fig. 5)")]
@@ -303,10 +440,10 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         times = [f * curve.t_ref_s for f in fracs]
         word = "t_f" if curve.failed else "t_end"
         labels = [f"({chr(ord('a') + k)}) {f:.2f} {word} = {t:.3g} s" for k, (f, t) in enumerate(zip(fracs, times))]
-        figures.bonds_strain_figure(out / "bonds_strain.png", curve, mark_times=times)
+        figures.bonds_strain_figure(out / "bonds_strain.png", curve, mark_times=times, time_note=time_note)
         content.figures.append(("bonds_strain.png", f"Broken bonds and axial strain vs creep time at one load, "
                                                     f"{curve.label} (Fig. 6; (a)-(d): crack-map times)"))
-        cracks = read_cracks(focus["folder"])
+        cracks = read_cracks(focus["folder"], _factor(focus))
         dims = [_num(focus.get(k)) for k in ("specimen.width", "specimen.height", "specimen.grain_size")]
         if cracks is None:
             reason = "cracks.csv missing or lacking columns in " + str(focus["folder"])
@@ -314,11 +451,19 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
             reason = "params.json lacks specimen.width/height/grain_size in " + str(focus["folder"])
         else:
             reason = None
+            specimen = None
+            if grains:
+                specimen, grain_text = _grains(focus, cracks)
+                content.notes.append(grain_text)
+            else:
+                content.notes.append("Crack maps: grains not drawn (--no-grains); specimen outline only.")
             for by in ("mode", "kind"):
                 name = f"crack_maps_{by}.png"
-                crackmaps.crack_maps_figure(out / name, cracks, times, labels, *dims, colour_by=by, title=curve.label)
+                crackmaps.crack_maps_figure(out / name, cracks, times, labels, *dims, colour_by=by, title=curve.label,
+                                            specimen=specimen)
                 content.figures.append((name, f"Crack maps at fractions of the lifetime, coloured by "
-                                              f"{crackmaps.TITLES[by]} (Fig. 7/8)"))
+                                              f"{crackmaps.TITLES[by]}" + (", on the run's grains" if specimen else
+                                                                           ", specimen outline") + " (Fig. 7/8)"))
         if reason:
             content.skipped += [(f"crack_maps_{by}.png", reason) for by in ("mode", "kind")]
 
