@@ -30,13 +30,19 @@ def true_lifetime(r):
     return float(np.exp(A_TRUE - B_TRUE * r))
 
 
-def write_run(root, name, ratio, seed=1, lifetime=None, failed=True, finished=True, end=None, segments=True):
-    """A creep run folder as run_creep_to_folder writes it (small history and crack list)."""
+BETA1_RUN = 1e-3
+
+
+def write_run(root, name, ratio, seed=1, lifetime=None, failed=True, finished=True, end=None, segments=True,
+              clock="event", mode="strength", params=None, n_bonds=700):
+    """A creep run folder as run_creep_to_folder writes it (small history and crack list).
+    ``params``: a full params.json tree (else a minimal one with ``clock`` and ``mode``)."""
     d = root / name
     d.mkdir(parents=True)
     (d / "run.json").write_text(json.dumps({"command": "creep", "seed": seed}))
-    params = {"specimen": {"width": WIDTH, "height": HEIGHT, "grain_size": GRAIN},
-              "stress_corrosion": {"clock": "event", "mode": "strength"}}
+    if params is None:
+        params = {"specimen": {"width": WIDTH, "height": HEIGHT, "grain_size": GRAIN},
+                  "stress_corrosion": {"clock": clock, "mode": mode, "beta1": BETA1_RUN, "rate_form": "beta"}}
     (d / "params.json").write_text(json.dumps(params))
     t_end = lifetime if failed else end
     rng = np.random.default_rng(seed)
@@ -70,7 +76,7 @@ def write_run(root, name, ratio, seed=1, lifetime=None, failed=True, finished=Tr
                    "failure_reason": "strain runs away" if failed else None, "creep_time_end_s": t_end,
                    "stress_pa": ratio * 250e6, "driving_stress_ratio": ratio, "ucs_pa": 250e6, "clock": "event",
                    "mode": "strength", "n_events": 10, "broken_ramp": 100, "broken_creep": int(broken[-1]),
-                   "broken_total": int(100 + broken[-1]), "macrocracks": int(broken[-1] // 2), "n_bonds": 700,
+                   "broken_total": int(100 + broken[-1]), "macrocracks": int(broken[-1] // 2), "n_bonds": n_bonds,
                    "dem_steps": 1000, "wall_s": 1.0, "primary_end_s": 0.2 * t_end if failed else None,
                    "tertiary_start_s": 0.8 * t_end if failed else None, "seed": seed, "params": params}
         (d / "summary.json").write_text(json.dumps(summary))
@@ -301,3 +307,199 @@ def test_cli_missing_study_and_empty_study_exit_2(tmp_path):
     assert main(["analyze", str(tmp_path / "nope")]) == 2
     (tmp_path / "empty").mkdir()
     assert main(["analyze", str(tmp_path / "empty")]) == 2
+
+
+# ---------------------------------------------------------------- rescaling to another beta1
+
+def test_rescaling_event_clock_study_divides_every_time_by_k(tmp_path):
+    from grainfrac_yade.analysis.study import analyze_study, load_study, read_cracks, read_history
+    study = make_study(tmp_path / "study", seeds=(1, 2), extra=False)
+    write_run(study, "survivor_run", 0.55, 1, failed=False, end=3e8)
+    k = 7.0
+    base = analyze_study(study, out=tmp_path / "base", map_fractions=(1.0,), grains=False)
+    fast = analyze_study(study, out=tmp_path / "fast", map_fractions=(1.0,), grains=False, beta1=k * BETA1_RUN)
+    runs0 = pd.read_csv(base.parent / "runs.csv").set_index("run")
+    runs1 = pd.read_csv(fast.parent / "runs.csv").set_index("run")
+    for col in ("lifetime_s", "creep_time_end_s", "primary_end_s", "tertiary_start_s"):
+        both = runs0[col].notna()
+        assert both.sum() >= 1 and np.allclose(runs1.loc[both, col], runs0.loc[both, col] / k, rtol=1e-12, atol=0)
+    assert runs1.loc["survivor_run", "creep_time_end_s"] == pytest.approx(3e8 / k, rel=1e-12)
+    assert np.allclose(runs1["time_factor"], 1 / k, rtol=1e-15) and (runs1["beta1_run"] == BETA1_RUN).all()
+    c0 = pd.read_csv(base.parent / "lifetime_fits.csv").set_index("dataset").loc["model"]
+    c1 = pd.read_csv(fast.parent / "lifetime_fits.csv").set_index("dataset").loc["model"]
+    assert c1["a_ln_s"] == pytest.approx(c0["a_ln_s"] - np.log(k), abs=1e-9)    # exp(a) / k
+    assert c1["A_s"] == pytest.approx(c0["A_s"] / k, rel=1e-9)
+    assert c1["b"] == pytest.approx(c0["b"], abs=1e-9) and c1["n"] == pytest.approx(c0["n"], abs=1e-9)
+    assert c1["b_se"] == pytest.approx(c0["b_se"], rel=1e-9)
+    # per-run files: history and crack times scaled, the ramp marker -1 kept
+    runs = load_study(study, beta1=k * BETA1_RUN)
+    folder = str(study / "ratio0.7_seed1")
+    f = runs.set_index("folder").loc[folder, "time_factor"]
+    h0, h1 = read_history(folder), read_history(folder, f)
+    assert np.allclose(h1["creep_time_s"], h0["creep_time_s"] / k, rtol=1e-12, atol=0)
+    cr0, cr1 = read_cracks(folder), read_cracks(folder, f)
+    ramp = cr0["creep_time_s"] < 0
+    assert ramp.any() and (cr1.loc[ramp, "creep_time_s"] == -1).all()
+    assert np.allclose(cr1.loc[~ramp, "creep_time_s"], cr0.loc[~ramp, "creep_time_s"] / k, rtol=1e-12, atol=0)
+    text = fast.read_text()
+    head = text.split("## Runs")[0]
+    assert "All creep times in this report are rescaled" in head and f"to beta1 = {k * BETA1_RUN:g} Pa/s" in head
+    assert f"{BETA1_RUN:g} Pa/s" in head and "exact" in head
+    assert "rescaled" not in base.read_text()
+
+
+@pytest.mark.parametrize("clock,mode,reason", [("paper", "strength", "paper clock"),
+                                               ("event", "area", "only strength mode")])
+def test_rescaling_refuses_paper_clock_and_area_runs(tmp_path, clock, mode, reason):
+    from grainfrac_yade.analysis.study import analyze_study
+    study = make_study(tmp_path / "study", ratios=(0.7, 0.8), extra=False)
+    write_run(study, "odd_run", 0.75, 1, lifetime=1e6, clock=clock, mode=mode)
+    with pytest.raises(GrainfracError) as err:
+        analyze_study(study, out=tmp_path / "rep", beta1=2e-3)
+    msg = str(err.value)
+    assert "odd_run" in msg and reason in msg and "fix:" in msg and "\n" not in msg
+    assert not (tmp_path / "rep").exists()
+    analyze_study(study, out=tmp_path / "rep", map_fractions=(1.0,), grains=False)   # without --beta1: fine
+
+
+def test_cli_beta1_file_and_its_errors(tmp_path, capsys):
+    study = make_study(tmp_path / "study", ratios=(0.6, 0.8), extra=False, segments=False)
+    toml = tmp_path / "calibrated.toml"
+    toml.write_text("[stress_corrosion]\nbeta1 = 4e-3\n")
+    res = run_cli(study, "--beta1-file", toml, "--out", tmp_path / "rep", "--map-fractions", "1")
+    assert res.returncode == 0, res.stderr
+    coef = pd.read_csv(tmp_path / "rep" / "lifetime_fits.csv").set_index("dataset")
+    assert coef.loc["model", "a_ln_s"] == pytest.approx(A_TRUE - np.log(4.0), abs=1e-9)
+    assert "--beta1-file" in (tmp_path / "rep" / "report.md").read_text()
+    from grainfrac_yade.cli import main
+    none = tmp_path / "none.toml"
+    none.write_text("[stress_corrosion]\nbeta2 = 1e-7\n")
+    for args, words in (([ "--beta1-file", str(tmp_path / "missing.toml")], ("missing.toml", "not found")),
+                        (["--beta1-file", str(none)], ("none.toml", "beta1")), (["--beta1", "-1"], ("positive",))):
+        capsys.readouterr()
+        assert main(["analyze", str(study), "--out", str(tmp_path / "rep2"), *args]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and all(w in err for w in words), err
+    assert not (tmp_path / "rep2").exists()
+
+
+# ---------------------------------------------------------------- grains under the crack maps
+
+SMALL = ["specimen.width=6e-3", "specimen.height=12e-3"]
+
+
+@pytest.fixture(scope="module")
+def real_run():
+    """A real parameter set (small specimen), its specimen and layout as the run would build them."""
+    from grainfrac_yade.layout import build_layout
+    from grainfrac_yade.params import load_parameters
+    from grainfrac_yade.specimen import build_specimen
+    params = load_parameters(overrides=SMALL)
+    seed = 5
+    specimen = build_specimen(params, seed)
+    return params, seed, specimen, build_layout(specimen, params.resolution.spheres_per_cell)
+
+
+def write_real_run(root, real_run, name="real_run", n_bonds=None):
+    """A synthetic creep run whose params.json is a real one and whose cracks sit on real bonds."""
+    params, seed, specimen, layout = real_run
+    tree = json.loads(json.dumps(params.to_dict()))
+    d = write_run(root, name, 0.7, seed, lifetime=true_lifetime(0.7), params=tree,
+                  n_bonds=layout.n_bonds if n_bonds is None else n_bonds)
+    cracks = pd.read_csv(d / "cracks.csv")
+    bond = np.arange(len(cracks)) * (layout.n_bonds // len(cracks))
+    cracks["bond"] = bond
+    cracks["x_m"], cracks["y_m"] = layout.bond_point[bond, 0], layout.bond_point[bond, 1]
+    cracks.to_csv(d / "cracks.csv", index=False)
+    return d
+
+
+def test_parameters_from_json_round_trips_and_fills_older_files(tmp_path, real_run):
+    from grainfrac_yade.analysis.runparams import load_run_parameters, parameters_from_json, rebuild_specimen
+    from grainfrac_yade.layout import build_layout
+    params, seed, specimen, layout = real_run
+    d = write_real_run(tmp_path, real_run)
+    assert parameters_from_json(d / "params.json") == params      # contacts "a/b", friction in degrees
+    assert parameters_from_json(d) == params
+    rebuilt = rebuild_specimen(d, seed, n_bonds=layout.n_bonds, cracks=pd.read_csv(d / "cracks.csv"))
+    assert rebuilt.specimen.n_cells == specimen.n_cells
+    assert np.array_equal(rebuilt.specimen.mineral, specimen.mineral)
+    assert build_layout(rebuilt.specimen, params.resolution.spheres_per_cell).n_bonds == layout.n_bonds
+    assert len(rebuilt.checks) == 2 and not rebuilt.run_params.filled
+    # an older params.json without a key added later
+    tree = json.loads((d / "params.json").read_text())
+    del tree["stress_corrosion"]["rate_form"]
+    (d / "params.json").write_text(json.dumps(tree))
+    with pytest.raises(GrainfracError, match="rate_form"):
+        parameters_from_json(d)
+    old = load_run_parameters(d, fill_missing=True)
+    assert old.filled == ("stress_corrosion.rate_form",) and old.params == params
+    assert rebuild_specimen(d, seed).specimen.n_cells == specimen.n_cells
+    del tree["specimen"]["lloyd_iterations"]   # shapes the tessellation: no rebuild
+    (d / "params.json").write_text(json.dumps(tree))
+    with pytest.raises(GrainfracError, match="lloyd_iterations"):
+        rebuild_specimen(d, seed)
+    with pytest.raises(GrainfracError, match="bonds"):
+        rebuild_specimen(write_real_run(tmp_path, real_run, "other"), seed, n_bonds=layout.n_bonds + 1)
+
+
+def _colours(path):
+    import matplotlib.image as mpimg
+    img = (mpimg.imread(path)[..., :3] * 255).astype(np.uint8)
+    return len(np.unique(img.reshape(-1, 3), axis=0))
+
+
+def test_crack_maps_drawn_on_the_rebuilt_grains_or_outline_with_reason(tmp_path, real_run):
+    from grainfrac_yade.analysis.study import analyze_study
+    study = tmp_path / "study"
+    write_real_run(study, real_run)
+    write_real_run(study, real_run, "real_run_2", n_bonds=None).joinpath("summary.json").write_text(
+        (study / "real_run" / "summary.json").read_text().replace('"driving_stress_ratio": 0.7',
+                                                                   '"driving_stress_ratio": 0.8'))
+    report = analyze_study(study, out=tmp_path / "grains", map_fractions=(0.5, 1.0), focus_ratio=0.7)
+    text = report.read_text()
+    assert "Crack maps drawn on the run's grains" in text and "verified:" in text
+    for by in ("mode", "kind"):
+        _check_png(report.parent / f"crack_maps_{by}.png")
+    plain = analyze_study(study, out=tmp_path / "plain", map_fractions=(0.5, 1.0), focus_ratio=0.7, grains=False)
+    assert _colours(report.parent / "crack_maps_mode.png") > 2 * _colours(plain.parent / "crack_maps_mode.png")
+    # a run whose records do not match its params.json: outline, the reason in the report, no crash
+    summary = study / "real_run" / "summary.json"
+    summary.write_text(summary.read_text().replace(f'"n_bonds": {real_run[3].n_bonds}', '"n_bonds": 3'))
+    bad = analyze_study(study, out=tmp_path / "bad", map_fractions=(0.5, 1.0), focus_ratio=0.7)
+    line = next(t for t in bad.read_text().splitlines() if "grains not drawn" in t)
+    assert "real_run" in line and "3" in line and "outline" in line
+    _check_png(bad.parent / "crack_maps_mode.png")
+
+
+# ---------------------------------------------------------------- several studies, titles
+
+def test_several_studies_fitted_separately_side_by_side(tmp_path, capsys):
+    first = make_study(tmp_path / "alpha", ratios=(0.6, 0.8), extra=False, segments=False)
+    second = tmp_path / "beta"
+    for r in (0.6, 0.7, 0.9):
+        write_run(second, f"r{r}", r, 1, lifetime=float(np.exp(20.0 - 10.0 * r)), segments=False)
+    res = run_cli(first, second, "--out", tmp_path / "rep", "--map-fractions", "1", "--no-grains")
+    assert res.returncode == 0, res.stderr
+    coef = pd.read_csv(tmp_path / "rep" / "lifetime_fits.csv").set_index("dataset")
+    assert coef.loc["alpha", "a_ln_s"] == pytest.approx(A_TRUE, abs=1e-9)
+    assert coef.loc["beta", "a_ln_s"] == pytest.approx(20.0, abs=1e-9) and coef.loc["beta", "b"] == pytest.approx(10.0)
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert "| quantity | alpha | beta |" in text and "[alpha/ratio0.6_seed1]" in text
+    from grainfrac_yade.cli import main
+    assert main(["analyze", str(first), str(second)]) == 2
+    assert "--out" in capsys.readouterr().err
+
+
+def test_long_titles_are_wrapped_inside_the_figure():
+    from grainfrac_yade.analysis.figures import _title
+    from grainfrac_yade.plotting import plt
+    fig, ax = plt.subplots(figsize=(4, 3))
+    t = _title(ax, "Axial strain vs creep time (normalised) (paper Fig. 5); failure leaves the top of the axis")
+    r = fig.canvas.get_renderer()
+    assert "\n" in t.get_text()
+    box = t.get_window_extent(r)
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.width
+    short = _title(ax, "Damage index")
+    assert "\n" not in short.get_text()
+    plt.close(fig)

@@ -57,10 +57,19 @@ def _save(fig, path):
     return path
 
 
-def _title(ax, text: str, fig_width_in: float, fontsize: float = 10, **kw):
-    """Title wrapped to the axes width (about 0.55 character widths per point of font size)."""
-    chars = max(30, int(fig_width_in * 72 * 0.85 / (0.55 * fontsize)))
-    ax.set_title(textwrap.fill(text, chars), fontsize=fontsize, **kw)
+def _title(ax, text: str, fontsize: float = 10, **kw):
+    """Title on one line if it fits inside the figure's width, else wrapped until it does."""
+    fig = ax.figure
+    title = ax.set_title(text, fontsize=fontsize, **kw)
+    renderer = fig.canvas.get_renderer()
+    box = ax.get_position()   # the title is centred on the axes: it must fit on both sides of the centre
+    centre = 0.5 * (box.x0 + box.x1)
+    room = 0.97 * 2 * min(centre, 1 - centre) * fig.bbox.width
+    chars = len(text)
+    while title.get_window_extent(renderer).width > room and chars > 20:
+        chars = int(chars * 0.9)
+        title.set_text(textwrap.fill(text, chars))
+    return title
 
 
 def _fit_lines(ax, fit: LifetimeFit, ratios, colour, label):
@@ -130,9 +139,8 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
         ax.axvline(lts, color="0.4", lw=1, ls=":")
     ax.set_yscale("log")
     ax.set_xlabel("driving-stress ratio sigma / sigma_c [-]")
-    ax.set_ylabel("lifetime (time to failure) [s]" + ("\n" + time_note if time_note else ""))
-    _title(ax, "Lifetime vs driving-stress ratio (paper Fig. 4)" + (f" - {time_note}" if time_note else ""),
-           fig.get_figwidth())
+    ax.set_ylabel("lifetime (time to failure) [s]")
+    _title(ax, "Lifetime vs driving-stress ratio (paper Fig. 4)" + (f" - {time_note}" if time_note else ""))
     ax.grid(True, which="major", alpha=0.3)
     leg = ax.legend(fontsize=6, loc="best", framealpha=0.85, title=time_note, title_fontsize=6.5)
     if time_note:
@@ -202,7 +210,7 @@ def strain_time_figure(path, curves, normalised: bool = False, time_note: str | 
         ax.set_xlabel("creep time [s]" + (f" ({time_note})" if time_note else ""))
     ax.set_ylabel("axial strain [%]")
     _title(ax, "Axial strain vs creep time" + (" (normalised)" if normalised else "") + " (paper Fig. 5); "
-           "failure leaves the top", fig.get_figwidth())
+           "failure leaves the top")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=6, loc="upper left")
     return _save(fig, path)
@@ -227,7 +235,7 @@ def bonds_strain_figure(path, curve: Curve, mark_times=(), time_note: str | None
     limits = _strain_limits([curve])
     if limits:
         ax.set_ylim(*limits)
-    ax.set_xlabel("creep time [s]" + (f" ({time_note})" if time_note else ""))
+    ax.set_xlabel("creep time [s]")
     ax.set_ylabel("axial strain [%]", color="tab:blue")
     ax2 = ax.twinx()
     nb = broken_creep(curve)
@@ -243,7 +251,8 @@ def bonds_strain_figure(path, curve: Curve, mark_times=(), time_note: str | None
         ax.text(tm, ax.get_ylim()[1], f"({chr(ord('a') + k)})", ha="center", va="bottom", fontsize=7,
                 color="tab:green")
     state = f"lifetime {curve.t_ref_s:.4g} s" if curve.failed else f"not failed by {curve.t_ref_s:.4g} s"
-    _title(ax, f"{curve.label}: {state} (paper Fig. 6)", fig.get_figwidth(), fontsize=9, pad=14)
+    _title(ax, f"{curve.label}: {state} (paper Fig. 6)" + (f"; {time_note}" if time_note else ""), fontsize=9,
+           pad=14)
     lines = ax.get_legend_handles_labels()
     lines2 = ax2.get_legend_handles_labels()
     ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], fontsize=7, loc="center left")
@@ -262,7 +271,7 @@ def damage_figure(path, curves):
     ax.set_ylabel("damage index D_n = N(t) / N(t_f) [-]")
     ax.set_xlim(0, 1.02)
     ax.set_ylim(0, 1.05)
-    _title(ax, "Damage index (paper Eq. 9, Fig. 9)", fig.get_figwidth())
+    _title(ax, "Damage index (paper Eq. 9, Fig. 9)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)

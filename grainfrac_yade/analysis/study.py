@@ -467,7 +467,10 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         if reason:
             content.skipped += [(f"crack_maps_{by}.png", reason) for by in ("mode", "kind")]
 
-    if multi:
+    if len(folders) > 1:
+        content.notes.append("Several studies: runs are labelled by study (column study; run = study/run) and each "
+                             "study (or each variant within a study) is fitted and drawn separately.")
+    elif multi:
         content.notes.append("The creep runs differ in parameters (see column variant): each variant is fitted "
                              "and drawn separately.")
     other = int((runs["outcome"] == "not creep").sum())
