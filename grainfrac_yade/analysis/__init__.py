@@ -2,8 +2,10 @@
 
 Modules: :mod:`.collect` (run folders -> DataFrame), :mod:`.lifetimes` (run outcomes, scatter per
 ratio), :mod:`.fits` (static-fatigue laws), :mod:`.labdata` (lab CSV, paper reference values),
-:mod:`.figures` and :mod:`.crackmaps` (PNG), :mod:`.report` (markdown), :mod:`.study`
-(``analyze_study``: a study folder -> report.md; imports matplotlib).
+:mod:`.figures` and :mod:`.crackmaps` (PNG), :mod:`.report` (markdown), :mod:`.runparams`
+(params.json -> Parameters, the run's specimen rebuilt and verified), :mod:`.rescale` (creep times
+at another beta1, exact for event-clock strength-mode runs), :mod:`.study` (``analyze_study``:
+study folder(s) -> report.md; imports matplotlib).
 """
 from .collect import collect_runs, group_stats  # noqa: F401
 from .fits import coefficient_table, fit_lifetimes, fit_line  # noqa: F401

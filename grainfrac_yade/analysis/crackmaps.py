@@ -100,7 +100,7 @@ def crack_maps_figure(path, cracks: pd.DataFrame, times, labels, width: float, h
         h.set_label(f"grain: {h.get_label()}")
     handles += mineral_handles
     if specimen is None:
-        handles.append(Line2D([], [], color="none", label="grains not drawn (specimen not rebuilt)"))
+        handles.append(Line2D([], [], color="none", label="grains not drawn (see report)"))
     ncol = 4 if mineral_handles else 3
     rows = -(-len(handles) // ncol)
     bottom = min(0.35, (0.2 * rows + 0.08) / fig.get_figheight())   # legend band [fraction of the figure]
