@@ -315,15 +315,19 @@ def _section_origin(origins: Mapping, section: str) -> str:
 
 
 # --------------------------------------------------------------------------- loading
-def _flatten(table: Mapping, prefix: str = "") -> dict:
+def flatten(table: Mapping, prefix: str = "", hashable: bool = False) -> dict:
+    """Nested dict -> {"section.key": value}; ``hashable`` turns lists into tuples (to compare, group)."""
     out = {}
     for key, value in table.items():
         dotted = f"{prefix}{key}"
         if isinstance(value, dict):
-            out.update(_flatten(value, dotted + "."))
+            out.update(flatten(value, dotted + ".", hashable))
         else:
-            out[dotted] = value
+            out[dotted] = tuple(value) if hashable and isinstance(value, list) else value
     return out
+
+
+_flatten = flatten
 
 
 def _merge(base: dict, new: Mapping, origins: dict, source: str, prefix: str = ""):

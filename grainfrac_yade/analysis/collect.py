@@ -6,6 +6,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..params import flatten as flatten_tree
+
 #: Parameter paths copied from each run's params.json into the table.
 PARAM_COLUMNS = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height",
                  "calibration.strength_scale", "calibration.stiffness_scale", "stress_corrosion.clock",
@@ -23,14 +25,7 @@ def _get(tree: dict, dotted: str):
 
 def flatten(tree: dict, prefix: str = "") -> dict:
     """Nested dict -> {"section.key": value} (lists kept as tuples so that they compare and hash)."""
-    out = {}
-    for key, value in tree.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, dict):
-            out.update(flatten(value, name + "."))
-        else:
-            out[name] = tuple(value) if isinstance(value, list) else value
-    return out
+    return flatten_tree(tree, prefix, hashable=True)
 
 
 def _read_json(path: Path) -> dict:

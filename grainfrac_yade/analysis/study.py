@@ -20,7 +20,7 @@ from .collect import collect_runs, flatten
 from .figures import Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
-from .lifetimes import classify_runs, lifetime_stats, representatives
+from .lifetimes import _num, classify_runs, lifetime_stats, representatives
 from .report import ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
 from .runparams import default_tree, rebuild_specimen
 
@@ -193,13 +193,6 @@ def lifetime_sets(runs: pd.DataFrame) -> list:
                                 at_load_ratio=at_load["driving_stress_ratio"].to_numpy(float)))
     return sets
 
-
-def _num(v) -> float:
-    try:
-        v = float(v)
-    except (TypeError, ValueError):
-        return float("nan")
-    return v
 
 
 def _factor(row: dict) -> float:
