@@ -19,8 +19,9 @@ import pandas as pd
 from ..errors import GrainfracError
 from .fits import check_lifetimes
 
-#: shared/reference next to the repository (the repository is <root>/main, shared is <root>/shared).
-DEFAULT_REFERENCE_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "reference"
+#: Copies of shared/reference kept in the repository (params/reference/README.md), so that every
+#: clone finds them; ``--reference DIR`` reads another folder.
+DEFAULT_REFERENCE_DIR = Path(__file__).resolve().parents[2] / "params" / "reference"
 PAPER_VALUES = "paper_values.csv"
 LAB_README = "lab_lifetimes_README.md"
 #: Lajtai & Schmidtke (1986) via lab_lifetimes_README.md: long-term strength of humid LdB granite
