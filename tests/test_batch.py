@@ -39,3 +39,17 @@ def test_a_row_without_load_is_one_clear_line(tmp_path):
     assert len(errors) == 1 and "ratio" in errors[0] and "fix:" in errors[0]
     assert "Traceback" not in log
     assert not (tmp_path / "bad" / "run.json").exists()
+
+
+def test_only_an_explicit_description_column_names_the_folder(tmp_path, monkeypatch):
+    from grainfrac_yade.yade_adapter.batch import explicit_description_column
+    named = tmp_path / "named.table"
+    named.write_text("# a comment\ndescription ratio seed\n'slow_ramp' 0.7 1\n")
+    plain = tmp_path / "plain.table"
+    plain.write_text("ratio seed\n0.7 1\n")
+    monkeypatch.setenv("YADE_BATCH", f"{named}:3")
+    assert explicit_description_column()
+    monkeypatch.setenv("YADE_BATCH", f"{plain}:2")
+    assert not explicit_description_column()
+    monkeypatch.delenv("YADE_BATCH")
+    assert not explicit_description_column()

@@ -231,6 +231,7 @@ def run_creep_in_yade():
         print(f"error: {exc}")
         sys.exit(2)
     name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
+    name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
     out = Path(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, name_parts + overrides)}")
     if (out / "summary.json").exists():
         print(f"creep row already finished, skipped: {out}")

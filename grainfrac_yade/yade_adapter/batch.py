@@ -6,6 +6,7 @@ with YADE's own ``readParamsFromTable`` and validated like files.
 """
 from __future__ import annotations
 
+import os
 import re
 
 from ..params import _flatten, default_files, read_toml
@@ -36,9 +37,29 @@ def read_table(extra_columns=None) -> tuple:
     table = yade.params.table
     overrides = [(k, getattr(table, k)) for k, v in defaults.items() if getattr(table, k) != v]
     controls = {k: getattr(table, k) for k in run_defaults}
-    if not controls["description"]:
-        controls["description"] = yade.O.tags.get("description", "") if hasattr(yade.O.tags, "get") else ""
+    if not controls["description"] and explicit_description_column():
+        controls["description"] = yade.O.tags["description"]
     return overrides, controls
+
+
+def explicit_description_column() -> bool:
+    """True if the running yade-batch table has its own ``description`` column.
+
+    YADE puts the row's description in ``O.tags["description"]`` and synthesizes one
+    ("col=value,...") when the table has none; only an explicit one names the run folder.
+    """
+    spec = os.environ.get("YADE_BATCH", "")
+    if not spec:
+        return False
+    table = spec.rsplit(":", 1)[0]
+    try:
+        with open(table) as fh:
+            for line in fh:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return "description" in line.split()
+    except OSError:
+        return False
+    return False
 
 
 def run_folder_name(controls: dict, overrides) -> str:
