@@ -88,3 +88,24 @@ def test_event_clock_lifetime_scales_exactly_with_beta1(small_ucs):
     assert base.failed and fast.failed
     assert fast.n_events == base.n_events and int(fast.scene.broken.sum()) == int(base.scene.broken.sum())
     assert fast.rows[-1]["creep_time_s"] == pytest.approx(base.rows[-1]["creep_time_s"] / 10, rel=1e-9)
+
+
+def test_small_specimen_creep_curve_has_three_stages():
+    """10 x 20 mm, seed 1, 0.6 of 258 MPa (the 10 x 20 mm mean UCS): a decelerating start, a
+    near-constant middle and an accelerating end before collapse (measured: primary ends at 0.40
+    t_f, tertiary starts at 0.46 t_f; strain rate 4e-12 -> 8e-16 -> 5e-11 1/s). Small specimens
+    creep in steps (16 events here), so this checks the stage detector on a real staircase; the
+    paper-size specimen gives smooth three-stage curves (README)."""
+    from grainfrac_yade.creep_analysis import STAGE_RATE_FACTOR, STAGE_WINDOW, creep_stages, local_rates
+    from grainfrac_yade.yade_adapter.creep_test import run_creep
+    p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3",
+                                   "stress_corrosion.creep_time_limit=1e30"])
+    run = run_creep(build_specimen(p, 1), p, 0.6 * 258e6)
+    assert run.failed and not run.failed_on_loading
+    t = np.array([r["creep_time_s"] for r in run.rows])
+    strain = np.array([r["axial_strain"] for r in run.rows])
+    primary_end, tertiary_start = creep_stages(t[:-1], strain[:-1], t[-1])
+    assert STAGE_WINDOW / 2 < primary_end / t[-1] <= tertiary_start / t[-1] < 1 - STAGE_WINDOW / 2
+    tau, rate = local_rates(t[:-1], strain[:-1], t[-1])
+    inner = rate[(tau >= STAGE_WINDOW / 2) & (tau <= 1 - STAGE_WINDOW / 2)]
+    assert inner[0] > STAGE_RATE_FACTOR * inner.min() and inner[-1] > STAGE_RATE_FACTOR * inner.min()
