@@ -91,7 +91,7 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
     """Lifetime vs driving-stress ratio, log time (paper Fig. 4): model points, lower bounds, both fits
     with confidence bands; lab points and fits, or the paper's UDEC value and the 1986 bound.
     ``time_note`` (e.g. rescaled times) goes into the title and the legend's title."""
-    fig, ax = plt.subplots(figsize=(7.2, 5.2))
+    fig, ax = plt.subplots(figsize=(12.5, 5.6))
     colours = plt.cm.tab10.colors
     all_ratios = []
     for k, s in enumerate(model_sets):
@@ -142,7 +142,9 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
     ax.set_ylabel("lifetime (time to failure) [s]")
     _title(ax, "Lifetime vs driving-stress ratio (paper Fig. 4)" + (f" - {time_note}" if time_note else ""))
     ax.grid(True, which="major", alpha=0.3)
-    leg = ax.legend(fontsize=6, loc="best", framealpha=0.85, title=time_note, title_fontsize=6.5)
+    # legend beside the axes: with several studies it would hide points inside
+    leg = ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), framealpha=0.85, title=time_note,
+                    title_fontsize=6.5)
     if time_note:
         leg.get_title().set_fontweight("bold")
     return _save(fig, path)
