@@ -503,3 +503,11 @@ def test_long_titles_are_wrapped_inside_the_figure():
     short = _title(ax, "Damage index")
     assert "\n" not in short.get_text()
     plt.close(fig)
+
+
+def test_a_run_that_failed_on_loading_is_its_own_outcome():
+    from grainfrac_yade.analysis.lifetimes import outcome
+    base = {"status": "finished", "command": "creep", "failed": True}
+    assert outcome(dict(base, lifetime_s=0.0, failed_on_loading=True)) == "failed at load"
+    assert outcome(dict(base, lifetime_s=0.0)) == "failed at load"          # older runs without the key
+    assert outcome(dict(base, lifetime_s=12.5, failed_on_loading=False)) == "failed"

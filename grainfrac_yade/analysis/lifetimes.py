@@ -41,6 +41,8 @@ def outcome(row) -> str:
         return "unfinished"
     failed = row.get("failed")
     if failed is True or failed == 1:
+        if row.get("failed_on_loading") is True:
+            return "failed at load"
         life = _num(row.get("lifetime_s"))
         if not math.isfinite(life) or life < 0:
             return "unreadable"
