@@ -327,9 +327,6 @@ def flatten(table: Mapping, prefix: str = "", hashable: bool = False) -> dict:
     return out
 
 
-_flatten = flatten
-
-
 def _merge(base: dict, new: Mapping, origins: dict, source: str, prefix: str = ""):
     for key, value in new.items():
         dotted = f"{prefix}{key}"
@@ -409,7 +406,7 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
         _merge(merged, read_toml(path), origins, str(path))
     for text in overrides:
         key, value = parse_override(text) if isinstance(text, str) else text
-        flat_known = _flatten(merged)
+        flat_known = flatten(merged)
         if key not in flat_known and not _is_new_pair_key(key):
             raise ParameterError("--set", key, "no such parameter",
                                  "use a dotted key that exists in the parameter files, e.g. "

@@ -49,16 +49,9 @@ def check_beta1(value, source: str = "--beta1") -> float:
 
 def beta1_from_toml(path) -> float:
     """``[stress_corrosion] beta1`` of a TOML file (e.g. params/stress_corrosion_calibrated.toml)."""
-    import tomllib
+    from ..params import read_toml   # one TOML reader: missing file / bad syntax as one-line errors
     path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise GrainfracError(f"{path}: --beta1-file not found; fix: give an existing TOML file with "
-                             "[stress_corrosion] beta1 = ... (or use --beta1 VALUE)") from None
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise GrainfracError(f"{path}: not readable TOML ({exc}); fix: correct the file") from None
+    data = read_toml(path)
     sc = data.get("stress_corrosion")
     if not isinstance(sc, dict) or "beta1" not in sc:
         raise GrainfracError(f"{path}: no [stress_corrosion] beta1; fix: add beta1 = ... [Pa/s] to its "

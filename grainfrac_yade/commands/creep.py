@@ -94,12 +94,12 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     t0 = time.time()
     out = prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
-    outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", {k: [r[k] for r in rows] for k in rows[0]})}
+    outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", history_columns(rows))}
     if vtk_times is not None:
         outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
     run = run_creep(specimen, params, stress, progress=progress, **outputs)
     rows = run.rows
-    hist = {k: np.array([r[k] for r in rows]) for k in rows[0]}
+    hist = history_columns(rows)
     broken_creep = hist["broken_total"] - run.ramp_broken
     t_end = float(hist["creep_time_s"][-1])
     lifetime = t_end if run.failed else None
@@ -139,6 +139,11 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                   title=f"{stress / 1e6:.0f} MPa: cracks at t = {t:.4g} s ({frac:.0%} of "
                         f"{'lifetime' if lifetime else 'run'})")
     return summary
+
+
+def history_columns(rows) -> dict:
+    """History rows (dicts) as columns {name: array}, as history.csv stores them."""
+    return {k: np.array([r[k] for r in rows]) for k in rows[0]}
 
 
 def write_crack_list(path, run):

@@ -92,10 +92,10 @@ def cmd_demo(args) -> int:
 
 def _flat_overrides(files, overrides) -> dict:
     """``--params`` files and ``section.key=value`` overrides as {path: value} columns of table rows."""
-    from ..params import _flatten, parse_override, read_toml
+    from ..params import flatten, parse_override, read_toml
     out = {}
     for path in files:
-        out.update(_flatten(read_toml(path)))
+        out.update(flatten(read_toml(path)))
     for item in overrides:
         key, value = parse_override(item) if isinstance(item, str) else item
         out[key] = value

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 import re
 
-from ..params import _flatten, default_files, read_toml
+from ..params import default_files, flatten, read_toml
 from . import load_yade
 
 #: Table columns that are not model parameters: run controls, with defaults.
@@ -20,7 +20,7 @@ def parameter_defaults() -> dict:
     """Flattened shipped parameters: {"section.key": value}."""
     merged = {}
     for path in default_files():
-        merged.update(_flatten(read_toml(path)))
+        merged.update(flatten(read_toml(path)))
     return merged
 
 

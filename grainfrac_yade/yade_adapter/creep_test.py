@@ -46,6 +46,7 @@ class CreepRun:
         #: at or after each time; the final state is always written when a folder is given)
         self.vtk_folder, self.vtk_times = vtk_folder, sorted(float(t) for t in vtk_times)
         self.vtk_written = []
+        self._vtk_rows = -1   # number of history rows when the last snapshot was written
         #: called with the rows so far every HISTORY_FLUSH_ROWS rows (partial history.csv)
         self.history_sink = history_sink
         self.progress = progress or (lambda msg: None)
@@ -197,10 +198,12 @@ class CreepRun:
             self.history_sink(self.rows)
 
     def write_vtk(self, creep_time):
+        """Snapshot of the current state, unless the last one was taken at this same history row."""
         from .vtk_output import write_snapshot
-        if self.corr is not None:
+        if self.corr is not None and self._vtk_rows != len(self.rows):
             write_snapshot(self.scene, self.corr, self.vtk_folder, len(self.vtk_written), creep_time)
             self.vtk_written.append(creep_time)
+            self._vtk_rows = len(self.rows)
 
     def run(self):
         self.ramp()
