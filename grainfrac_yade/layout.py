@@ -40,6 +40,17 @@ class ClumpLayout:
     bond_face: np.ndarray       # (b,) face index
     bond_area: np.ndarray       # (b,) [m^2]
     bond_point: np.ndarray      # (b, 3) contact point on the face [m]
+    #: False for deformable cells (``resolution.grain_model = "deformable"``): every sphere is a
+    #: body of its own, and the spheres of one cell are held together by the links below
+    rigid_cells: bool = True
+    link_spheres: np.ndarray | None = None           # (m, 2) sphere pairs of unbreakable intra-cell links
+    link_normal_stiffness: np.ndarray | None = None  # (m,) [N/m]
+    link_shear_stiffness: np.ndarray | None = None   # (m,) [N/m]
+    sphere_area: np.ndarray | None = None            # (s,) cell area lumped on each sphere [m^2] (mass share)
+
+    @property
+    def n_links(self) -> int:
+        return 0 if self.link_spheres is None else len(self.link_spheres)
 
     @property
     def n_spheres(self) -> int:
