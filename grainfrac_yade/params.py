@@ -93,6 +93,10 @@ class ContactParams:
 class ResolutionParams:
     """How finely a Voronoi cell is resolved by spheres."""
     spheres_per_cell: int = _spec("1", "positive_int", "target spheres per cell clump; 1 = one sphere")
+    grain_model: str = _spec("", "choice", "rigid: each cell one rigid body; deformable: each cell a cluster of "
+                             "spheres held together by unbreakable elastic links", ("rigid", "deformable"))
+    nodes_per_face: int = _spec("1", "positive_int", "deformable cells: breakable bonds per Voronoi face "
+                                "(ignored by rigid cells)")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -107,6 +107,25 @@ def test_bad_file_gives_one_clear_line(tmp_path, old, new, key, words):
     assert key in msg and words in msg and "fix:" in msg
 
 
+@pytest.mark.parametrize("old,new,key,words", [
+    ('grain_model = "rigid"', 'grain_model = "soft"', "resolution.grain_model", "not one of ['rigid', 'deformable']"),
+    ("nodes_per_face = 2", "nodes_per_face = 0", "resolution.nodes_per_face", "must be >= 1"),
+])
+def test_bad_grain_model_gives_one_clear_line(tmp_path, old, new, key, words):
+    f, files = _write_variant(tmp_path, old, new, name="numerics.toml")
+    with pytest.raises(ParameterError) as err:
+        load_parameters(files)
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert str(f) in msg and key in msg and words in msg and "fix:" in msg
+
+
+def test_grain_model_defaults_to_rigid_cells(params):
+    assert params.resolution.grain_model == "rigid" and params.resolution.nodes_per_face == 2
+    p = load_parameters(overrides=["resolution.grain_model=deformable", "resolution.nodes_per_face=3"])
+    assert p.resolution.grain_model == "deformable" and p.resolution.nodes_per_face == 3
+
+
 def test_missing_file_and_bad_syntax(tmp_path):
     with pytest.raises(ParameterError, match="nope.toml: \\(file\\): file not found"):
         load_parameters(extra_files=[tmp_path / "nope.toml"])
