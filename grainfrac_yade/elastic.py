@@ -68,6 +68,9 @@ class Network:
     spring_face: np.ndarray     # (m,) face index; -1 for internal links
     tri_nodes: np.ndarray       # (e, 3)
     tri_stiffness: np.ndarray   # (e, 3, 3) plane-strain D x thickness [N/m]
+    #: (m, 2, 2) lever arms of the forces' torques where they differ from the kinematic arms
+    #: (YADE: the contact point, radius - penetration/2, while the shear increment uses the radius)
+    spring_torque_arm: np.ndarray | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -98,8 +101,12 @@ def _dof_map(net: Network):
     return dofs, int(per_node.sum())
 
 
-def _spring_rows(net: Network, dofs: np.ndarray):
-    """Dof indices (m, 6) and coefficients of the normal and tangential relative displacement (m, 6)."""
+def _spring_rows(net: Network, dofs: np.ndarray, arm=None):
+    """Dof indices (m, 6) and coefficients of the normal and tangential relative displacement (m, 6).
+
+    With ``arm`` = the torque arms, the same rows are the generalised forces of unit spring forces.
+    """
+    arm = net.spring_arm if arm is None else arm
     n = net.spring_normal
     t = np.column_stack([-n[:, 1], n[:, 0]])
     a, b = net.spring_nodes[:, 0], net.spring_nodes[:, 1]
@@ -107,8 +114,8 @@ def _spring_rows(net: Network, dofs: np.ndarray):
 
     def coefficients(d):
         # z x arm = (-arm_y, arm_x); its component along d is the rotation's lever
-        lever_a = d[:, 0] * -net.spring_arm[:, 0, 1] + d[:, 1] * net.spring_arm[:, 0, 0]
-        lever_b = d[:, 0] * -net.spring_arm[:, 1, 1] + d[:, 1] * net.spring_arm[:, 1, 0]
+        lever_a = d[:, 0] * -arm[:, 0, 1] + d[:, 1] * arm[:, 0, 0]
+        lever_b = d[:, 0] * -arm[:, 1, 1] + d[:, 1] * arm[:, 1, 0]
         return np.column_stack([-d[:, 0], -d[:, 1], -lever_a, d[:, 0], d[:, 1], lever_b])
 
     return idx, coefficients(n), coefficients(t)
@@ -137,8 +144,9 @@ def stiffness_matrix(net: Network):
     dofs, ndof = _dof_map(net)
     rows, cols, vals = [], [], []
     idx, cn, ct = _spring_rows(net, dofs)
-    for k, c in ((net.spring_kn, cn), (net.spring_ks, ct)):
-        block = k[:, None, None] * c[:, :, None] * c[:, None, :]
+    _, fn, ft = _spring_rows(net, dofs, net.spring_torque_arm) if net.spring_torque_arm is not None else (0, cn, ct)
+    for k, c, f in ((net.spring_kn, cn, fn), (net.spring_ks, ct, ft)):
+        block = k[:, None, None] * f[:, :, None] * c[:, None, :]
         rows.append(np.repeat(idx, 6, axis=1).ravel())
         cols.append(np.tile(idx, (1, 6)).ravel())
         vals.append(block.reshape(len(k), -1).ravel())
@@ -257,12 +265,21 @@ def contact_ratios(net: Network, sol: ElasticSolution):
 
 # --------------------------------------------------------------------------- model builders
 def _spring_geometry(center_a, radius_a, center_b, radius_b, body_a, body_b):
-    """Normal along the centre line and YADE's lever arms (sphere radii along the normal) from the bodies."""
+    """Normal along the centre line and YADE's lever arms from the bodies.
+
+    Kinematic arms: the sphere radii along the normal (``Ig2_Sphere_Sphere_ScGeom`` with
+    ``avoidGranularRatcheting``); torque arms: to the contact point, radius - penetration/2
+    (the JCFpm law's torques).  Returns (normal, kinematic arms, torque arms).
+    """
     d = center_b - center_a
-    normal = d / np.linalg.norm(d, axis=1)[:, None]
-    arm_a = (center_a - body_a) + radius_a[:, None] * normal
-    arm_b = (center_b - body_b) - radius_b[:, None] * normal
-    return normal, np.stack([arm_a, arm_b], axis=1)
+    dist = np.linalg.norm(d, axis=1)
+    normal = d / dist[:, None]
+    half_pen = 0.5 * (radius_a + radius_b - dist)
+
+    def arms(ra, rb):
+        return np.stack([(center_a - body_a) + ra[:, None] * normal, (center_b - body_b) - rb[:, None] * normal], axis=1)
+
+    return normal, arms(radius_a, radius_b), arms(radius_a - half_pen, radius_b - half_pen)
 
 
 def rigid_network(specimen: Specimen, params: Parameters) -> Network:
@@ -275,14 +292,15 @@ def rigid_network(specimen: Specimen, params: Parameters) -> Network:
     s = layout.bond_spheres
     cells = layout.sphere_cell[s]
     c2 = layout.sphere_center[:, :2]
-    normal, arm = _spring_geometry(c2[s[:, 0]], layout.sphere_radius[s[:, 0]], c2[s[:, 1]],
+    normal, arm, torque_arm = _spring_geometry(c2[s[:, 0]], layout.sphere_radius[s[:, 0]], c2[s[:, 1]],
                                    layout.sphere_radius[s[:, 1]], t.cell_centroid[cells[:, 0]],
                                    t.cell_centroid[cells[:, 1]])
     return Network(node_pos=t.cell_centroid.copy(), node_rotates=np.ones(t.n_cells, dtype=bool),
                    node_cell=np.arange(t.n_cells), spring_nodes=cells, spring_normal=normal, spring_arm=arm,
                    spring_kn=props.normal_stiffness, spring_ks=props.shear_stiffness,
                    spring_area=layout.bond_area.copy(), spring_face=layout.bond_face.copy(),
-                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)))
+                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)),
+                   spring_torque_arm=torque_arm)
 
 
 def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
@@ -296,7 +314,7 @@ def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
     props = bond_properties(specimen, layout, params)
     c2, r = layout.sphere_center[:, :2], layout.sphere_radius
     pairs = np.concatenate([layout.bond_spheres, layout.link_spheres])
-    normal, arm = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
+    normal, arm, torque_arm = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
                                    c2[pairs[:, 0]], c2[pairs[:, 1]])
     n_links = layout.n_links
     return Network(node_pos=c2.copy(), node_rotates=np.ones(layout.n_spheres, dtype=bool),
@@ -305,7 +323,8 @@ def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
                    spring_ks=np.concatenate([props.shear_stiffness, layout.link_shear_stiffness]),
                    spring_area=np.concatenate([layout.bond_area, np.full(n_links, np.nan)]),
                    spring_face=np.concatenate([layout.bond_face, np.full(n_links, -1)]),
-                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)))
+                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)),
+                   spring_torque_arm=torque_arm)
 
 
 def _require_2d(t):
@@ -361,10 +380,11 @@ def build_network(specimen: Specimen, params: Parameters, grains: str, nodes_per
 
 
 def elastic_summary(specimen: Specimen, params: Parameters, grains: str, nodes_per_face: int = 2,
-                    contacts: str = "corners", rings: int = 1, strain: float = DEFAULT_STRAIN):
+                    contacts: str = "corners", rings: int = 1, strain: float = DEFAULT_STRAIN,
+                    platens: str = "cells"):
     """(summary dict, network, solution) of one grain model in uniaxial compression."""
     net = build_network(specimen, params, grains, nodes_per_face, contacts, rings)
-    sol = solve_uniaxial(net, specimen, strain)
+    sol = solve_uniaxial(net, specimen, strain, platens)
     summary = {"grains": grains, "young_pa": sol.young, "poisson": sol.poisson,
                "applied_stress_pa": sol.applied_stress, "axial_strain": strain,
                "n_nodes": net.n_nodes, "n_triangles": int(len(net.tri_nodes)),
