@@ -47,6 +47,9 @@ class ClumpLayout:
     link_normal_stiffness: np.ndarray | None = None  # (m,) [N/m]
     link_shear_stiffness: np.ndarray | None = None   # (m,) [N/m]
     sphere_area: np.ndarray | None = None            # (s,) cell area lumped on each sphere [m^2] (mass share)
+    #: fraction of the centroid-to-face distance of grain in series with each bond (1: rigid cells,
+    #: whose elasticity lives in the bonds; the inset of deformable cells, whose links carry the rest)
+    series_fraction: float = 1.0
 
     @property
     def n_links(self) -> int:
@@ -70,6 +73,14 @@ def build_layout(specimen: Specimen, spheres_per_cell: int) -> ClumpLayout:
         raise GrainfracError("resolution.spheres_per_cell: clumps of several spheres are built for "
                              "2D specimens only; fix: use spheres_per_cell = 1 with specimen.dimension = 3")
     return _face_lined_layout(specimen, spheres_per_cell)
+
+
+def layout_for(specimen: Specimen, params: Parameters) -> ClumpLayout:
+    """The layout of ``params.resolution``: rigid cells (``spheres_per_cell``) or deformable cells."""
+    if params.resolution.grain_model == "deformable":
+        from .deformable import build_deformable_layout
+        return build_deformable_layout(specimen, params)
+    return build_layout(specimen, params.resolution.spheres_per_cell)
 
 
 def _to3d(points: np.ndarray, z: float) -> np.ndarray:
@@ -190,8 +201,8 @@ def bond_properties(specimen: Specimen, layout: ClumpLayout, params: Parameters)
     ma, mb = specimen.mineral[cells[:, 0]], specimen.mineral[cells[:, 1]]
     mid = t.face_midpoint[face]
     normal = t.face_normal[face]
-    la = np.abs(((mid - t.cell_centroid[cells[:, 0]]) * normal).sum(1))
-    lb = np.abs(((mid - t.cell_centroid[cells[:, 1]]) * normal).sum(1))
+    la = layout.series_fraction * np.abs(((mid - t.cell_centroid[cells[:, 0]]) * normal).sum(1))
+    lb = layout.series_fraction * np.abs(((mid - t.cell_centroid[cells[:, 1]]) * normal).sum(1))
     area = layout.bond_area
     kn = area / (1 / table["normal_stiffness"][ma, mb] + la / e_mod[ma] + lb / e_mod[mb])
     ks = area / (1 / table["shear_stiffness"][ma, mb] + la / g_mod[ma] + lb / g_mod[mb])
