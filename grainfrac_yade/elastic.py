@@ -23,7 +23,8 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
     each carrying 1/K of the face (as the DEM's deformable cells do).
 ``lattice``
     The YADE deformable cells (:mod:`grainfrac_yade.deformable`) solved
-    statically: every sphere a body, links and bonds as YADE springs.
+    statically: every sphere a body (translation only), links and bonds as
+    YADE springs.
 
 Loading: the cells with a face on the top (bottom) wall form rigid-in-y
 platens closing by ``strain`` x height (rotation blocked, lateral motion free,
@@ -304,7 +305,8 @@ def rigid_network(specimen: Specimen, params: Parameters) -> Network:
 
 
 def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
-    """The YADE deformable cells: every sphere a rotating body, bonds and links as YADE springs."""
+    """The YADE deformable cells: every sphere a body that translates only (rotations blocked, see
+    :mod:`grainfrac_yade.deformable`), bonds and links as YADE springs."""
     from .layout import bond_properties, layout_for
     _require_2d(specimen.tessellation)
     layout = layout or layout_for(specimen, params)
@@ -317,7 +319,7 @@ def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
     normal, arm, torque_arm = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
                                    c2[pairs[:, 0]], c2[pairs[:, 1]])
     n_links = layout.n_links
-    return Network(node_pos=c2.copy(), node_rotates=np.ones(layout.n_spheres, dtype=bool),
+    return Network(node_pos=c2.copy(), node_rotates=np.zeros(layout.n_spheres, dtype=bool),
                    node_cell=layout.sphere_cell.copy(), spring_nodes=pairs, spring_normal=normal, spring_arm=arm,
                    spring_kn=np.concatenate([props.normal_stiffness, layout.link_normal_stiffness]),
                    spring_ks=np.concatenate([props.shear_stiffness, layout.link_shear_stiffness]),
