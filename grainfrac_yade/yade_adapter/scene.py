@@ -13,6 +13,15 @@ stays as a frictional contact that carries compression once its crack closes
 back to the initial gap, and no tension.  On a break the law sets tensile
 strength and cohesion to zero (Table 2's residual values); this module then
 writes the residual friction phi_r itself (the law keeps phi).
+
+Rigid cells (``layout.rigid_cells``, the default grain model) are one YADE body
+each: a sphere, or a clump of spheres with the polygon's mass and inertia.
+Deformable cells are clusters of separate sphere bodies (free rotation about z,
+as rigid cells) held together by *links*: JCFpm bonds with strengths so large
+that they never break, kept in :attr:`GrainScene.links` apart from the
+breakable bonds (:attr:`GrainScene.interactions`), so bond bookkeeping, stress
+corrosion and cracks see only the breakable bonds.  Code that acts on cells
+uses :meth:`GrainScene.bodies_of`, which covers both models.
 """
 from __future__ import annotations
 
@@ -27,17 +36,30 @@ from ..params import Parameters
 from ..specimen import Specimen
 from . import load_yade
 
+# TEMPORARY fallback until layout.layout_for exists (rigid layouts only); remove it then.
+try:
+    from ..layout import layout_for
+except ImportError:
+    layout_for = lambda s, p: build_layout(s, p.resolution.spheres_per_cell)  # noqa: E731
+
 #: Bond break modes, the codes of YADE's JCFpm crack file.
 INTACT, TENSION, SHEAR = 0, 1, 2
 #: Material type shared by all cells: JCFpm bonds only form between equal types.
 COHESIVE_TYPE = 1
+#: FnMax and FsMax [N] of the intra-cell links of deformable cells: never reached, so a link never
+#: breaks (not 0: FnMax = 0 only switches the tension check off, a shear break would still happen).
+LINK_STRENGTH = 1e30
 
 
 @dataclass
 class GrainScene:
     """A built YADE scene plus the numpy bookkeeping of its bonds.
 
-    Arrays are indexed by cell (``cell_body``) or bond (everything ``bond_*``).
+    Arrays are indexed by cell (``cell_body``, ``cell_bodies``), sphere (``sphere_body``) or
+    breakable bond (``interactions`` and everything ``bond_*``).  ``cell_bodies[c]`` holds all
+    body ids of cell c (one for rigid cells); ``cell_body[c]`` is the cell's body for rigid
+    cells, and for deformable cells only a representative: the body of the cell's sphere
+    nearest its centroid.  ``links`` are the unbreakable intra-cell links of deformable cells.
     """
     specimen: Specimen
     layout: ClumpLayout
@@ -45,10 +67,12 @@ class GrainScene:
     params: Parameters
     O: object
     cell_body: np.ndarray
+    cell_bodies: list
     sphere_body: np.ndarray
     interactions: list
     law: object
     newton: object
+    links: list = field(default_factory=list)     # unbreakable intra-cell links (deformable cells)
     drivers: list = field(default_factory=list)   # called before every DEM step
     extras: list = field(default_factory=list)    # listed engines acting between steps (platens, corrosion)
     broken: np.ndarray = None
@@ -83,6 +107,14 @@ class GrainScene:
     def bond_mineral_pair(self) -> np.ndarray:
         """(n_bonds, 2) mineral indices of the two cells."""
         return self.specimen.face_minerals[self.layout.bond_face]
+
+    def bodies_of(self, cells) -> np.ndarray:
+        """All body ids of ``cells``, cell by cell in the given order (one per rigid cell)."""
+        cells = np.atleast_1d(np.asarray(cells, dtype=np.int64))
+        if self.layout.rigid_cells:
+            return self.cell_body[cells]
+        parts = [self.cell_bodies[c] for c in cells]
+        return np.concatenate(parts) if parts else np.empty(0, dtype=np.int64)
 
     def engine_names(self) -> list:
         """YADE engines (class names), then the Python-side drivers and extras."""
@@ -163,14 +195,22 @@ class GrainScene:
         return fn, fs
 
     def cell_positions(self, cells=None) -> np.ndarray:
-        """(n, 3) current positions of cell bodies [m]."""
-        ids = self.cell_body if cells is None else self.cell_body[np.asarray(cells)]
-        return np.array([tuple(self.O.bodies[int(b)].state.pos) for b in ids])
+        """(n, 3) current positions of cells [m]: the body (rigid), the mass centre of the spheres (deformable)."""
+        cells = np.arange(self.specimen.n_cells) if cells is None else np.asarray(cells)
+        bodies = self.O.bodies
+        if self.layout.rigid_cells:
+            return np.array([tuple(bodies[int(b)].state.pos) for b in self.cell_body[cells]])
+        out = []
+        for c in cells:
+            states = [bodies[int(b)].state for b in self.cell_bodies[c]]
+            m = np.array([st.mass for st in states])
+            out.append(m @ np.array([tuple(st.pos) for st in states]) / m.sum())
+        return np.array(out)
 
     def cell_forces(self, cells) -> np.ndarray:
-        """(n, 3) resultant interaction force on each cell body from the last step [N]."""
+        """(n, 3) resultant interaction force on each cell (summed over its bodies) from the last step [N]."""
         f = self.O.forces.f
-        return np.array([tuple(f(int(b))) for b in self.cell_body[np.asarray(cells)]])
+        return np.array([np.sum([tuple(f(int(b))) for b in self.bodies_of([c])], axis=0) for c in cells])
 
 
 def broken_counts(scene) -> dict:
@@ -198,67 +238,75 @@ def _blocked_dofs(dim: int) -> str:
     return "zXY" if dim == 2 else ""
 
 
-def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
-                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray) -> float:
-    """Conservative critical DEM time step [s]: min over cells of sqrt(m/K) and sqrt(I/K_rot).
+def _oscillation_step(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq: np.ndarray,
+                      mass: np.ndarray, inertia: np.ndarray) -> float:
+    """min over bodies of sqrt(m/K) and sqrt(I/K_rot) for springs of stiffness ``k`` joining ``ends`` (c, 2).
 
-    K sums k_n + k_s of a cell's bonds; K_rot sums (k_n + k_s) |r|^2 with r the
-    lever arm from the cell body to the bond point.
+    K sums k over a body's springs, K_rot sums k x ``lever_sq`` ((2c,): the first ends' squared
+    lever arms, then the second ends').
     """
-    cells = specimen.tessellation.face_cells[layout.bond_face]
-    k = props.normal_stiffness + props.shear_stiffness
-    n = specimen.n_cells
-    k_cell = np.bincount(cells.ravel(), weights=np.repeat(k, 2), minlength=n)
-    lever = np.concatenate([layout.bond_point - body_pos[cells[:, 0]], layout.bond_point - body_pos[cells[:, 1]]])
-    k_rot = np.bincount(np.concatenate([cells[:, 0], cells[:, 1]]),
-                        weights=np.tile(k, 2) * (lever**2).sum(1), minlength=n)
+    k_body = np.bincount(ends.ravel(), weights=np.repeat(k, 2), minlength=n_bodies)
+    k_rot = np.bincount(np.concatenate([ends[:, 0], ends[:, 1]]), weights=np.tile(k, 2) * lever_sq,
+                        minlength=n_bodies)
     with np.errstate(divide="ignore"):
-        t_trans = np.sqrt(mass / k_cell)
+        t_trans = np.sqrt(mass / k_body)
         t_rot = np.sqrt(inertia / k_rot)
     return float(min(t_trans.min(), t_rot.min()))
 
 
-def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | None = None) -> GrainScene:
-    """Build the plain mechanical YADE scene of ``specimen`` (replaces any current scene)."""
-    yade = load_yade()
-    from yade import O, utils, Vector3
-    from yade import wrapper as w
+def _links(layout: ClumpLayout):
+    """(m, 2) sphere pairs, k_n and k_s [N/m] of the layout's intra-cell links (empty without links)."""
+    if not layout.n_links:
+        return np.empty((0, 2), dtype=np.int64), np.empty(0), np.empty(0)
+    return layout.link_spheres, layout.link_normal_stiffness, layout.link_shear_stiffness
 
-    for pair, c in params.contacts.items():
-        if c.residual_tensile_strength > 0 or c.residual_cohesion > 0:
-            raise GrainfracError(f'contacts."{"/".join(pair)}": residual tensile strength and cohesion must be 0 '
-                                 "with YADE's JCFpm law (it drops both to zero on a break); fix: set them to 0")
-    layout = layout or build_layout(specimen, params.resolution.spheres_per_cell)
-    props = bond_properties(specimen, layout, params)
-    mass, inertia = cell_mass_inertia(specimen, params, params.numerics.density_scale)
-    dim = specimen.tessellation.dim
 
-    O.reset()
-    mats = []
-    for name in specimen.mineral_names:
-        g, c = params.grains[name], params.contact(name, name)
-        # Strengths of 1 Pa make the first-step bonds cohesive; every bond's values are written below.
-        mats.append(O.materials.append(w.JCFpmMat(
-            young=g.young, poisson=g.poisson, density=g.density, type=COHESIVE_TYPE,
-            frictionAngle=c.friction_angle, residualFrictionAngle=c.residual_friction_angle,
-            tensileStrength=1.0, cohesion=1.0)))
-    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True)
-    newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
-    O.engines = [
-        w.ForceResetter(),
-        w.InsertionSortCollider([w.Bo1_Sphere_Aabb()]),
-        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom()],
-                          [w.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)], [law]),
-        newton,
-    ]
-    blocked = _blocked_dofs(dim)
-    n_cells = specimen.n_cells
-    sphere_body = np.empty(layout.n_spheres, dtype=np.int64)
-    cell_body = np.empty(n_cells, dtype=np.int64)
+def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
+                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None) -> float:
+    """Conservative critical DEM time step [s]: min over bodies of sqrt(m/K) and sqrt(I/K_rot).
+
+    Rigid cells: the bodies are the cells (``mass``, ``inertia`` per cell; ``body_pos`` (n, 3)
+    the cell bodies' positions).  K sums k_n + k_s of a cell's bonds; K_rot sums
+    (k_n + k_s) |r|^2 with r the lever arm from the cell body to the bond point.
+
+    Deformable cells: the bodies are the spheres (``mass``, ``inertia`` per sphere).  K sums
+    k_n + k_s of a sphere's bonds and links; K_rot sums (k_n + k_s) r l with r the sphere radius
+    (the lever of rotation in YADE's shear increment) and l = max(r, (d + r - r_other)/2) the lever
+    of the JCFpm torque (force applied half-way across the gap of spheres d apart): r^2 for
+    touching spheres, more for a link across a cell.
+    """
+    if layout.rigid_cells:
+        cells = specimen.tessellation.face_cells[layout.bond_face]
+        lever = np.concatenate([layout.bond_point - body_pos[cells[:, 0]],
+                                layout.bond_point - body_pos[cells[:, 1]]])
+        return _oscillation_step(specimen.n_cells, cells, props.normal_stiffness + props.shear_stiffness,
+                                 (lever**2).sum(1), mass, inertia)
+    link_spheres, link_kn, link_ks = _links(layout)
+    ends = np.concatenate([layout.bond_spheres, link_spheres]).astype(np.int64)
+    k = np.concatenate([props.normal_stiffness + props.shear_stiffness, link_kn + link_ks])
+    r = layout.sphere_radius[ends]
+    d = np.linalg.norm(layout.sphere_center[ends[:, 0]] - layout.sphere_center[ends[:, 1]], axis=1)
+    torque_lever = 0.5 * (d[:, None] + r - r[:, ::-1])
+    lever_sq = (r * np.maximum(r, torque_lever)).T.ravel()
+    return _oscillation_step(layout.n_spheres, ends, k, lever_sq, mass, inertia)
+
+
+def _cell_spheres(layout: ClumpLayout, n_cells: int) -> list:
+    """Sphere indices of each cell, ascending."""
     order = np.argsort(layout.sphere_cell, kind="stable")
     bounds = np.searchsorted(layout.sphere_cell[order], np.arange(n_cells + 1))
-    for cell in range(n_cells):
-        members = order[bounds[cell]:bounds[cell + 1]]
+    return [order[bounds[c]:bounds[c + 1]] for c in range(n_cells)]
+
+
+def _append_rigid_cells(O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked):
+    """One body per cell (sphere or clump) with the polygon's mass and inertia.
+
+    Returns (sphere_body, cell_body, body positions (n, 3), inertia about the bodies).
+    """
+    dim = specimen.tessellation.dim
+    sphere_body = np.empty(layout.n_spheres, dtype=np.int64)
+    cell_body = np.empty(specimen.n_cells, dtype=np.int64)
+    for cell, members in enumerate(_cell_spheres(layout, specimen.n_cells)):
         mat = mats[specimen.mineral[cell]]
         spheres = [utils.sphere(Vector3(*layout.sphere_center[m]), float(layout.sphere_radius[m]), material=mat)
                    for m in members]
@@ -279,6 +327,107 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         st.mass = float(mass[cell])
         st.inertia = Vector3(*([float(inertia[cell])] * 3))
         st.blockedDOFs = blocked
+    return sphere_body, cell_body, body_pos3, inertia
+
+
+def sphere_mass_inertia(specimen: Specimen, layout: ClumpLayout, cell_mass: np.ndarray):
+    """Mass [kg] and inertia [kg m^2] of each sphere of deformable cells.
+
+    Mass: the cell's areal mass (cell mass / cell area, i.e. density x density scale x thickness)
+    times the area lumped on the sphere (``layout.sphere_area``), so a cell's spheres carry its
+    mass.  Inertia: a disc's 0.5 m r^2 on all three axes (pseudo-2D).
+    """
+    areal = cell_mass / specimen.tessellation.cell_measure
+    mass = areal[layout.sphere_cell] * layout.sphere_area
+    return mass, 0.5 * mass * layout.sphere_radius**2
+
+
+def _append_deformable_cells(O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked):
+    """One sphere body per layout sphere (not clumped).
+
+    Returns (sphere_body, cell_body (each cell's sphere nearest its centroid), cell_bodies).
+    """
+    spheres = [utils.sphere(Vector3(*layout.sphere_center[m]), float(layout.sphere_radius[m]),
+                            material=mats[specimen.mineral[layout.sphere_cell[m]]]) for m in range(layout.n_spheres)]
+    sphere_body = np.asarray(O.bodies.append(spheres), dtype=np.int64)
+    for m, body in enumerate(sphere_body):
+        st = O.bodies[int(body)].state
+        st.mass = float(mass[m])
+        st.inertia = Vector3(*([float(inertia[m])] * 3))
+        st.blockedDOFs = blocked
+    members = _cell_spheres(layout, specimen.n_cells)
+    if any(len(m) == 0 for m in members):
+        raise GrainfracError("deformable layout: a cell has no sphere; fix: the layout builder must give every "
+                             "cell at least one sphere")
+    centroid = specimen.tessellation.cell_centroid
+    nearest = [m[np.argmin(((layout.sphere_center[m, :2] - centroid[c, :2]) ** 2).sum(1))]
+               for c, m in enumerate(members)]
+    return sphere_body, sphere_body[nearest], [sphere_body[m] for m in members]
+
+
+def _create_links(utils, specimen, layout, params, sphere_body) -> list:
+    """Unbreakable JCFpm bonds between spheres of one cell (k_n, k_s from the layout, friction of the
+    cell's mineral, strengths ``LINK_STRENGTH``)."""
+    link_spheres, link_kn, link_ks = _links(layout)
+    names = specimen.mineral_names
+    tan_phi = np.array([math.tan(params.contact(m, m).friction_angle) for m in names])
+    links = []
+    for k, (i, j) in enumerate(link_spheres):
+        inter = utils.createInteraction(int(sphere_body[i]), int(sphere_body[j]))
+        ph = inter.phys
+        ph.kn, ph.ks = float(link_kn[k]), float(link_ks[k])
+        ph.FnMax = ph.FsMax = LINK_STRENGTH
+        ph.tanFrictionAngle = float(tan_phi[specimen.mineral[layout.sphere_cell[i]]])
+        links.append(inter)
+    return links
+
+
+def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | None = None) -> GrainScene:
+    """Build the plain mechanical YADE scene of ``specimen`` (replaces any current scene)."""
+    yade = load_yade()
+    from yade import O, utils, Vector3
+    from yade import wrapper as w
+
+    for pair, c in params.contacts.items():
+        if c.residual_tensile_strength > 0 or c.residual_cohesion > 0:
+            raise GrainfracError(f'contacts."{"/".join(pair)}": residual tensile strength and cohesion must be 0 '
+                                 "with YADE's JCFpm law (it drops both to zero on a break); fix: set them to 0")
+    layout = layout or layout_for(specimen, params)
+    dim = specimen.tessellation.dim
+    if not layout.rigid_cells and dim != 2:
+        raise GrainfracError("resolution.grain_model: deformable cells are built for 2D specimens only; fix: use "
+                             'grain_model = "rigid" with specimen.dimension = 3')
+    props = bond_properties(specimen, layout, params)
+    mass, inertia = cell_mass_inertia(specimen, params, params.numerics.density_scale)
+
+    O.reset()
+    mats = []
+    for name in specimen.mineral_names:
+        g, c = params.grains[name], params.contact(name, name)
+        # Strengths of 1 Pa make the first-step bonds cohesive; every bond's values are written below.
+        mats.append(O.materials.append(w.JCFpmMat(
+            young=g.young, poisson=g.poisson, density=g.density, type=COHESIVE_TYPE,
+            frictionAngle=c.friction_angle, residualFrictionAngle=c.residual_friction_angle,
+            tensileStrength=1.0, cohesion=1.0)))
+    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True)
+    newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
+    O.engines = [
+        w.ForceResetter(),
+        w.InsertionSortCollider([w.Bo1_Sphere_Aabb()]),
+        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom()],
+                          [w.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)], [law]),
+        newton,
+    ]
+    blocked = _blocked_dofs(dim)
+    if layout.rigid_cells:
+        sphere_body, cell_body, body_pos3, inertia = _append_rigid_cells(
+            O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
+        cell_bodies = [cell_body[c:c + 1] for c in range(specimen.n_cells)]
+    else:
+        mass, inertia = sphere_mass_inertia(specimen, layout, mass)
+        body_pos3 = None
+        sphere_body, cell_body, cell_bodies = _append_deformable_cells(
+            O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
     interactions = []
     tan_phi = np.tan(props.friction_angle)
     for k, (i, j) in enumerate(layout.bond_spheres):
@@ -292,8 +441,9 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         ph.tanFrictionAngle = float(tan_phi[k])
         ph.crossSection = area
         interactions.append(inter)
+    links = _create_links(utils, specimen, layout, params, sphere_body)
     dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3)
     O.dt = params.numerics.timestep_safety * dt_crit
     return GrainScene(specimen=specimen, layout=layout, props=props, params=params, O=O,
-                      cell_body=cell_body, sphere_body=sphere_body, interactions=interactions,
-                      law=law, newton=newton)
+                      cell_body=cell_body, cell_bodies=cell_bodies, sphere_body=sphere_body,
+                      interactions=interactions, law=law, newton=newton, links=links)
