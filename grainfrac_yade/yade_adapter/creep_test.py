@@ -55,7 +55,7 @@ class CreepRun:
         self.platens = Platens(self.scene, params.ucs.platen_lateral)
         self.scene.extras.append(self.platens)
         self.free = np.setdiff1d(np.arange(specimen.n_cells), np.union1d(self.platens.top, self.platens.bottom))
-        self._free_bodies = [self.scene.O.bodies[int(b)] for b in self.scene.cell_body[self.free]]
+        self._free_bodies = [self.scene.O.bodies[int(b)] for b in self.scene.bodies_of(self.free)]
         self.rows, self.ramp_broken = [], 0
         self.failed, self.failure_reason = False, ""
         self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
@@ -68,7 +68,8 @@ class CreepRun:
 
     # ------------------------------------------------------------------ measures
     def unbalanced(self, mean_bond_force):
-        """Largest and mean resultant force on free cells [N], and mean / mean_bond_force."""
+        """Largest resultant force on a free body [N], and mean / mean_bond_force (bodies: cells, or the
+        spheres of deformable cells)."""
         f = self.scene.O.forces.f
         res = np.array([f(b.id).norm() for b in self._free_bodies])
         rel = res.mean() / mean_bond_force if mean_bond_force > 0 else math.inf

@@ -5,7 +5,10 @@ their vertical motion is prescribed together, their rotation is blocked (the
 platen face stays flat), and their lateral motion is free (smooth platen,
 ``platen_lateral = "free"``) or blocked (rough platen, ``"fixed"``).  The axial
 stress is the platens' reaction over the specimen cross-section (width x
-thickness); lateral strain comes from the cells on the side walls.
+thickness); lateral strain comes from the cells on the side walls.  With
+deformable cells all bodies (spheres) of those cells take part: a platen cell's
+spheres all move at the platen's speed, and the side-wall positions are the
+means over the side cells' spheres.
 """
 from __future__ import annotations
 
@@ -34,10 +37,8 @@ class Platens:
         self.width, self.height = float(t.box[0]), float(t.box[1])
         self.cross_section = self.width * scene.specimen.thickness
         O = scene.O
-        self._top_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.top]]
-        self._bottom_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.bottom]]
-        self._left_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.left]]
-        self._right_bodies = [O.bodies[int(b)] for b in scene.cell_body[self.right]]
+        self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies = (
+            [O.bodies[int(b)] for b in scene.bodies_of(cells)] for cells in (self.top, self.bottom, self.left, self.right))
         for b in self._top_bodies + self._bottom_bodies:
             b.state.blockedDOFs = PLATEN_BLOCKED[lateral]
             b.state.vel = (0, 0, 0)

@@ -2,11 +2,14 @@
 
 Cell 0 is fixed; cell 1 carries a persistent force and may translate in the
 plane (no rotation), so at equilibrium the bond carries exactly that force.
+The cells are always rigid single spheres (one bond), whatever
+``resolution.spheres_per_cell`` and ``resolution.grain_model`` say.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..layout import build_layout
 from ..specimen import specimen_from_tessellation
 from ..tessellation import tessellate_seeds
 from .corrosion_engine import StressCorrosion
@@ -33,7 +36,8 @@ class BondUnderForce:
     def __init__(self, params, normal_stress, shear_stress, mineral="quartz"):
         """``normal_stress`` tension positive, ``shear_stress`` >= 0 [Pa] on the face."""
         self.params = params
-        self.scene = build_scene(two_cell_specimen(params, mineral), params)
+        specimen = two_cell_specimen(params, mineral)
+        self.scene = build_scene(specimen, params, build_layout(specimen, 1))
         O = self.scene.O
         area = float(self.scene.layout.bond_area[0])
         self.force = (normal_stress * area, shear_stress * area, 0.0)
