@@ -24,6 +24,33 @@ def rigid_motion(vertices: list, centroids: np.ndarray, positions: np.ndarray, a
     return out
 
 
+def cluster_rigid_motion(reference: np.ndarray, current: np.ndarray, group: np.ndarray, weights: np.ndarray,
+                         centroids: np.ndarray):
+    """Least-squares rigid motion (translation + rotation about z) of groups of points (2D).
+
+    ``reference`` and ``current`` (p, >=2) point positions, ``group`` (p,) the group of each point
+    (0..n-1, every group non-empty), ``weights`` (p,) positive; ``centroids`` (n, >=2) a reference
+    point per group (e.g. a polygon's centroid).  Returns the current position of each group's
+    reference point (n, 2) and the rotation angle [rad] (n,) that minimise
+    sum w |R (x0 - c0) + c - x|^2 (c0, c: weighted mean points), i.e. what :func:`rigid_motion`
+    takes.  A group of one point (or of points on one spot) only translates.
+    """
+    n = len(centroids)
+    w_sum = np.bincount(group, weights=weights, minlength=n)
+
+    def mean(x):
+        return np.column_stack([np.bincount(group, weights=weights * x[:, i], minlength=n) / w_sum for i in (0, 1)])
+
+    c0, c1 = mean(reference), mean(current)
+    a, b = reference[:, :2] - c0[group], current[:, :2] - c1[group]
+    sin = np.bincount(group, weights=weights * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]), minlength=n)
+    cos = np.bincount(group, weights=weights * (a * b).sum(1), minlength=n)
+    angle = np.arctan2(sin, cos)
+    d = centroids[:, :2] - c0
+    ca, sa = np.cos(angle), np.sin(angle)
+    return c1 + np.column_stack([ca * d[:, 0] - sa * d[:, 1], sa * d[:, 0] + ca * d[:, 1]]), angle
+
+
 def _data_block(data: dict, n: int) -> list:
     lines = [f"CELL_DATA {n}"] if data else []
     for name, values in data.items():

@@ -11,12 +11,25 @@ from pathlib import Path
 
 import numpy as np
 
-from ..vtkio import rigid_motion, write_polygons, write_segments
+from ..vtkio import cluster_rigid_motion, rigid_motion, write_polygons, write_segments
 from .scene import bond_segments
 
 
+def sphere_positions(scene) -> np.ndarray:
+    """(s, 3) current positions of the layout's spheres [m] (deformable cells: one body each)."""
+    return np.array([tuple(scene.O.bodies[int(b)].state.pos) for b in scene.sphere_body])
+
+
 def cell_motion(scene):
-    """(n, 3) positions [m] and (n,) rotation angles about z [rad] of the cell bodies."""
+    """(n, 2+) positions [m] of the cell centroids and (n,) rotation angles about z [rad].
+
+    Rigid cells: the cell bodies' positions and rotations.  Deformable cells: the least-squares
+    rigid motion (translation + rotation) of each cell's spheres, weighted by their lumped areas.
+    """
+    if not scene.layout.rigid_cells:
+        lay = scene.layout
+        return cluster_rigid_motion(lay.sphere_center, sphere_positions(scene), lay.sphere_cell, lay.sphere_area,
+                                    scene.specimen.tessellation.cell_centroid)
     pos, angle = [], []
     for b in scene.cell_body:
         st = scene.O.bodies[int(b)].state
@@ -24,6 +37,18 @@ def cell_motion(scene):
         pos.append(tuple(st.pos))
         angle.append(float(ang) * float(axis[2]))
     return np.array(pos), np.array(angle)
+
+
+def bond_shift(scene, pos) -> np.ndarray:
+    """(b, 2) displacement [m] drawn for each bond: the mean of its two cells' (rigid) or two spheres'
+    (deformable) displacements; ``pos``: the cell positions of :func:`cell_motion`."""
+    lay, tess = scene.layout, scene.specimen.tessellation
+    if not lay.rigid_cells:
+        disp = sphere_positions(scene)[:, :2] - lay.sphere_center[:, :2]
+        return 0.5 * (disp[lay.bond_spheres[:, 0]] + disp[lay.bond_spheres[:, 1]])
+    cells_of_bond = scene.bond_cells
+    return 0.5 * (pos[cells_of_bond[:, 0], :2] + pos[cells_of_bond[:, 1], :2]
+                  - tess.cell_centroid[cells_of_bond[:, 0], :2] - tess.cell_centroid[cells_of_bond[:, 1], :2])
 
 
 def write_snapshot(scene, corr, folder, index: int, creep_time: float) -> list:
@@ -41,10 +66,7 @@ def write_snapshot(scene, corr, folder, index: int, creep_time: float) -> list:
     title = f"creep time {creep_time:.9g} s"
     cells = write_polygons(folder / f"cells_{index:04d}.vtk", polygons,
                            {"mineral": spec.mineral, "clump": spec.clump_label}, title=title)
-    cells_of_bond = scene.bond_cells
-    shift = 0.5 * (pos[cells_of_bond[:, 0], :2] + pos[cells_of_bond[:, 1], :2]
-                   - tess.cell_centroid[cells_of_bond[:, 0], :2] - tess.cell_centroid[cells_of_bond[:, 1], :2])
-    segments = bond_segments(scene, np.arange(scene.n_bonds)) + shift[:, None, :]
+    segments = bond_segments(scene, np.arange(scene.n_bonds)) + bond_shift(scene, pos)[:, None, :]
     if corr.p.mode == "area":
         tensile, cohesion = corr.tensile0 * corr.area_fraction, corr.cohesion0 * corr.area_fraction
     else:
