@@ -184,3 +184,15 @@ def test_temperature_form_without_activation_energy_is_one_clear_error():
         load_parameters(overrides=[("stress_corrosion.rate_form", "physical"),
                                    ("stress_corrosion.rate_prefactor", 1.0),
                                    ("stress_corrosion.activation_volume", 1e-4)])
+
+
+def test_params_json_older_than_grain_model_loads_as_rigid_cells(tmp_path, params):
+    """Runs written before resolution.grain_model / nodes_per_face existed were rigid-cell runs."""
+    import json
+    from grainfrac_yade.analysis.runparams import load_run_parameters
+    tree = params.to_dict()
+    del tree["resolution"]["grain_model"], tree["resolution"]["nodes_per_face"]
+    (tmp_path / "params.json").write_text(json.dumps(tree))
+    old = load_run_parameters(tmp_path, fill_missing=True)
+    assert set(old.filled) == {"resolution.grain_model", "resolution.nodes_per_face"}
+    assert old.params.resolution.grain_model == "rigid" and old.params == params
