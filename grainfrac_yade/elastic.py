@@ -72,6 +72,9 @@ class Network:
     #: (m, 2, 2) lever arms of the forces' torques where they differ from the kinematic arms
     #: (YADE: the contact point, radius - penetration/2, while the shear increment uses the radius)
     spring_torque_arm: np.ndarray | None = None
+    #: (m,) factor on the relative translation in the shear displacement (YADE's
+    #: ``avoidGranularRatcheting``: (r_a + r_b) / distance, which makes a rigid rotation shear-free)
+    spring_shear_translation_scale: np.ndarray | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -102,10 +105,11 @@ def _dof_map(net: Network):
     return dofs, int(per_node.sum())
 
 
-def _spring_rows(net: Network, dofs: np.ndarray, arm=None):
+def _spring_rows(net: Network, dofs: np.ndarray, arm=None, shear_scale=None):
     """Dof indices (m, 6) and coefficients of the normal and tangential relative displacement (m, 6).
 
-    With ``arm`` = the torque arms, the same rows are the generalised forces of unit spring forces.
+    ``shear_scale`` multiplies the relative translation in the tangential row.  With ``arm`` = the
+    torque arms and no scale, the same rows are the generalised forces of unit spring forces.
     """
     arm = net.spring_arm if arm is None else arm
     n = net.spring_normal
@@ -113,13 +117,14 @@ def _spring_rows(net: Network, dofs: np.ndarray, arm=None):
     a, b = net.spring_nodes[:, 0], net.spring_nodes[:, 1]
     idx = np.column_stack([dofs[a, 0], dofs[a, 1], dofs[a, 2], dofs[b, 0], dofs[b, 1], dofs[b, 2]])
 
-    def coefficients(d):
+    def coefficients(d, scale=1.0):
         # z x arm = (-arm_y, arm_x); its component along d is the rotation's lever
         lever_a = d[:, 0] * -arm[:, 0, 1] + d[:, 1] * arm[:, 0, 0]
         lever_b = d[:, 0] * -arm[:, 1, 1] + d[:, 1] * arm[:, 1, 0]
-        return np.column_stack([-d[:, 0], -d[:, 1], -lever_a, d[:, 0], d[:, 1], lever_b])
+        ds = d * np.reshape(scale, (-1, 1))
+        return np.column_stack([-ds[:, 0], -ds[:, 1], -lever_a, ds[:, 0], ds[:, 1], lever_b])
 
-    return idx, coefficients(n), coefficients(t)
+    return idx, coefficients(n), coefficients(t, 1.0 if shear_scale is None else shear_scale)
 
 
 def _triangle_b(net: Network):
@@ -144,8 +149,8 @@ def stiffness_matrix(net: Network):
     """Global sparse stiffness matrix and the dof map."""
     dofs, ndof = _dof_map(net)
     rows, cols, vals = [], [], []
-    idx, cn, ct = _spring_rows(net, dofs)
-    _, fn, ft = _spring_rows(net, dofs, net.spring_torque_arm) if net.spring_torque_arm is not None else (0, cn, ct)
+    idx, cn, ct = _spring_rows(net, dofs, shear_scale=net.spring_shear_translation_scale)
+    _, fn, ft = _spring_rows(net, dofs, net.spring_torque_arm)
     for k, c, f in ((net.spring_kn, cn, fn), (net.spring_ks, ct, ft)):
         block = k[:, None, None] * f[:, :, None] * c[:, None, :]
         rows.append(np.repeat(idx, 6, axis=1).ravel())
@@ -221,7 +226,7 @@ def solve_uniaxial(net: Network, specimen: Specimen, strain: float = DEFAULT_STR
         left = np.isin(net.node_cell, t.cells_on_side("left"))
         right = np.isin(net.node_cell, t.cells_on_side("right"))
     lateral = (u[dofs[right, 0]].mean() - u[dofs[left, 0]].mean()) / width
-    idx, cn, ct = _spring_rows(net, dofs)
+    idx, cn, ct = _spring_rows(net, dofs, shear_scale=net.spring_shear_translation_scale)
     uu = np.where(idx >= 0, u[np.maximum(idx, 0)], 0.0)
     disp = np.column_stack([u[dofs[:, 0]], u[dofs[:, 1]], np.where(dofs[:, 2] >= 0, u[np.maximum(dofs[:, 2], 0)], 0)])
     return ElasticSolution(young=stress / strain, poisson=lateral / strain, applied_stress=stress, strain=strain,
@@ -268,9 +273,10 @@ def contact_ratios(net: Network, sol: ElasticSolution):
 def _spring_geometry(center_a, radius_a, center_b, radius_b, body_a, body_b):
     """Normal along the centre line and YADE's lever arms from the bodies.
 
-    Kinematic arms: the sphere radii along the normal (``Ig2_Sphere_Sphere_ScGeom`` with
-    ``avoidGranularRatcheting``); torque arms: to the contact point, radius - penetration/2
-    (the JCFpm law's torques).  Returns (normal, kinematic arms, torque arms).
+    Kinematic arms: the sphere radii along the normal, and the relative translation scaled by
+    (r_a + r_b) / distance (``Ig2_Sphere_Sphere_ScGeom`` with ``avoidGranularRatcheting``); torque
+    arms: to the contact point, radius - penetration/2 (the JCFpm law's torques).  Returns
+    (normal, kinematic arms, torque arms, translation scale).
     """
     d = center_b - center_a
     dist = np.linalg.norm(d, axis=1)
@@ -280,7 +286,8 @@ def _spring_geometry(center_a, radius_a, center_b, radius_b, body_a, body_b):
     def arms(ra, rb):
         return np.stack([(center_a - body_a) + ra[:, None] * normal, (center_b - body_b) - rb[:, None] * normal], axis=1)
 
-    return normal, arms(radius_a, radius_b), arms(radius_a - half_pen, radius_b - half_pen)
+    return normal, arms(radius_a, radius_b), arms(radius_a - half_pen, radius_b - half_pen), \
+        (radius_a + radius_b) / dist
 
 
 def rigid_network(specimen: Specimen, params: Parameters) -> Network:
@@ -293,7 +300,7 @@ def rigid_network(specimen: Specimen, params: Parameters) -> Network:
     s = layout.bond_spheres
     cells = layout.sphere_cell[s]
     c2 = layout.sphere_center[:, :2]
-    normal, arm, torque_arm = _spring_geometry(c2[s[:, 0]], layout.sphere_radius[s[:, 0]], c2[s[:, 1]],
+    normal, arm, torque_arm, shear_scale = _spring_geometry(c2[s[:, 0]], layout.sphere_radius[s[:, 0]], c2[s[:, 1]],
                                    layout.sphere_radius[s[:, 1]], t.cell_centroid[cells[:, 0]],
                                    t.cell_centroid[cells[:, 1]])
     return Network(node_pos=t.cell_centroid.copy(), node_rotates=np.ones(t.n_cells, dtype=bool),
@@ -301,7 +308,7 @@ def rigid_network(specimen: Specimen, params: Parameters) -> Network:
                    spring_kn=props.normal_stiffness, spring_ks=props.shear_stiffness,
                    spring_area=layout.bond_area.copy(), spring_face=layout.bond_face.copy(),
                    tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)),
-                   spring_torque_arm=torque_arm)
+                   spring_torque_arm=torque_arm, spring_shear_translation_scale=shear_scale)
 
 
 def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
@@ -316,8 +323,10 @@ def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
     props = bond_properties(specimen, layout, params)
     c2, r = layout.sphere_center[:, :2], layout.sphere_radius
     pairs = np.concatenate([layout.bond_spheres, layout.link_spheres])
-    normal, arm, torque_arm = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
-                                   c2[pairs[:, 0]], c2[pairs[:, 1]])
+    # spheres translate only and the scene takes the plain relative displacement (no ratcheting
+    # guard): the arms play no part
+    normal, arm, _, _ = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
+                                         c2[pairs[:, 0]], c2[pairs[:, 1]])
     n_links = layout.n_links
     return Network(node_pos=c2.copy(), node_rotates=np.zeros(layout.n_spheres, dtype=bool),
                    node_cell=layout.sphere_cell.copy(), spring_nodes=pairs, spring_normal=normal, spring_arm=arm,
@@ -325,8 +334,7 @@ def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
                    spring_ks=np.concatenate([props.shear_stiffness, layout.link_shear_stiffness]),
                    spring_area=np.concatenate([layout.bond_area, np.full(n_links, np.nan)]),
                    spring_face=np.concatenate([layout.bond_face, np.full(n_links, -1)]),
-                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)),
-                   spring_torque_arm=torque_arm)
+                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)))
 
 
 def _require_2d(t):
