@@ -14,8 +14,9 @@ def register(sub, common):
                    help="rigid: the project's rigid cells and bonds; deformable: triangle-mesh cells with "
                         "Table 1 moduli (the paper's deformable blocks); lattice: the YADE deformable cells "
                         "solved statically (default: deformable)")
-    p.add_argument("--nodes-per-face", type=int, default=2,
-                   help="deformable: contact nodes per face (2 = UDEC's corner sub-contacts)")
+    p.add_argument("--nodes-per-face", type=int,
+                   help="deformable and lattice: contact nodes per face (resolution.nodes_per_face, default 2 = "
+                        "UDEC's corner sub-contacts)")
     p.add_argument("--contacts", choices=CONTACT_PLACEMENTS, default="corners",
                    help="deformable: contact nodes at the face ends (trapezoid shares) or sub-segment centres")
     p.add_argument("--rings", type=int, default=1, help="deformable: radial mesh refinement of each cell")
@@ -27,9 +28,13 @@ def register(sub, common):
 
 def cmd_elastic(args) -> int:
     from ..cli import load_params_from_args
+    if args.nodes_per_face is not None:
+        args.overrides.append(f"resolution.nodes_per_face={args.nodes_per_face}")
+    if args.grains == "lattice":
+        args.overrides.append("resolution.grain_model=deformable")
     params = load_params_from_args(args)
     out = args.out or f"results/elastic_seed{args.seed}"
-    summary = run_elastic_to_folder(params, args.seed, out, args.grains, args.nodes_per_face, args.contacts,
+    summary = run_elastic_to_folder(params, args.seed, out, args.grains, params.resolution.nodes_per_face, args.contacts,
                                     args.rings, args.platens, overwrite=args.overwrite)
     for name, s in summary["models"].items():
         print(f"{name:10s} E {s['young_pa'] / 1e9:6.1f} GPa  nu {s['poisson']:.3f}  shear/applied p50 "
@@ -41,7 +46,9 @@ def cmd_elastic(args) -> int:
 
 def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face=2, contacts="corners",
                           rings=1, platens="cells", overwrite=False) -> dict:
-    """Solve ``grains`` and, for comparison, the rigid cells; write summary.json and the histogram PNG.
+    """Solve ``grains`` and, for comparison, the rigid cells (and for the lattice the mesh reference
+    at the same contact nodes, with ``relative_error_vs_reference``); write summary.json and the
+    histogram PNG.
 
     ``summary.json`` holds the chosen model's keys at the top level and every solved model under
     ``models``.
@@ -52,12 +59,18 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     models, ratios = {}, {}
-    for name in dict.fromkeys([grains, "rigid"]):
+    # the lattice is always compared with the mesh reference at the same contact nodes per face
+    names = [grains, "rigid"] + (["deformable"] if grains == "lattice" else [])
+    for name in dict.fromkeys(names):
         s, net, sol = elastic_summary(specimen, params, name, nodes_per_face, contacts, rings,
                                       platens=platens if name != "rigid" else "cells")
         models[name] = s
         ratios[name] = contact_ratios(net, sol)
     summary = dict(models[grains])
+    if grains == "lattice":
+        ref = models["deformable"]
+        summary["relative_error_vs_reference"] = {k: v / ref[k] - 1.0 for k, v in models["lattice"].items()
+                                                  if isinstance(v, float) and k in ref and ref[k]}
     summary.update(models=models, seed=seed, n_cells=specimen.n_cells, platens=platens,
                    stiffness_scale=params.calibration.stiffness_scale, code_version=code_version())
     write_json(out / "summary.json", summary)
