@@ -16,12 +16,16 @@ writes the residual friction phi_r itself (the law keeps phi).
 
 Rigid cells (``layout.rigid_cells``, the default grain model) are one YADE body
 each: a sphere, or a clump of spheres with the polygon's mass and inertia.
-Deformable cells are clusters of separate sphere bodies (free rotation about z,
-as rigid cells) held together by *links*: JCFpm bonds with strengths so large
-that they never break, kept in :attr:`GrainScene.links` apart from the
-breakable bonds (:attr:`GrainScene.interactions`), so bond bookkeeping, stress
-corrosion and cracks see only the breakable bonds.  Code that acts on cells
-uses :meth:`GrainScene.bodies_of`, which covers both models.
+Deformable cells are clusters of separate sphere bodies held together by
+*links*: JCFpm bonds with strengths so large that they never break, kept in
+:attr:`GrainScene.links` apart from the breakable bonds
+(:attr:`GrainScene.interactions`), so bond bookkeeping, stress corrosion and
+cracks see only the breakable bonds.  Code that acts on cells uses
+:meth:`GrainScene.bodies_of`, which covers both models.  Their spheres translate
+only (``DEFORMABLE_BLOCKED_DOFS``) and their contact geometry takes the plain
+relative displacement (``DEFORMABLE_RATCHETING_GUARD``): every bond and link is a
+two-node spring, the model :mod:`grainfrac_yade.deformable` fits and
+:func:`grainfrac_yade.elastic.lattice_network` solves statically.
 """
 from __future__ import annotations
 
@@ -49,6 +53,24 @@ COHESIVE_TYPE = 1
 #: FnMax and FsMax [N] of the intra-cell links of deformable cells: never reached, so a link never
 #: breaks (not 0: FnMax = 0 only switches the tension check off, a shear break would still happen).
 LINK_STRENGTH = 1e30
+#: Blocked DOFs of the spheres of deformable cells: in-plane translation only.  Free z-rotation
+#: ("zXY", as rigid cells) was measured on 4 x 8 mm, seed 1, 2 nodes per face (axial strain 3e-4,
+#: same at 1x and 5x the UCS rate, both with YADE's default kinematics): the spheres, held in
+#: rotation only by the links' shear springs, spin (median 1e-3 rad against cell rotations of
+#: 1e-4) and load the bonds in shear: E 61 against
+#: 79 GPa, bond shear p99 / max 2.6 / 5.1 x the applied stress against 0.92 / 1.02, 3 bonds broken
+#: at 3e-4 strain against none.  The price: a translation-only link resists a rigid rotation of its
+#: cell (its shear spring sees the chord), so cells that turn after cracking are held back; UCS of
+#: that specimen with the shipped (rigid-cell) calibration: 1451 MPa, against 187 MPa with free
+#: rotation ("zXY" with YADE's default kinematics) and 252 MPa with rigid cells.
+DEFORMABLE_BLOCKED_DOFS = "zXYZ"
+#: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in deformable scenes.  YADE's default (True)
+#: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
+#: a link between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
+#: False: the plain relative displacement, k_s as given (bonds join touching spheres: no change for
+#: them).  With it the DEM gives the static lattice solve's E and Poisson's ratio (92.7 GPa, 0.155
+#: on 4 x 8 mm, seed 1; 79.2 GPa, 0.247 with the default).  Rigid cells keep YADE's default.
+DEFORMABLE_RATCHETING_GUARD = False
 
 
 @dataclass
@@ -243,13 +265,15 @@ def _oscillation_step(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq: 
     """min over bodies of sqrt(m/K) and sqrt(I/K_rot) for springs of stiffness ``k`` joining ``ends`` (c, 2).
 
     K sums k over a body's springs, K_rot sums k x ``lever_sq`` ((2c,): the first ends' squared
-    lever arms, then the second ends').
+    lever arms, then the second ends').  ``inertia`` None: bodies that do not rotate, sqrt(m/K) only.
     """
     k_body = np.bincount(ends.ravel(), weights=np.repeat(k, 2), minlength=n_bodies)
-    k_rot = np.bincount(np.concatenate([ends[:, 0], ends[:, 1]]), weights=np.tile(k, 2) * lever_sq,
-                        minlength=n_bodies)
     with np.errstate(divide="ignore"):
         t_trans = np.sqrt(mass / k_body)
+        if inertia is None:
+            return float(t_trans.min())
+        k_rot = np.bincount(np.concatenate([ends[:, 0], ends[:, 1]]), weights=np.tile(k, 2) * lever_sq,
+                            minlength=n_bodies)
         t_rot = np.sqrt(inertia / k_rot)
     return float(min(t_trans.min(), t_rot.min()))
 
@@ -262,7 +286,8 @@ def _links(layout: ClumpLayout):
 
 
 def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
-                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None) -> float:
+                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
+                      rotating: bool = True, ratcheting_guard: bool = True) -> float:
     """Conservative critical DEM time step [s]: min over bodies of sqrt(m/K) and sqrt(I/K_rot).
 
     Rigid cells: the bodies are the cells (``mass``, ``inertia`` per cell; ``body_pos`` (n, 3)
@@ -270,10 +295,12 @@ def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Spec
     (k_n + k_s) |r|^2 with r the lever arm from the cell body to the bond point.
 
     Deformable cells: the bodies are the spheres (``mass``, ``inertia`` per sphere).  K sums
-    k_n + k_s of a sphere's bonds and links; K_rot sums (k_n + k_s) r l with r the sphere radius
-    (the lever of rotation in YADE's shear increment) and l = max(r, (d + r - r_other)/2) the lever
-    of the JCFpm torque (force applied half-way across the gap of spheres d apart): r^2 for
-    touching spheres, more for a link across a cell.
+    k_n + k_s of a sphere's bonds and links.  ``rotating=False`` (rotation blocked,
+    ``DEFORMABLE_BLOCKED_DOFS``, the default): sqrt(m/K) only.  Otherwise K_rot sums
+    (k_n + k_s) a l: l = max(r, (d + r - r_other)/2) the lever of the JCFpm torque (r for touching
+    spheres; for spheres d apart the force acts half-way across the gap), a the lever of rotation
+    in YADE's shear increment: the radius r with ``ratcheting_guard``
+    (``avoidGranularRatcheting``, YADE's default), l without.
     """
     if layout.rigid_cells:
         cells = specimen.tessellation.face_cells[layout.bond_face]
@@ -286,9 +313,9 @@ def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Spec
     k = np.concatenate([props.normal_stiffness + props.shear_stiffness, link_kn + link_ks])
     r = layout.sphere_radius[ends]
     d = np.linalg.norm(layout.sphere_center[ends[:, 0]] - layout.sphere_center[ends[:, 1]], axis=1)
-    torque_lever = 0.5 * (d[:, None] + r - r[:, ::-1])
-    lever_sq = (r * np.maximum(r, torque_lever)).T.ravel()
-    return _oscillation_step(layout.n_spheres, ends, k, lever_sq, mass, inertia)
+    torque_lever = np.maximum(r, 0.5 * (d[:, None] + r - r[:, ::-1]))
+    lever_sq = ((r if ratcheting_guard else torque_lever) * torque_lever).T.ravel()
+    return _oscillation_step(layout.n_spheres, ends, k, lever_sq, mass, inertia if rotating else None)
 
 
 def _cell_spheres(layout: ClumpLayout, n_cells: int) -> list:
@@ -410,15 +437,18 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             frictionAngle=c.friction_angle, residualFrictionAngle=c.residual_friction_angle,
             tensileStrength=1.0, cohesion=1.0)))
     law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True)
+    geometry = w.Ig2_Sphere_Sphere_ScGeom()
+    if not layout.rigid_cells:
+        geometry.avoidGranularRatcheting = DEFORMABLE_RATCHETING_GUARD
     newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
     O.engines = [
         w.ForceResetter(),
         w.InsertionSortCollider([w.Bo1_Sphere_Aabb()]),
-        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom()],
+        w.InteractionLoop([geometry],
                           [w.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)], [law]),
         newton,
     ]
-    blocked = _blocked_dofs(dim)
+    blocked = _blocked_dofs(dim) if layout.rigid_cells else DEFORMABLE_BLOCKED_DOFS
     if layout.rigid_cells:
         sphere_body, cell_body, body_pos3, inertia = _append_rigid_cells(
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
@@ -442,7 +472,8 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         ph.crossSection = area
         interactions.append(inter)
     links = _create_links(utils, specimen, layout, params, sphere_body)
-    dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3)
+    dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating="Z" not in blocked,
+                                ratcheting_guard=geometry.avoidGranularRatcheting)
     O.dt = params.numerics.timestep_safety * dt_crit
     return GrainScene(specimen=specimen, layout=layout, props=props, params=params, O=O,
                       cell_body=cell_body, cell_bodies=cell_bodies, sphere_body=sphere_body,
