@@ -130,3 +130,34 @@ def test_rigid_solve_agrees_with_yade_after_a_small_elastic_ramp():
     assert platens.axial_stress() == pytest.approx(sol.applied_stress, rel=1e-3)
     assert np.abs(fn - sol.normal_force).max() < 1e-3 * scale
     assert np.abs(fs - np.abs(sol.shear_force)).max() < 1e-3 * scale
+
+
+@needs_yade
+@pytest.mark.yade
+def test_deformable_scene_agrees_with_the_lattice_solve_after_a_small_elastic_ramp():
+    """The YADE scene of deformable cells is the spring lattice that the static solve models:
+    after a slow ramp to a strain of 2e-4 and relaxation, the platen stress and every bond's
+    forces agree with :func:`lattice_network`'s solution (the same check as for rigid cells)."""
+    from grainfrac_yade.elastic import lattice_network
+    from grainfrac_yade.yade_adapter.platens import Platens
+    from grainfrac_yade.yade_adapter.scene import build_scene
+    p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.damping=0.7",
+                                   "resolution.grain_model=deformable"])
+    s = build_specimen(p, 1)
+    scene = build_scene(s, p)
+    net = lattice_network(s, p, scene.layout)
+    platens = Platens(scene)
+    scene.extras.append(platens)
+    strain, steps = 2e-4, 4000
+    platens.set_axial_velocity(strain * platens.height / (steps * scene.O.dt))
+    scene.run(steps)
+    platens.set_axial_velocity(0.0)
+    scene.run(40000)
+    assert not scene.broken.any()
+    sol = solve_uniaxial(net, s, platens.axial_strain())
+    fn, fs = scene.bond_forces()
+    nb = scene.n_bonds
+    scale = np.abs(sol.normal_force[:nb]).max()
+    assert platens.axial_stress() == pytest.approx(sol.applied_stress, rel=1e-3)
+    assert np.abs(fn - sol.normal_force[:nb]).max() < 1e-3 * scale
+    assert np.abs(fs - np.abs(sol.shear_force[:nb])).max() < 1e-3 * scale
