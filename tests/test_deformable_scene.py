@@ -58,7 +58,8 @@ def grid_layout(specimen, params):
     points = np.array(points).reshape(-1, 2)
     return ClumpLayout(
         sphere_cell=sphere_cell, sphere_center=np.column_stack([centers, np.full(len(centers), z)]),
-        sphere_radius=np.full(len(centers), r), bond_spheres=np.array(pairs, dtype=np.int64).reshape(-1, 2), bond_face=faces,
+        sphere_radius=np.full(len(centers), r), bond_spheres=np.array(pairs, dtype=np.int64).reshape(-1, 2),
+        bond_face=faces,
         bond_area=specimen.face_area[faces] / 2, bond_point=np.column_stack([points, np.full(len(points), z)]),
         rigid_cells=False, link_spheres=links,
         link_normal_stiffness=np.full(len(links), young * specimen.thickness),

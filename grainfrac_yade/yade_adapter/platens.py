@@ -38,7 +38,8 @@ class Platens:
         self.cross_section = self.width * scene.specimen.thickness
         O = scene.O
         self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies = (
-            [O.bodies[int(b)] for b in scene.bodies_of(cells)] for cells in (self.top, self.bottom, self.left, self.right))
+            [O.bodies[int(b)] for b in scene.bodies_of(cells)]
+            for cells in (self.top, self.bottom, self.left, self.right))
         for b in self._top_bodies + self._bottom_bodies:
             b.state.blockedDOFs = PLATEN_BLOCKED[lateral]
             b.state.vel = (0, 0, 0)

@@ -53,23 +53,23 @@ COHESIVE_TYPE = 1
 #: FnMax and FsMax [N] of the intra-cell links of deformable cells: never reached, so a link never
 #: breaks (not 0: FnMax = 0 only switches the tension check off, a shear break would still happen).
 LINK_STRENGTH = 1e30
-#: Blocked DOFs of the spheres of deformable cells: in-plane translation only.  Free z-rotation
-#: ("zXY", as rigid cells) was measured on 4 x 8 mm, seed 1, 2 nodes per face (axial strain 3e-4,
-#: same at 1x and 5x the UCS rate, both with YADE's default kinematics): the spheres, held in
-#: rotation only by the links' shear springs, spin (median 1e-3 rad against cell rotations of
-#: 1e-4) and load the bonds in shear: E 61 against
-#: 79 GPa, bond shear p99 / max 2.6 / 5.1 x the applied stress against 0.92 / 1.02, 3 bonds broken
-#: at 3e-4 strain against none.  The price: a translation-only link resists a rigid rotation of its
-#: cell (its shear spring sees the chord), so cells that turn after cracking are held back; UCS of
-#: that specimen with the shipped (rigid-cell) calibration: 1451 MPa, against 187 MPa with free
-#: rotation ("zXY" with YADE's default kinematics) and 252 MPa with rigid cells.
+#: Blocked DOFs of the spheres of deformable cells: in-plane translation only, the springs that
+#: :mod:`grainfrac_yade.deformable` fits and the static lattice solve assumes.  Measured (layout of
+#: commit fa5f3f4) on 4 x 8 mm, seed 1, 2 nodes per face, axial strain 3e-4 (5x the UCS rate;
+#: static lattice solve: E 89.6 GPa, nu 0.209, bond shear p99 1.05 x the applied stress):
+#:   "zXYZ", plain kinematics (below): E 89.8 GPa, nu 0.208, p99 1.05, DEM step 3.7e-8 s;
+#:   "zXY" (free spin, as rigid cells), YADE's default kinematics: E 80.5 GPa, nu 0.255, p99 0.80
+#:   (max 1.56), DEM step 8.1e-9 s (the rotation of the smallest spheres sets it: 4.6x more steps).
+#: The price of blocking: a translation-only link resists a rigid rotation of its cell (its shear
+#: spring sees the chord), so cells that turn after cracking are held back.  UCS with the shipped
+#: (rigid-cell) calibration: 1414 MPa blocked, 677 MPa free spin, 252 MPa rigid cells.
 DEFORMABLE_BLOCKED_DOFS = "zXYZ"
 #: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in deformable scenes.  YADE's default (True)
 #: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
 #: a link between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
 #: False: the plain relative displacement, k_s as given (bonds join touching spheres: no change for
-#: them).  With it the DEM gives the static lattice solve's E and Poisson's ratio (92.7 GPa, 0.155
-#: on 4 x 8 mm, seed 1; 79.2 GPa, 0.247 with the default).  Rigid cells keep YADE's default.
+#: them); the DEM then gives the static lattice solve's E and Poisson's ratio (tested; 85.5 GPa,
+#: nu 0.227 with the default).  Rigid cells keep YADE's default.
 DEFORMABLE_RATCHETING_GUARD = False
 
 
