@@ -35,6 +35,14 @@ def code_version() -> str:
     return __version__
 
 
+def summary_header(params, seed) -> dict:
+    """summary.json keys shared by UCS and creep runs: seed, code version, all parameters, and at the
+    top level how the cells are realised (``spheres_per_cell``, ``grain_model``, ``nodes_per_face``)."""
+    r = params.resolution
+    return {"seed": seed, "code_version": code_version(), "params": params.to_dict(),
+            "spheres_per_cell": r.spheres_per_cell, "grain_model": r.grain_model, "nodes_per_face": r.nodes_per_face}
+
+
 def _clean(value):
     """JSON-safe copy: NaN/inf become None, numpy scalars become Python numbers."""
     if isinstance(value, dict):

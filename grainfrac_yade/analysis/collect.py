@@ -9,7 +9,8 @@ import pandas as pd
 from ..params import flatten as flatten_tree
 
 #: Parameter paths copied from each run's params.json into the table.
-PARAM_COLUMNS = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height",
+PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resolution.nodes_per_face",
+                 "specimen.grain_size", "specimen.width", "specimen.height",
                  "calibration.strength_scale", "calibration.stiffness_scale", "stress_corrosion.clock",
                  "stress_corrosion.mode", "stress_corrosion.beta1")
 
@@ -73,8 +74,9 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
 
 
 def group_stats(frame: pd.DataFrame, by, values) -> pd.DataFrame:
-    """Mean, standard deviation and count of ``values`` per group of ``by`` (finished runs)."""
+    """Mean, standard deviation and count of ``values`` per group of ``by`` (finished runs; a run
+    lacking a ``by`` value, e.g. a key its params.json predates, is a group of its own, not dropped)."""
     done = frame[frame["status"] == "finished"]
-    agg = done.groupby(list(by))[list(values)].agg(["mean", "std", "count"])
+    agg = done.groupby(list(by), dropna=False)[list(values)].agg(["mean", "std", "count"])
     agg.columns = [f"{v}_{s}" for v, s in agg.columns]
     return agg.reset_index()

@@ -140,14 +140,14 @@ def rebuild_specimen(folder, seed, n_bonds=None, cracks=None) -> RebuiltSpecimen
     if params.specimen.dimension != 2:
         raise GrainfracError(f"{folder}: 3D specimen (specimen.dimension = {params.specimen.dimension}); "
                              "fix: grain maps are drawn for 2D specimens only")
-    from ..layout import build_layout
+    from ..layout import layout_for
     from ..specimen import build_specimen
     specimen = build_specimen(params, seed)
     checks = []
     need_layout = n_bonds is not None or (cracks is not None and len(cracks) and
                                           all(c in cracks for c in ("bond", "x_m", "y_m")))
     if need_layout:
-        layout = build_layout(specimen, params.resolution.spheres_per_cell)
+        layout = layout_for(specimen, params)
         if n_bonds is not None and np.isfinite(float(n_bonds)):
             if layout.n_bonds != int(n_bonds):
                 raise GrainfracError(f"{folder}: rebuilt specimen has {layout.n_bonds} bonds, summary.json "

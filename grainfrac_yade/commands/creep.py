@@ -87,7 +87,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
 
     from ..creep_analysis import creep_stages, damage_index
     from ..plotting import crack_map
-    from ..runio import code_version, prepare_run_dir, write_csv, write_json
+    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..yade_adapter.creep_test import run_creep
     from ..yade_adapter.scene import bond_segments
@@ -120,7 +120,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "n_bonds": run.scene.n_bonds, "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
         "primary_end_s": primary_end, "tertiary_start_s": tertiary_start,
         "vtk_creep_times_s": run.vtk_written,
-        "seed": seed, "code_version": code_version(), "params": params.to_dict(),
+        **summary_header(params, seed),
     }
     if run.initial_bond_stresses is not None:
         write_csv(out / "bond_stresses_start.csv", run.initial_bond_stresses)
@@ -227,8 +227,8 @@ def run_creep_in_yade():
 
     from ..params import load_parameters
     from ..yade_adapter.batch import read_table, run_folder_name
-    overrides, controls = read_table(CREEP_ROW_COLUMNS)
     try:
+        overrides, controls = read_table(CREEP_ROW_COLUMNS)
         params = load_parameters(overrides=overrides)
         given = {k: (float(controls[k]) or None) for k in CREEP_ROW_COLUMNS}
         stress, ratio, ref = resolve_stress(params, given["stress"], given["ratio"], given["ucs"])

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..layout import build_layout
+from ..layout import layout_for
 from ..plotting import specimen_figure
 from ..runio import prepare_run_dir, write_json
 from ..specimen import build_specimen
@@ -39,7 +39,7 @@ def bond_network_segments(specimen, layout) -> tuple:
 def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bool = False) -> dict:
     out = prepare_run_dir(out, "specimen", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
-    layout = build_layout(specimen, params.resolution.spheres_per_cell)
+    layout = layout_for(specimen, params)
     record = specimen_record(specimen, layout)
     record["spheres_per_cell_parameter"] = params.resolution.spheres_per_cell
     write_json(Path(out) / "specimen.json", record)

@@ -26,7 +26,7 @@ def cmd_ucs(args) -> int:
 
 def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
     from ..plotting import crack_map
-    from ..runio import code_version, prepare_run_dir, write_csv, write_json
+    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
@@ -36,8 +36,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)
     summary = ucs_summary(history)
     summary.update(result)
-    summary.update(seed=seed, code_version=code_version(), params=params.to_dict(),
-                   n_cells=specimen.n_cells, spheres_per_cell=params.resolution.spheres_per_cell)
+    summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
     write_json(out / "summary.json", summary)

@@ -2,13 +2,15 @@
 
 Every parameter path (``section.key``, the names of ``--set``) is a possible
 column of a batch table, plus ``seed``, ``out`` and ``study``.  Values are read
-with YADE's own ``readParamsFromTable`` and validated like files.
+with YADE's own ``readParamsFromTable`` (each cell is a Python expression, so text is
+quoted: ``'deformable'``) and validated like files.
 """
 from __future__ import annotations
 
 import os
 import re
 
+from ..errors import GrainfracError
 from ..params import default_files, flatten, read_toml
 from . import load_yade
 
@@ -33,7 +35,12 @@ def read_table(extra_columns=None) -> tuple:
     from yade import utils
     defaults = parameter_defaults()
     run_defaults = dict(RUN_COLUMNS, **(extra_columns or {}))
-    utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
+    try:
+        utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
+    except NameError as exc:   # YADE evaluates every cell as Python: an unknown column, or text without quotes
+        raise GrainfracError(f"batch table row {os.environ.get('YADE_BATCH', '')}: {exc}; fix: columns are "
+                             f"parameter paths (section.key) or {', '.join(run_defaults)}, and text cells are "
+                             "quoted, e.g. 'deformable'") from None
     table = yade.params.table
     overrides = [(k, getattr(table, k)) for k, v in defaults.items() if getattr(table, k) != v]
     controls = {k: getattr(table, k) for k in run_defaults}

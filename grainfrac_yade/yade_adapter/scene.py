@@ -35,16 +35,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import GrainfracError
-from ..layout import BondProperties, ClumpLayout, bond_properties, build_layout, cell_mass_inertia
+from ..layout import BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for
 from ..params import Parameters
 from ..specimen import Specimen
 from . import load_yade
-
-# TEMPORARY fallback until layout.layout_for exists (rigid layouts only); remove it then.
-try:
-    from ..layout import layout_for
-except ImportError:
-    layout_for = lambda s, p: build_layout(s, p.resolution.spheres_per_cell)  # noqa: E731
 
 #: Bond break modes, the codes of YADE's JCFpm crack file.
 INTACT, TENSION, SHEAR = 0, 1, 2
