@@ -299,12 +299,12 @@ def _spring_geometry(center_a, radius_a, center_b, radius_b, body_a, body_b):
         (radius_a + radius_b) / dist
 
 
-def rigid_network(specimen: Specimen, params: Parameters) -> Network:
+def rigid_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
     """Rigid cells with the project's bonds (``resolution.spheres_per_cell``) and series springs."""
     from .layout import bond_properties, build_layout
     t = specimen.tessellation
     _require_2d(t)
-    layout = build_layout(specimen, params.resolution.spheres_per_cell)
+    layout = layout or build_layout(specimen, params.resolution.spheres_per_cell)
     props = bond_properties(specimen, layout, params)
     s = layout.bond_spheres
     cells = layout.sphere_cell[s]
