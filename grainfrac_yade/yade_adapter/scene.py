@@ -54,9 +54,10 @@ LINK_STRENGTH = 1e30
 #:   "zXYZ", plain kinematics (below): E 89.8 GPa, nu 0.208, p99 1.05, DEM step 3.7e-8 s;
 #:   "zXY" (free spin, as rigid cells), YADE's default kinematics: E 80.5 GPa, nu 0.255, p99 0.80
 #:   (max 1.56), DEM step 8.1e-9 s (the rotation of the smallest spheres sets it: 4.6x more steps).
-#: The price of blocking: a translation-only link resists a rigid rotation of its cell (its shear
-#: spring sees the chord), so cells that turn after cracking are held back.  UCS with the shipped
-#: (rigid-cell) calibration: 1414 MPa blocked, 677 MPa free spin, 252 MPa rigid cells.
+#: Blocking has a price only where links carry shear springs: a translation-only link with one
+#: resists the rigid rotation of its cell (its shear spring sees the chord).  With such links a
+#: 4 x 8 mm specimen with the rigid-cell calibration reached a UCS of 1414 MPa (677 MPa free spin,
+#: 252 MPa rigid cells); the links of :mod:`grainfrac_yade.deformable` are normal springs only.
 DEFORMABLE_BLOCKED_DOFS = "zXYZ"
 #: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in deformable scenes.  YADE's default (True)
 #: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
