@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from grainfrac_yade import corrosion
+from grainfrac_yade.errors import NumericalFailure
 
 STATE_VERSION = 1  # bump when a state_dict layout changes; from_state refuses other versions
 EVENT_REL_TOL = 1e-12  # bonds whose time to failure is within this relative distance of dt fail
@@ -39,7 +40,9 @@ class PaperClock:
     """Adaptive creep step of paper Eq. 8.
 
     dt_b = min(2 dt_{b-1}, dt_max) if the unbalanced force F_u < threshold, else dt_min; the
-    first step (and the first after :meth:`reset_step`) is dt_min.
+    first step (and the first after :meth:`reset_step`) is dt_min. "Balanced" means F_u below
+    the threshold and nothing else (:meth:`balanced`): the creep loop counts DEM steps without
+    balance against the same test, so the step never grows on a state the loop calls unsettled.
 
     Parameters
     ----------
@@ -92,18 +95,15 @@ class PaperClock:
         Parameters
         ----------
         unbalanced_force : float
-            F_u after the last DEM relaxation [N], finite and >= 0.
+            F_u after the last DEM relaxation [N], finite and >= 0 (see :meth:`balanced`).
 
         Returns
         -------
         float
             dt_b [s], in [dt_min, dt_max].
         """
-        f = _number("unbalanced_force", unbalanced_force, "pass the DEM's unbalanced force in N")
-        if not (0 <= f < math.inf):
-            raise ValueError(f"unbalanced_force must be finite and >= 0 N (got {f!r}); "
-                             "a non-finite value means the DEM blew up")
-        if self._dt is None or f >= self.unbalanced_force_threshold:
+        balanced = self.balanced(unbalanced_force)  # checked even where the step is dt_min anyway
+        if self._dt is None or not balanced:
             dt = self.dt_min
         else:
             dt = min(2.0 * self._dt, self.dt_max)
@@ -111,6 +111,25 @@ class PaperClock:
         self._creep_time += dt
         self._n_steps += 1
         return dt
+
+    def balanced(self, unbalanced_force):
+        """True if F_u is below the threshold: the step may double, and the state counts as settled.
+
+        Parameters
+        ----------
+        unbalanced_force : float
+            F_u [N, or relative], >= 0. NaN or inf (the DEM blew up) raises NumericalFailure.
+        """
+        try:
+            f = float(unbalanced_force)
+        except (TypeError, ValueError):
+            raise ValueError(f"unbalanced_force must be a number (got {unbalanced_force!r}); "
+                             "pass the DEM's unbalanced force") from None
+        if not math.isfinite(f):
+            raise NumericalFailure(f"unbalanced force is {f} (the DEM blew up)")
+        if f < 0:
+            raise ValueError(f"unbalanced_force must be >= 0 (got {f!r}); pass a magnitude")
+        return f < self.unbalanced_force_threshold
 
     def advance_many(self, unbalanced_forces):
         """Take one step per value of ``unbalanced_forces`` [N]; return the summed creep time [s].

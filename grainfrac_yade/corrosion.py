@@ -17,10 +17,14 @@ Two degradation modes, both under FROZEN stresses/forces between DEM re-equilibr
     p = F_n/A0 and q = |F_s|/A0 [Pa]. The YADE side scales stiffness as k = a k0.
 
 Every exponent is clipped to [-LOG_LIMIT, LOG_LIMIT], so no function overflows or returns NaN
-for finite input; ``inf`` appears only as the documented answer 'never fails'.
+for finite input; ``inf`` appears only as the documented answer 'never fails'. A NaN or infinite
+stress, force or strength (a DEM that blew up) is refused with
+:class:`~grainfrac_yade.errors.NumericalFailure`: it never yields a time, a verdict or a strength.
 """
 import numpy as np
 from scipy import special
+
+from .errors import NumericalFailure
 
 # float64 exp() overflows above ln(1.8e308) ~ 709.8 and leaves the normal range below
 # ln(2.2e-308) ~ -708.4; clipping every exponent to +-700 keeps exp() finite and normal with
@@ -72,6 +76,26 @@ def _check_shear(tau, name="shear_stress"):
         raise ValueError(f"{name} must be |F_s|/A >= 0 Pa; pass the magnitude")
 
 
+def check_finite(name, values, labels=None, item="bond"):
+    """Raise NumericalFailure if ``values`` (one per ``item``) hold NaN or inf; name how many and the first.
+
+    ``labels``: the items' numbers, to name the first bad one (default: its position).
+    """
+    v = np.ravel(_arr(values))
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        first = bad[0] if labels is None else np.ravel(labels)[bad[0]]
+        raise NumericalFailure(f"{name} is NaN or infinite at {bad.size} of {v.size} {item}(s) (first: {item} "
+                               f"{first}, {v[bad[0]]})")
+
+
+def _finite(**named):
+    """The arrays of ``named`` (name=value, in order), each checked by :func:`check_finite`."""
+    for name, value in named.items():
+        check_finite(name, value)
+    return [_arr(v) for v in named.values()]
+
+
 def _log_rate(stress, beta1, beta2):
     """ln(beta1 exp(beta2 stress)) clipped to +-LOG_LIMIT (beta2*stress may overflow to inf)."""
     with np.errstate(over="ignore", under="ignore"):
@@ -107,7 +131,8 @@ def degradation_rate(stress, beta1, beta2):
         Rate [Pa/s] in [exp(-LOG_LIMIT), RATE_CAP]: the exponent is clipped to +-LOG_LIMIT.
     """
     b1, b2 = _check_law(beta1, beta2)
-    return np.exp(_log_rate(_arr(stress), b1, b2))
+    stress, = _finite(stress=stress)
+    return np.exp(_log_rate(stress, b1, b2))
 
 
 def shear_strength(cohesion, normal_stress, tan_friction):
@@ -147,8 +172,10 @@ def failed_now(tensile_strength, cohesion, normal_stress, shear_stress, tan_fric
     -------
     tensile_failed, shear_failed : ndarray of bool
     """
-    sigma, tau = _arr(normal_stress), _arr(shear_stress)
-    return sigma >= _arr(tensile_strength), tau >= shear_strength(cohesion, sigma, tan_friction)
+    jt, jc, sigma, tau, tphi = _finite(tensile_strength=tensile_strength, cohesion=cohesion,
+                                       normal_stress=normal_stress, shear_stress=shear_stress,
+                                       tan_friction=tan_friction)
+    return sigma >= jt, tau >= shear_strength(jc, sigma, tphi)
 
 
 def _loss(log_rate, dt):
@@ -193,11 +220,13 @@ def degrade(tensile_strength, cohesion, normal_stress, shear_stress, dt, beta1, 
         [Pa], never below 0.
     """
     b1, b2 = _check_law(beta1, beta2)
-    _check_shear(shear_stress)
+    jt, jc, sigma, tau = _finite(tensile_strength=tensile_strength, cohesion=cohesion,
+                                 normal_stress=normal_stress, shear_stress=shear_stress)
+    _check_shear(tau)
     d = _check_dt(dt)
     with np.errstate(over="ignore"):  # only for strengths near -1.8e308, clipped to 0 below
-        jt = _arr(tensile_strength) - _loss(_log_rate(_arr(normal_stress), b1, b2), d)
-        jc = _arr(cohesion) - _loss(_log_rate(_arr(shear_stress), b1, b2), d)
+        jt = jt - _loss(_log_rate(sigma, b1, b2), d)
+        jc = jc - _loss(_log_rate(tau, b1, b2), d)
     return np.maximum(jt, 0.0), np.maximum(jc, 0.0)
 
 
@@ -230,9 +259,10 @@ def time_to_failure(tensile_strength, cohesion, normal_stress, shear_stress, tan
         MODE_TENSION (1, also on ties), MODE_SHEAR (2) or MODE_NEVER (0).
     """
     b1, b2 = _check_law(beta1, beta2)
-    _check_shear(shear_stress)
-    jt, jc, sigma, tau, tphi = np.broadcast_arrays(*map(_arr, (
-        tensile_strength, cohesion, normal_stress, shear_stress, tan_friction)))
+    jt, jc, sigma, tau, tphi = np.broadcast_arrays(*_finite(
+        tensile_strength=tensile_strength, cohesion=cohesion, normal_stress=normal_stress,
+        shear_stress=shear_stress, tan_friction=tan_friction))
+    _check_shear(tau)
     with np.errstate(over="ignore"):  # inf only where sigma < 0 ('never' anyway)
         gap_t = jt - sigma
         gap_s = shear_strength(jc, sigma, tphi) - tau  # cohesion still to lose; +inf: never
@@ -254,10 +284,11 @@ def _area_args(area_fraction, p, q, jt0, jc0, beta1, beta2):
     for name, v in (("tensile_strength0", jt0), ("cohesion0", jc0)):
         if not np.all((_arr(v) > 0) & np.isfinite(_arr(v))):
             raise ValueError(f"{name} must be finite and > 0 Pa (got {v!r})")
+    p, q = _finite(normal_force_per_area0=p, shear_force_per_area0=q)
     _check_shear(q, "shear_force_per_area0")
     b1, b2 = _check_law(beta1, beta2)
     with np.errstate(over="ignore", under="ignore"):  # inf is clipped downstream
-        k_t, k_s = b2 * _arr(p), b2 * _arr(q)
+        k_t, k_s = b2 * p, b2 * q
     l_t = np.log(b1) - np.log(_arr(jt0))
     l_s = np.log(b1) - np.log(_arr(jc0))
     return a, k_t, k_s, l_t, l_s
@@ -310,7 +341,9 @@ def area_rate(area_fraction, normal_force_per_area0, shear_force_per_area0, tens
 
 def _area_limits(p, q, jt0, jc0, tan_friction):
     """Per-channel failure area fractions (-inf: channel never met for a > 0)."""
-    p, q, jt0, jc0, tphi = np.broadcast_arrays(*map(_arr, (p, q, jt0, jc0, tan_friction)))
+    p, q, jt0, jc0, tphi = np.broadcast_arrays(*_finite(
+        normal_force_per_area0=p, shear_force_per_area0=q, tensile_strength0=jt0, cohesion0=jc0,
+        tan_friction=tan_friction))
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         a_t = np.where(p > 0, p / jt0, -np.inf)       # p/a >= J^T0
         need = q + p * tphi                           # = tau0 - s_n0 tan(phi)
@@ -562,13 +595,16 @@ def area_time_single_channel(area_from, area_to, force_per_area0, strength0, bet
         Time [s].
     """
     b1, b2 = _check_law(beta1, beta2)
-    k = b2 * _arr(force_per_area0)
+    force, = _finite(force_per_area0=force_per_area0)
+    with np.errstate(over="ignore"):  # beta2 p beyond the float range: inf, clipped below
+        k = b2 * force
     if np.any(k < 0):
         raise ValueError("force_per_area0 must be >= 0 Pa for the single-channel closed form")
 
     def antiderivative(a):
         x = k / np.where(a > 0, a, 1.0)
-        return np.where(a > 0, a * np.exp(-np.minimum(x, LOG_LIMIT)) * _one_minus_x_ex_e1(x), 0.0)
+        with np.errstate(under="ignore"):  # e^-x G(x) below 1e-308: the time is 0 to float precision
+            return np.where(a > 0, a * np.exp(-np.minimum(x, LOG_LIMIT)) * _one_minus_x_ex_e1(x), 0.0)
 
     a0, a1 = _arr(area_from), _arr(area_to)
     return _arr(strength0) / b1 * (antiderivative(a0) - antiderivative(a1))

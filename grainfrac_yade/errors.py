@@ -15,3 +15,13 @@ class ParameterError(GrainfracError):
     def __init__(self, source, key, problem, fix):
         self.source, self.key, self.problem, self.fix = source, key, problem, fix
         super().__init__(f"{source}: {key}: {problem}; fix: {fix}")
+
+
+class NumericalFailure(ValueError):
+    """A simulation produced NaN or infinite numbers (the DEM blew up) or stopped advancing.
+
+    Not a user error and not a result: a creep run that meets it ends with
+    ``numerical_failure: true`` in its summary, and the analysis lists it apart
+    (never as a lifetime or a lower bound).  A ValueError, as the law's and the
+    clocks' other checks on their arguments.
+    """

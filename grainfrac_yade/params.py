@@ -14,6 +14,7 @@ the pair explicitly.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -21,7 +22,7 @@ from itertools import combinations_with_replacement
 from pathlib import Path
 from typing import Any, Mapping
 
-from .errors import ParameterError
+from .errors import GrainfracError, ParameterError
 
 PARAMS_DIR = Path(__file__).resolve().parent.parent / "params"
 DEFAULT_FILES = ("ldb_granite.toml", "stress_corrosion.toml", "numerics.toml", "loading.toml",
@@ -29,6 +30,8 @@ DEFAULT_FILES = ("ldb_granite.toml", "stress_corrosion.toml", "numerics.toml", "
 
 #: Tolerance on the sum of area fractions (they are printed to 3 decimals in the paper).
 FRACTION_SUM_TOLERANCE = 1e-6
+#: Similarity (difflib ratio) above which a misspelt key is matched to a valid one.
+NEAREST_KEY_CUTOFF = 0.6
 
 
 def _spec(unit: str, check: str, doc: str = "", choices: tuple = ()):
@@ -292,13 +295,28 @@ def _check_value(value: Any, spec: Mapping, source: str, key: str):
     return value
 
 
+def nearest_key(word: str, keys) -> str | None:
+    """The valid key ``word`` most likely misspells: one whose last dotted part is ``word``, else the
+    most similar whole key or last part (difflib, :data:`NEAREST_KEY_CUTOFF`); None if none is close."""
+    keys = list(keys)
+    same_tail = [k for k in keys if k.rsplit(".", 1)[-1] == word]
+    if same_tail:
+        return same_tail[0]
+    close = difflib.get_close_matches(word, keys, n=1, cutoff=NEAREST_KEY_CUTOFF)
+    if close:
+        return close[0]
+    tails = {k.rsplit(".", 1)[-1]: k for k in keys}
+    close = difflib.get_close_matches(word.rsplit(".", 1)[-1], list(tails), n=1, cutoff=NEAREST_KEY_CUTOFF)
+    return tails[close[0]] if close else None
+
+
 def _build(cls, table: Mapping, origins: Mapping, section: str):
     """Build dataclass ``cls`` from a TOML table, rejecting unknown and missing keys."""
     names = [f.name for f in dataclasses.fields(cls)]
     for key in table:
         if key not in names:
-            close = [n for n in names if n.startswith(key[:3])]
-            hint = f"did you mean {close[0]!r}?" if close else f"known keys: {', '.join(names)}"
+            close = nearest_key(key, names)
+            hint = f"did you mean {close!r}?" if close else f"known keys: {', '.join(names)}"
             raise ParameterError(origins.get(f"{section}.{key}".replace('"', ""), "parameters"), f"{section}.{key}",
                                  "unknown key", f"remove it or correct the spelling ({hint})")
     values = {}
@@ -412,9 +430,10 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
         key, value = parse_override(text) if isinstance(text, str) else text
         flat_known = flatten(merged)
         if key not in flat_known and not _is_new_pair_key(key):
+            close = nearest_key(key, flat_known)
             raise ParameterError("--set", key, "no such parameter",
-                                 "use a dotted key that exists in the parameter files, e.g. "
-                                 "stress_corrosion.beta1")
+                                 f"did you mean {close}?" if close else "use a dotted key that exists in the "
+                                 "parameter files, e.g. stress_corrosion.beta1")
         _merge(merged, _nest(key, value), origins, "--set")
     return build_parameters(merged, origins, tuple(str(p) for p in files))
 
@@ -454,7 +473,27 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
                              f"dt_min = {sc.dt_min:g} s exceeds dt_max = {sc.dt_max:g} s",
                              "make dt_min <= dt_max")
     typed["stress_corrosion"] = _rate_constants(sc, origins)
+    _check_grain_size(typed["specimen"], origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
+
+
+def _check_grain_size(sp: SpecimenParams, origins: Mapping):
+    """A grain must be smaller than the specimen's width and height: at or above, the specimen is a few
+    cells at most (a lone cell has no face to bond). The 3D box depth may be thinner (one layer)."""
+    name, side = min([("width", sp.width), ("height", sp.height)], key=lambda s: s[1])
+    if sp.grain_size >= side:
+        raise ParameterError(origins.get("specimen.grain_size", "parameters"), "specimen.grain_size",
+                             f"{sp.grain_size:g} m is at or above the specimen's {name} ({side:g} m)",
+                             f"make specimen.grain_size smaller than specimen.{name} (paper: 1 mm in a 31.7 mm "
+                             f"wide specimen) or enlarge the specimen")
+
+
+def require_plane(params: Parameters, command: str):
+    """GrainfracError unless the specimen is 2D: ``command`` runs plane specimens only."""
+    if params.specimen.dimension != 2:
+        raise GrainfracError(f"specimen.dimension = {params.specimen.dimension}: the {command} command runs plane "
+                             "(2D) specimens only; fix: set specimen.dimension = 2 (the specimen command builds "
+                             "3D specimens)")
 
 
 def _rate_constants(sc: StressCorrosionParams, origins: Mapping) -> StressCorrosionParams:

@@ -3,10 +3,14 @@
 Every run folder records its resolved parameters, seed and code version.
 Files are written to a temporary name and renamed, so an interrupted run never
 leaves a half-written file; an existing run is never overwritten unless asked.
+``summary.json`` marks a finished run: commands write it last, and replacing a
+run removes the old one first, so a killed run never leaves a summary that
+claims completion.
 """
 from __future__ import annotations
 
 import datetime as _dt
+import hashlib
 import json
 import math
 import os
@@ -20,6 +24,10 @@ from .errors import GrainfracError
 
 #: Files whose presence marks a folder as holding a finished or running run.
 RUN_MARKERS = ("run.json",)
+#: The file that marks a run as finished (written last).
+SUMMARY = "summary.json"
+#: Parameter-tree entries that record provenance, not the model: never compared between runs.
+PROVENANCE_KEYS = ("sources",)
 
 
 def code_version() -> str:
@@ -59,32 +67,35 @@ def _clean(value):
     return value
 
 
-def write_json(path, data) -> Path:
-    """Write ``data`` as indented JSON atomically."""
+def _write_atomically(path, write) -> Path:
+    """Call ``write(tmp)`` on a temporary name beside ``path``, flush it to disk, rename it to ``path``."""
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as fh:
-        json.dump(_clean(data), fh, indent=2, sort_keys=False)
-        fh.write("\n")
+    write(tmp)
+    with open(tmp, "rb+") as fh:
+        os.fsync(fh.fileno())
     os.replace(tmp, path)
     return path
+
+
+def write_json(path, data) -> Path:
+    """Write ``data`` as indented JSON atomically."""
+    text = json.dumps(_clean(data), indent=2, sort_keys=False) + "\n"
+    return _write_atomically(path, lambda tmp: Path(tmp).write_text(text))
 
 
 def write_csv(path, frame) -> Path:
     """Write a pandas DataFrame (or dict of columns) as CSV atomically."""
     import pandas as pd
-    path = Path(path)
     frame = frame if isinstance(frame, pd.DataFrame) else pd.DataFrame(frame)
-    tmp = path.with_name(path.name + ".tmp")
-    frame.to_csv(tmp, index=False)
-    os.replace(tmp, path)
-    return path
+    return _write_atomically(path, lambda tmp: frame.to_csv(tmp, index=False))
 
 
 def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, argv=None) -> Path:
     """Create ``out`` and write ``run.json`` (command, seed, code version) and ``params.json``.
 
-    Refuses a folder that already holds a run unless ``overwrite``.
+    Refuses a folder that already holds a run unless ``overwrite``; replacing one removes its
+    summary.json first (the old run's completion must not outlive it).
     """
     out = Path(out)
     if out.exists() and not out.is_dir():
@@ -93,6 +104,7 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
         raise GrainfracError(f"{out}: already holds a run (run.json); fix: choose another --out "
                              "or pass --overwrite to replace it")
     out.mkdir(parents=True, exist_ok=True)
+    (out / SUMMARY).unlink(missing_ok=True)
     write_json(out / "params.json", params.to_dict())
     write_json(out / "run.json", {
         "command": command, "argv": list(sys.argv if argv is None else argv), "seed": seed,
@@ -100,3 +112,52 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
         "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     })
     return out
+
+
+def comparable_parameters(tree: dict) -> dict:
+    """A parameter tree (``Parameters.to_dict()`` or a params.json) as {dotted key: value} as JSON
+    stores it, without the provenance entries (:data:`PROVENANCE_KEYS`)."""
+    from .params import flatten
+    tree = json.loads(json.dumps(_clean({k: v for k, v in tree.items() if k not in PROVENANCE_KEYS})))
+    return flatten(tree)
+
+
+def _same(a, b) -> bool:
+    """Equal values as JSON stores them (1 == 1.0, but true is not 1)."""
+    return a == b and isinstance(a, bool) == isinstance(b, bool)
+
+
+def stored_run_differences(folder, params, run_values: dict) -> list:
+    """What differs between the finished run in ``folder`` and a run of ``params`` with ``run_values``.
+
+    Compares the folder's params.json with ``params`` (every key; a key missing from an older
+    params.json counts as the shipped default, as the analysis reads it) and its summary.json's
+    ``run_values`` keys (e.g. seed, stress_pa). Returns "key: stored X, now Y" strings, [] if equal.
+    """
+    from .params import flatten, load_parameters
+    folder = Path(folder)
+    try:
+        stored = comparable_parameters(json.loads((folder / "params.json").read_text()))
+        summary = json.loads((folder / SUMMARY).read_text())
+    except (OSError, ValueError) as exc:
+        return [f"stored run unreadable ({type(exc).__name__}: {exc})"]
+    now = comparable_parameters(params.to_dict())
+    defaults = comparable_parameters(load_parameters().to_dict())
+    diffs = []
+    for key in sorted(set(stored) | set(now)):
+        old = stored.get(key, defaults.get(key, "(missing)"))
+        new = now.get(key, "(missing)")
+        if not _same(old, new):
+            diffs.append(f"{key}: stored {old!r}, now {new!r}")
+    run_now = flatten(json.loads(json.dumps(_clean(run_values))))
+    for key, new in run_now.items():
+        old = summary.get(key, "(missing)")
+        if not _same(old, new):
+            diffs.append(f"{key}: stored {old!r}, now {new!r}")
+    return diffs
+
+
+def run_digest(params, run_values: dict) -> str:
+    """8 hex digits identifying the resolved parameters and run values (e.g. seed, load) of a run."""
+    data = {"params": comparable_parameters(params.to_dict()), "run": _clean(run_values)}
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:8]

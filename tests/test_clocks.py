@@ -108,10 +108,32 @@ def test_bad_parameters_name_themselves(cls, kwargs, name):
         cls(**kwargs)
 
 
-@pytest.mark.parametrize("force", [-1.0, math.nan, math.inf])
-def test_bad_unbalanced_force_is_refused(force):
-    with pytest.raises(ValueError, match="unbalanced_force"):
-        PaperClock().next_step(force)
+def test_bad_unbalanced_force_is_refused():
+    with pytest.raises(ValueError, match="^unbalanced_force must be >= 0 "):
+        PaperClock().next_step(-1.0)
+
+
+@pytest.mark.parametrize("force", [math.nan, math.inf])
+def test_non_finite_unbalanced_force_is_a_numerical_failure_even_on_the_first_step(force):
+    from grainfrac_yade.errors import NumericalFailure
+    clock = PaperClock()
+    with pytest.raises(NumericalFailure) as err:
+        clock.next_step(force)
+    assert str(err.value) == f"unbalanced force is {force} (the DEM blew up)"
+    assert clock.n_steps == 0 and clock.creep_time == 0.0
+
+
+@pytest.mark.parametrize("threshold", [F_U, 1e-2])
+def test_one_notion_of_balanced_decides_the_step(threshold):
+    """balanced(F_u) is F_u < threshold, and the step doubles exactly when it holds (the creep
+    loop's no-equilibrium counter uses the same method: tests/test_reliability.py)."""
+    d = 1e-5
+    below, at = threshold * (1 - 1e-12), threshold
+    for f, expected in ((0.0, True), (below, True), (at, False), (2 * threshold, False)):
+        clock = PaperClock(dt_min=d, dt_max=1e4, unbalanced_force_threshold=threshold)
+        clock.next_step(0.0)                       # first step: dt_min whatever F_u
+        assert clock.balanced(f) is expected
+        assert clock.next_step(f) == (2 * d if expected else d)
 
 
 def test_state_of_another_kind_or_version_is_refused():
@@ -226,3 +248,18 @@ def test_event_clock_state_round_trip_and_validation():
         clock.next_interval(1.0, 1.0, 0.0, 0.0, 0.0, B1, B2, mode="area")
     with pytest.raises(ValueError, match="dt"):
         clock.advance(math.inf)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_event_clock_refuses_non_finite_stresses(bad):
+    """A NaN stress used to give a finite time to failure (the quotient helper replaced the NaN gap by 1)."""
+    from grainfrac_yade.errors import NumericalFailure
+    clock = EventClock(0.1)
+    for mode, extra in (("strength", {}), ("area", {"area_fraction": [1.0, 1.0]})):
+        with pytest.raises(NumericalFailure, match="NaN or infinite at 1 of 2 bond"):
+            clock.next_interval([20e6, 20e6], [52e6, 52e6], [1e6, bad], [0.0, 0.0], TAN55, B1, B2, mode=mode,
+                                **extra)
+        with pytest.raises(NumericalFailure, match="NaN or infinite at 1 of 2 bond"):
+            clock.apply(1.0, [1], [20e6, 20e6], [52e6, 52e6], [1e6, bad], [0.0, 0.0], TAN55, B1, B2, mode=mode,
+                        **extra)
+    assert clock.creep_time == 0.0 and clock.n_intervals == 0

@@ -243,3 +243,62 @@ def test_no_overflow_or_nan_in_area_mode(beta2, strength0):
             assert np.all(np.isfinite(t)) and np.all(t >= 0)
             new = c.degrade_area(a, p, q, strength0, strength0, 1e3, beta1, beta2)
             assert np.all((new >= 0) & (new <= a))
+
+
+# ------------------------------------------------------------------ non-finite input and overflow
+NON_FINITE = [math.nan, math.inf, -math.inf]
+# one call per public function; ``bad`` is put in the middle of three bonds
+LAW_CALLS = {
+    "degradation_rate": lambda bad: c.degradation_rate([1e6, bad, 2e6], B1, B2),
+    "failed_now": lambda bad: c.failed_now(20e6, 52e6, [0.0, bad, 1e6], 1e6, TAN55),
+    "degrade": lambda bad: c.degrade(20e6, 52e6, [0.0, bad, 1e6], 1e6, 1e3, B1, B2),
+    "time_to_failure": lambda bad: c.time_to_failure(20e6, 52e6, [0.0, bad, 1e6], 1e6, TAN55, B1, B2),
+    "area_rate": lambda bad: c.area_rate(1.0, [0.0, bad, 1e6], 1e6, JT0, JC0, B1, B2),
+    "area_time": lambda bad: c.area_time(1.0, 0.5, [0.0, bad, 1e6], 1e6, JT0, JC0, B1, B2),
+    "time_to_failure_area": lambda bad: c.time_to_failure_area(1.0, [0.0, bad, 1e6], 1e6, JT0, JC0, TAN55, B1, B2),
+    "degrade_area": lambda bad: c.degrade_area(1.0, [0.0, bad, 1e6], 1e6, JT0, JC0, 1e3, B1, B2),
+    "area_failure_point": lambda bad: c.area_failure_point([0.0, bad, 1e6], 1e6, JT0, JC0, TAN55),
+    "failed_now_area": lambda bad: c.failed_now_area(1.0, [0.0, bad, 1e6], 1e6, JT0, JC0, TAN55),
+}
+ARG_NAME = {"degradation_rate": "stress", "failed_now": "normal_stress", "degrade": "normal_stress",
+            "time_to_failure": "normal_stress"}
+
+
+@pytest.mark.parametrize("bad", NON_FINITE)
+@pytest.mark.parametrize("name", LAW_CALLS)
+def test_a_non_finite_stress_is_a_numerical_failure_never_a_time_or_verdict(name, bad):
+    """A NaN or infinite stress (a DEM that blew up) gives no time, no strength, no failure verdict."""
+    from grainfrac_yade.errors import NumericalFailure
+    arg = ARG_NAME.get(name, "normal_force_per_area0")
+    with pytest.raises(NumericalFailure) as err:
+        LAW_CALLS[name](bad)
+    assert str(err.value) == f"{arg} is NaN or infinite at 1 of 3 bond(s) (first: bond 1, {bad})"
+
+
+@pytest.mark.parametrize("bad", NON_FINITE)
+def test_a_non_finite_shear_stress_or_strength_is_refused_too(bad):
+    from grainfrac_yade.errors import NumericalFailure
+    with pytest.raises(NumericalFailure, match="^shear_stress is NaN or infinite"):
+        c.time_to_failure(20e6, 52e6, 0.0, [1e6, abs(bad)], TAN55, B1, B2)
+    with pytest.raises(NumericalFailure, match="^tensile_strength is NaN or infinite"):
+        c.degrade([bad, 20e6], 52e6, 0.0, 1e6, 1e3, B1, B2)
+
+
+def test_beta2_times_stress_of_1e4_gives_capped_finite_rates_and_times():
+    """beta2 sigma = 1e4: exp() would overflow; the exponent is clipped at LOG_LIMIT (no warning:
+    this module runs with float warnings as errors), so rate = RATE_CAP and t = gap / RATE_CAP."""
+    beta2, sigma, jt = 1e-3, 1e7, 2e7          # beta2 * sigma = 1e4; ln(beta1) + 1e4 > LOG_LIMIT
+    assert c.degradation_rate(sigma, B1, beta2) == c.RATE_CAP == math.exp(c.LOG_LIMIT)
+    t, mode = c.time_to_failure(jt, 52e6, sigma, 0.0, TAN55, B1, beta2)
+    assert mode == c.MODE_TENSION and t == pytest.approx((jt - sigma) / c.RATE_CAP, rel=1e-12) and t > 0
+    new_t, new_c = c.degrade(jt, 52e6, sigma, 0.0, 1e-300, B1, beta2)   # loss RATE_CAP * 1e-300 ~ 1e4 Pa
+    assert new_t == pytest.approx(jt - c.RATE_CAP * 1e-300, rel=1e-12)
+    assert new_c == pytest.approx(52e6 - B1 * 1e-300, rel=1e-12)        # tau = 0: the plain law
+    t_shear, mode = c.time_to_failure(jt, 52e6, -1e12, sigma, TAN55, B1, beta2)
+    assert np.isinf(t_shear) and mode == c.MODE_NEVER                      # friction carries tau: never
+    # area mode: p = 1e7 Pa at beta2 = 1e-3 1/Pa, both channels near or at the cap
+    t_area, mode = c.time_to_failure_area(1.0, sigma, sigma, jt, 52e6, TAN55, B1, beta2)
+    a_fail, _ = c.area_failure_point(sigma, sigma, jt, 52e6, TAN55)
+    assert np.isfinite(t_area) and 0 < t_area <= (1.0 - a_fail) / (c.RATE_CAP * B1 / 52e6) * (1 + 1e-9)
+    assert np.isfinite(c.area_time_single_channel(1.0, 0.5, sigma, jt, B1, beta2))
+    assert 0 <= c.degrade_area(1.0, sigma, sigma, jt, 52e6, 1e-300, B1, beta2) <= 1.0

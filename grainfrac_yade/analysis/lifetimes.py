@@ -6,6 +6,8 @@ Outcome of each run folder (column ``outcome``):
 - ``failed at load``: failed at creep time 0 (no creep life; ln 0 is undefined, so not in the fit);
 - ``not failed``: the run ended at ``creep_time_end_s`` without failure: a lower bound of the
   lifetime, drawn but not fitted;
+- ``numerical failure``: the run stopped on NaN/inf numbers or a stalled clock (summary key
+  ``numerical_failure``): no result, listed with its reason, never a lifetime or a lower bound;
 - ``unfinished``: no summary.json yet (running, killed or crashed);
 - ``unreadable``: a JSON file that cannot be parsed, or a summary that contradicts itself;
 - ``not creep``: another command's run in the same folder (e.g. a UCS test), ignored.
@@ -39,6 +41,8 @@ def outcome(row) -> str:
         return "not creep"
     if row.get("status") != "finished":
         return "unfinished"
+    if row.get("numerical_failure") in (True, 1):
+        return "numerical failure"
     failed = row.get("failed")
     if failed is True or failed == 1:
         if row.get("failed_on_loading") is True:

@@ -118,7 +118,9 @@ def render_report(c: ReportContent) -> str:
              "Every folder holding a run.json is listed. Outcomes: *failed* (lifetime = creep time at failure, "
              "fitted), *failed at load* (failed at creep time 0: no creep life, not in the log fit), "
              "*not failed* (the run ended without failure: its end time is a lower bound of the lifetime, drawn "
-             "as an open marker with an arrow and **not used in the fit**), *unfinished* (no summary.json: "
+             "as an open marker with an arrow and **not used in the fit**), *numerical failure* (the run stopped on NaN or "
+             "infinite numbers or a stalled creep clock, reason in failure_reason: no result, neither a lifetime "
+             "nor a lower bound), *unfinished* (no summary.json: "
              "running, stopped or crashed), *unreadable* (a JSON file that cannot be parsed, or a failed run without a "
              "valid lifetime).", "",
              markdown_table(_runs_for_table(c), RUN_COLUMNS), ""]

@@ -29,10 +29,10 @@ MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
 #: Parameters that do not make a different model (a longer time limit is the same model).
 VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",)
 #: Outcomes of creep runs that belong to a model variant.
-CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "unfinished")
+CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "unfinished")
 #: Columns of runs.csv (those present).
 RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
-             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "failure_reason", "clock", "mode", "n_events",
+             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "mode", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
              "tertiary_start_s", "dem_steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
              "study", "beta1_run", "time_factor", "code_version", "problem")
@@ -115,6 +115,8 @@ def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
         reach = f"; history.csv reaches t = {hist['creep_time_s'].iloc[-1]:.4g} s" if hist is not None and len(hist) \
             else ""
         runs.at[i, "problem"] = "no summary.json (running, stopped or crashed)" + reach
+    for i in runs.index[runs["outcome"] == "numerical failure"]:
+        runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else "numerical failure"
     runs.attrs["filled"] = filled
     return runs
 
@@ -350,6 +352,8 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
                 + (" fitted" if s.fit is not None else ": fit skipped (needs failed runs at 2 or more ratios)"))
         note += f"; {int((g['outcome'] == 'not failed').sum())} run(s) did not fail (lower bounds, drawn, not fitted)"
         note += f"; {n_load} failed at load (t = 0, not in the log fit)" if n_load else ""
+        n_num = int((g["outcome"] == "numerical failure").sum())
+        note += f"; {n_num} numerical failure(s) (no result: not fitted, not a lower bound)" if n_num else ""
         note += f"; {int((g['outcome'] == 'unfinished').sum())} unfinished (not used)."
         content.fit_notes.append(note)
     lab_set = None

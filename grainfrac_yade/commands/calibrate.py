@@ -38,10 +38,11 @@ def register(sub, common):
 
 def cmd_calibrate(args) -> int:
     from ..cli import overrides_from_args
-    from ..params import load_parameters
+    from ..params import load_parameters, require_plane
     from ..runio import prepare_run_dir, write_csv
     base = overrides_from_args(args)
     params = load_parameters(extra_files=args.params, overrides=base)
+    require_plane(params, "calibrate")
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,
                           overwrite=args.overwrite)
     strength, stiffness = params.calibration.strength_scale, params.calibration.stiffness_scale

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +28,9 @@ def register(sub, common):
 
 
 def outcome(summary: dict) -> str:
-    """One phrase: lifetime, failure on loading, or not failed by the end."""
+    """One phrase: numerical failure, lifetime, failure on loading, or not failed by the end."""
+    if summary.get("numerical_failure"):
+        return f"no result ({summary['failure_reason']})"
     if summary.get("failed_on_loading"):
         return "failed on loading (during the ramp)"
     if summary["failed"]:
@@ -69,9 +70,11 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None):
 
 def cmd_creep(args) -> int:
     from ..cli import load_params_from_args
+    from ..params import require_plane
     if args.clock:
         args.overrides.append(f"stress_corrosion.clock={args.clock}")
     params = load_params_from_args(args)
+    require_plane(params, "creep")
     stress, ratio, ref = resolve_stress(params, args.stress, args.ratio, args.ucs)
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
     s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
@@ -83,36 +86,45 @@ def cmd_creep(args) -> int:
 
 def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None,
                         vtk_times=None) -> dict:
+    """Run a creep test into ``out``; summary.json is written last (it marks the run finished).
+
+    A numerical failure (NaN/inf, a stalled clock) gives ``numerical_failure: true``, ``failed:
+    null`` (unknown) and ``lifetime_s: null``, with the reason in ``failure_reason``.
+    """
     import time
 
     from ..creep_analysis import creep_stages, damage_index
     from ..plotting import crack_map
+    from ..params import require_plane
     from ..runio import prepare_run_dir, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..yade_adapter.creep_test import run_creep
-    from ..yade_adapter.scene import bond_segments
+    from ..yade_adapter.scene import bond_segments, broken_counts
     t0 = time.time()
+    require_plane(params, "creep")
     out = prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", history_columns(rows))}
     if vtk_times is not None:
         outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
     run = run_creep(specimen, params, stress, progress=progress, **outputs)
-    rows = run.rows
+    numerical = bool(run.numerical_failure)
+    rows = run.rows or [_row_before_history(run, broken_counts(run.scene))]
     hist = history_columns(rows)
     broken_creep = hist["broken_total"] - run.ramp_broken
     t_end = float(hist["creep_time_s"][-1])
-    lifetime = t_end if run.failed else None
+    lifetime = t_end if run.failed and not numerical else None
     # stages from the history before the collapse row (the failure itself would dominate every rate)
     primary_end, tertiary_start = (creep_stages(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end)
-                                   if run.failed and len(rows) > 3 else (None, None))
+                                   if lifetime is not None and len(rows) > 3 else (None, None))
     hist["broken_creep"] = broken_creep
     hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
-    write_csv(out / "history.csv", hist)
+    if run.rows:
+        write_csv(out / "history.csv", hist)
     write_crack_list(out / "cracks.csv", run)
     summary = {
-        "lifetime_s": lifetime, "failed": run.failed, "failure_reason": run.failure_reason,
-        "failed_on_loading": run.failed_on_loading,
+        "lifetime_s": lifetime, "failed": None if numerical else run.failed, "failure_reason": run.failure_reason,
+        "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
         "clock": params.stress_corrosion.clock, "mode": params.stress_corrosion.mode,
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
@@ -128,7 +140,6 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         t = run.initial_bond_stresses["shear_stress_pa"]
         summary.update(shear_stress_p99_pa=float(np.percentile(t, 99)), shear_stress_max_pa=float(t.max()),
                        shear_utilisation_max=float(np.max(run.initial_bond_stresses["shear_utilisation"])))
-    write_json(out / "summary.json", summary)
     strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
     for frac in MAP_FRACTIONS:
@@ -138,7 +149,15 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                   run.scene.break_mode[idx], macro=run.macro_time[idx] <= t,
                   title=f"{stress / 1e6:.0f} MPa: cracks at t = {t:.4g} s ({frac:.0%} of "
                         f"{'lifetime' if lifetime else 'run'})")
+    write_json(out / "summary.json", summary)   # last: marks the run finished
     return summary
+
+
+def _row_before_history(run, counts) -> dict:
+    """Stand-in history row (creep time 0, no strain) for a run that ended before its first row
+    (a numerical failure during the ramp); never written to history.csv."""
+    return {"creep_time_s": 0.0, "axial_strain": 0.0, "lateral_strain": 0.0, "axial_stress_pa": 0.0, **counts,
+            "macrocracks": 0, "dem_steps": int(run.scene.O.iter), "wall_s": 0.0}
 
 
 def history_columns(rows) -> dict:
@@ -204,7 +223,8 @@ def strain_time_figure(hist, summary, path):
     ax2.set_ylabel("broken bonds since creep start", color="tab:red")
     ax.set_xlabel("creep time [s]")
     ax.set_ylabel("axial strain [%]")
-    state = f"lifetime {summary['lifetime_s']:.4g} s" if summary["failed"] else "not failed"
+    state = ("numerical failure: no result" if summary.get("numerical_failure") else
+             f"lifetime {summary['lifetime_s']:.4g} s" if summary["failed"] else "not failed")
     ax.set_title(f"{summary['stress_pa'] / 1e6:.0f} MPa ({summary['clock']} clock): {state}")
     fig.tight_layout()
     fig.savefig(path, dpi=150)
@@ -221,24 +241,24 @@ def run_creep_in_yade():
     Columns: ``ratio`` (driving-stress ratio) or ``stress`` [Pa], optional ``ucs`` [Pa] that the
     ratio refers to (default: calibration.reference_ucs), ``seed``, ``study``, ``out``, and any
     parameter path.  A row whose folder already holds a summary.json is skipped (a study can be
-    rerun to complete it); an unfinished folder is started again.
+    rerun to complete it) if its stored parameters, seed and load equal the row's, else the row
+    stops with one line (see :mod:`grainfrac_yade.yade_adapter.batch`, column ``on_change``); an
+    unfinished folder is started again.
     """
-    from pathlib import Path
-
-    from ..params import load_parameters
-    from ..yade_adapter.batch import read_table, run_folder_name
-    try:
+    from ..params import load_parameters, require_plane
+    from ..yade_adapter.batch import read_table, row_errors, row_folder, run_folder_name
+    with row_errors():
         overrides, controls = read_table(CREEP_ROW_COLUMNS)
         params = load_parameters(overrides=overrides)
+        require_plane(params, "creep")
         given = {k: (float(controls[k]) or None) for k in CREEP_ROW_COLUMNS}
         stress, ratio, ref = resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
-    except GrainfracError as exc:
-        print(f"error: {exc}")
-        sys.exit(2)
-    name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
-    name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
-    out = Path(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, name_parts + overrides)}")
-    if (out / "summary.json").exists():
+        name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
+        name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
+        name = run_folder_name(controls, name_parts + overrides)
+        out, done = row_folder(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
+                               {"seed": int(controls["seed"]), "stress_pa": stress})
+    if done:
         print(f"creep row already finished, skipped: {out}")
         return
     s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,

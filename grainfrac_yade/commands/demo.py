@@ -49,6 +49,7 @@ def cmd_demo(args) -> int:
     from ..batchrun import run_batch, write_table
     from ..cli import load_params_from_args
     from ..errors import GrainfracError
+    from ..params import require_plane
     from .specimen import run_specimen
     t0 = time.time()
     repo = Path(__file__).resolve().parents[2]
@@ -58,6 +59,7 @@ def cmd_demo(args) -> int:
     geometry = [("specimen.width", args.width), ("specimen.height", args.height)]
     args.overrides = list(args.overrides) + [f"{k}={v}" for k, v in geometry]
     params = load_params_from_args(args)   # validates --params/--set before anything runs
+    require_plane(params, "demo")
     extra = _flat_overrides(args.params, args.overrides)
     _say(t0, f"specimen {args.width * 1e3:.0f} x {args.height * 1e3:.0f} mm, seeds {args.seeds}, "
              f"ratios {args.ratios}, {args.jobs} jobs -> {out}")

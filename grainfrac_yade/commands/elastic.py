@@ -28,11 +28,13 @@ def register(sub, common):
 
 def cmd_elastic(args) -> int:
     from ..cli import load_params_from_args
+    from ..params import require_plane
     if args.nodes_per_face is not None:
         args.overrides.append(f"resolution.nodes_per_face={args.nodes_per_face}")
     if args.grains == "lattice":
         args.overrides.append("resolution.grain_model=deformable")
     params = load_params_from_args(args)
+    require_plane(params, "elastic")
     out = args.out or f"results/elastic_seed{args.seed}"
     summary = run_elastic_to_folder(params, args.seed, out, args.grains, params.resolution.nodes_per_face, args.contacts,
                                     args.rings, args.platens, overwrite=args.overwrite)

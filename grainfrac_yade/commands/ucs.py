@@ -14,7 +14,9 @@ def register(sub, common):
 
 def cmd_ucs(args) -> int:
     from ..cli import load_params_from_args
+    from ..params import require_plane
     params = load_params_from_args(args)
+    require_plane(params, "ucs")
     out = args.out or f"results/ucs_seed{args.seed}"
     summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
     print(f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {summary['young_pa'] / 1e9:.1f} GPa, "
@@ -25,12 +27,15 @@ def cmd_ucs(args) -> int:
 
 
 def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
+    """Run a UCS test into ``out``; summary.json is written last (it marks the run finished)."""
+    from ..params import require_plane
     from ..plotting import crack_map
     from ..runio import prepare_run_dir, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
     from ..yade_adapter.ucs_test import run_ucs
+    require_plane(params, "ucs")
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)
@@ -39,11 +44,11 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
-    write_json(out / "summary.json", summary)
     stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at peak ({summary['ucs_pa'] / 1e6:.0f} MPa), seed {seed}")
+    write_json(out / "summary.json", summary)   # last: marks the run finished
     return summary
 
 
@@ -87,11 +92,18 @@ def stress_strain_figure(history, summary, path):
 
 
 def run_ucs_in_yade():
-    """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults)."""
-    from ..params import load_parameters
-    from ..yade_adapter.batch import read_table, run_folder_name
-    overrides, controls = read_table()
-    params = load_parameters(overrides=overrides)
-    out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
-    s = run_ucs_to_folder(params, int(controls["seed"]), out)
+    """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults); a finished row
+    is skipped or stops as a creep row does (:mod:`grainfrac_yade.yade_adapter.batch`)."""
+    from ..params import load_parameters, require_plane
+    from ..yade_adapter.batch import read_table, row_errors, row_folder, run_folder_name
+    with row_errors():
+        overrides, controls = read_table()
+        params = load_parameters(overrides=overrides)
+        require_plane(params, "ucs")
+        out, done = row_folder(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}",
+                               params, controls, {"seed": int(controls["seed"])})
+    if done:
+        print(f"UCS row already finished, skipped: {out}")
+        return
+    s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists())
     print(f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {s['young_pa'] / 1e9:.1f} GPa -> {out}")

@@ -1,21 +1,34 @@
 """Parameters for scripts run by ``yade`` / ``yade-batch`` (YADE's ``readParamsFromTable``).
 
 Every parameter path (``section.key``, the names of ``--set``) is a possible
-column of a batch table, plus ``seed``, ``out`` and ``study``.  Values are read
-with YADE's own ``readParamsFromTable`` (each cell is a Python expression, so text is
-quoted: ``'deformable'``) and validated like files.
+column of a batch table, plus ``seed``, ``out``, ``study``, ``description`` and
+``on_change``.  Values are read with YADE's own ``readParamsFromTable`` (each cell
+is a Python expression, so text is quoted: ``'deformable'``) and validated like files.
+
+A row whose folder already holds a finished run (summary.json) is skipped only if
+that run's stored parameters (params.json) and run values (seed, load) equal the
+row's; otherwise the row stops with one line naming the folder and the keys that
+differ, or, with ``on_change`` = ``'new_folder'``, runs into ``<folder>_<digest>``
+(:func:`grainfrac_yade.runio.run_digest` of its parameters), skipped in turn once
+finished there.
 """
 from __future__ import annotations
 
 import os
 import re
+import sys
+from contextlib import contextmanager
+from pathlib import Path
 
 from ..errors import GrainfracError
-from ..params import default_files, flatten, read_toml
+from ..params import default_files, flatten, nearest_key, read_toml
+from ..runio import SUMMARY, run_digest, stored_run_differences
 from . import load_yade
 
 #: Table columns that are not model parameters: run controls, with defaults.
-RUN_COLUMNS = {"seed": 1, "out": "", "study": "default", "description": ""}
+RUN_COLUMNS = {"seed": 1, "out": "", "study": "default", "description": "", "on_change": "stop"}
+#: What a row does when its folder holds a finished run with other parameters (column ``on_change``).
+ON_CHANGE = ("stop", "new_folder")
 
 
 def parameter_defaults() -> dict:
@@ -24,6 +37,18 @@ def parameter_defaults() -> dict:
     for path in default_files():
         merged.update(flatten(read_toml(path)))
     return merged
+
+
+def check_columns(columns, valid, where: str) -> None:
+    """GrainfracError naming the first column not in ``valid`` and the valid key it most likely misspells
+    (``where``: the table row, as YADE_BATCH names it)."""
+    for col in columns:
+        if col == "description" or col.startswith("!") or col in valid:
+            continue
+        close = nearest_key(col, valid)
+        hint = f"did you mean {close}?" if close else ("columns are parameter paths (section.key, as in "
+                                                       "params/*.toml) or " + ", ".join(RUN_COLUMNS))
+        raise GrainfracError(f"batch table {where}: unknown column {col!r}; fix: {hint}")
 
 
 def read_table(extra_columns=None) -> tuple:
@@ -35,15 +60,22 @@ def read_table(extra_columns=None) -> tuple:
     from yade import utils
     defaults = parameter_defaults()
     run_defaults = dict(RUN_COLUMNS, **(extra_columns or {}))
+    spec = os.environ.get("YADE_BATCH", "")
+    if spec:
+        table, line = spec.rsplit(":", 1)
+        row = utils.TableParamReader(table).paramDict().get(int(line), {})
+        check_columns(row, {**defaults, **run_defaults}, spec)
     try:
         utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
-    except NameError as exc:   # YADE evaluates every cell as Python: an unknown column, or text without quotes
-        raise GrainfracError(f"batch table row {os.environ.get('YADE_BATCH', '')}: {exc}; fix: columns are "
-                             f"parameter paths (section.key) or {', '.join(run_defaults)}, and text cells are "
-                             "quoted, e.g. 'deformable'") from None
+    except NameError as exc:   # YADE evaluates every cell as Python: text without quotes (columns checked above)
+        raise GrainfracError(f"batch table row {spec}: {exc}; fix: text cells must be quoted, e.g. 'deformable'"
+                             ) from None
     table = yade.params.table
     overrides = [(k, getattr(table, k)) for k, v in defaults.items() if getattr(table, k) != v]
     controls = {k: getattr(table, k) for k in run_defaults}
+    if controls["on_change"] not in ON_CHANGE:
+        raise GrainfracError(f"batch table row {spec}: on_change = {controls['on_change']!r}; fix: use one of "
+                             f"{', '.join(repr(v) for v in ON_CHANGE)}")
     if not controls["description"] and explicit_description_column():
         controls["description"] = yade.O.tags["description"]
     return overrides, controls
@@ -74,3 +106,35 @@ def run_folder_name(controls: dict, overrides) -> str:
     desc = controls.get("description") or "_".join(f"{k.split('.')[-1]}={v}" for k, v in overrides)
     desc = f"{desc}_seed{controls['seed']}" if "seed" not in desc else desc
     return re.sub(r"[^A-Za-z0-9_.=+-]+", "_", desc).strip("_") or f"seed{controls['seed']}"
+
+
+def row_folder(out, params, controls: dict, run_values: dict) -> tuple:
+    """(folder, done): the folder a batch row runs into, and whether it already holds this row's finished run.
+
+    ``run_values``: what besides the parameters makes the run (e.g. seed, stress_pa), compared
+    with the stored summary.json. A finished run that differs: GrainfracError naming the folder
+    and the differing keys, or with ``controls["on_change"] == "new_folder"`` the folder
+    ``<out>_<digest>`` (decided the same way).
+    """
+    out = Path(out)
+    if not (out / SUMMARY).exists():
+        return out, False
+    diffs = stored_run_differences(out, params, run_values)
+    if not diffs:
+        return out, True
+    if controls.get("on_change") == "new_folder":
+        new = out.with_name(f"{out.name}_{run_digest(params, run_values)}")
+        return row_folder(new, params, dict(controls, on_change="stop"), run_values)
+    raise GrainfracError(f"{out}: holds a finished run with other parameters ({'; '.join(diffs)}); fix: give the "
+                         "row another out or study, remove the folder, or add a column on_change with 'new_folder' "
+                         "to run it into a new folder")
+
+
+@contextmanager
+def row_errors():
+    """A GrainfracError inside a batch row becomes one ``error:`` line in its log and exit status 2."""
+    try:
+        yield
+    except GrainfracError as exc:
+        print(f"error: {exc}")
+        sys.exit(2)

@@ -13,6 +13,10 @@ A bond the law says has failed is handed to YADE's JCFpm law with its strength a
 hair (``BREAK_MARGIN``) below its current load, so the law breaks it on the next
 step, in its true mode, and records it (a strength of exactly 0 would never break
 in tension: shared/yade_notes.md).
+
+NaN or infinite bond forces (a DEM that blew up) are refused where they are read
+(:meth:`StressCorrosion.stresses`), and nothing non-finite is ever written to YADE:
+both raise :class:`~grainfrac_yade.errors.NumericalFailure`.
 """
 from __future__ import annotations
 
@@ -50,8 +54,12 @@ class StressCorrosion:
 
     # ------------------------------------------------------------------ reading
     def stresses(self, idx):
-        """sigma (tension positive) and tau [Pa] of bonds ``idx``; per intact area A0 in area mode."""
+        """sigma (tension positive) and tau [Pa] of bonds ``idx``; per intact area A0 in area mode.
+
+        NumericalFailure if a force is NaN or infinite."""
         fn, fs = self.scene.bond_forces(idx)
+        corrosion.check_finite("bond normal force", fn, idx)
+        corrosion.check_finite("bond shear force", fs, idx)
         return fn / self.area0[idx], fs / self.area0[idx]
 
     def intact(self) -> np.ndarray:
@@ -72,6 +80,7 @@ class StressCorrosion:
             cap_t = np.maximum(self.tensile0[idx] * a, MIN_STRENGTH_FRACTION * self.tensile0[idx]) * self.area0[idx]
             cap_c = np.maximum(self.cohesion0[idx] * a, MIN_STRENGTH_FRACTION * self.cohesion0[idx]) * self.area0[idx]
             kn, ks = self.kn0[idx] * np.maximum(a, MIN_STRENGTH_FRACTION), self.ks0[idx] * np.maximum(a, MIN_STRENGTH_FRACTION)
+            _check_written(idx, cap_t, cap_c, kn)
             for n, k in enumerate(idx):
                 ph = inter[k].phys
                 if ph.isCohesive:
@@ -82,6 +91,7 @@ class StressCorrosion:
             return
         ft = np.maximum(self.tensile[idx], MIN_STRENGTH_FRACTION * self.tensile0[idx]) * self.area0[idx]
         fc = np.maximum(self.cohesion[idx], MIN_STRENGTH_FRACTION * self.cohesion0[idx]) * self.area0[idx]
+        _check_written(idx, ft, fc)
         for n, k in enumerate(idx):
             ph = inter[k].phys
             if ph.isCohesive:
@@ -90,6 +100,7 @@ class StressCorrosion:
     def hand_over_failures(self, idx, sigma, tau, modes):
         """Set bonds ``idx`` (at their failure point) a hair below their load so the law breaks them."""
         inter = self.scene.interactions
+        _check_written(idx, sigma, tau)   # Python's max(nan, 0) is nan: refuse before any max() below
         for k, s, t, m in zip(idx, sigma, tau, modes):
             ph = inter[k].phys
             if m == corrosion.MODE_CORRODED:  # nothing left; friction alone carries it: break it ourselves
@@ -129,3 +140,9 @@ class StressCorrosion:
         self.cohesion = np.asarray(state["cohesion_pa"], float)
         self.area_fraction = np.asarray(state["area_fraction"], float)
         self.write(self.intact())
+
+
+def _check_written(idx, *values):
+    """NumericalFailure unless every value meant for YADE's bonds ``idx`` is finite."""
+    for v in values:
+        corrosion.check_finite("value written to a YADE bond", v, idx)

@@ -12,6 +12,11 @@ Failure: the platens cannot hold the load at equilibrium -- no equilibrium at th
 held stress within ``creep.max_relaxation_steps`` DEM steps (the strain runs
 away) -- or the axial strain exceeds ``creep.failure_strain``.  Lifetime is the
 creep time at failure.  Creep time is separate from DEM time.
+
+Numerical failure: NaN or infinite forces, stresses or strains (the DEM blew
+up), or ``MAX_STALLED_INTERVALS`` creep intervals of length 0 in a row that
+break no bond, end the run with ``numerical_failure`` set and the reason in
+``failure_reason``: neither a lifetime nor a survival.
 """
 from __future__ import annotations
 
@@ -22,6 +27,7 @@ import numpy as np
 
 from .. import corrosion
 from ..clocks import EVENT_REL_TOL, EventClock, PaperClock
+from ..errors import NumericalFailure
 from ..params import unbalanced_threshold
 from .corrosion_engine import StressCorrosion
 from .platens import Platens, StressServo
@@ -34,6 +40,9 @@ UDEC_UNIT_THICKNESS = 1.0
 PROGRESS_EVERY = 20
 #: History rows between writes of the partial history (an interrupted run keeps what it measured).
 HISTORY_FLUSH_ROWS = 50
+#: Event clock: creep intervals of length 0 in a row that break no bond (a bond handed over at its
+#: failure point that the contact law does not break) before the run ends as a numerical failure.
+MAX_STALLED_INTERVALS = 10
 
 
 class CreepRun:
@@ -55,10 +64,11 @@ class CreepRun:
         self.platens = Platens(self.scene, params.ucs.platen_lateral)
         self.scene.extras.append(self.platens)
         self.free = np.setdiff1d(np.arange(specimen.n_cells), np.union1d(self.platens.top, self.platens.bottom))
-        self._free_bodies = [self.scene.O.bodies[int(b)] for b in self.scene.bodies_of(self.free)]
+        self._free_ids = [int(b) for b in self.scene.bodies_of(self.free)]
         self.rows, self.ramp_broken = [], 0
         self.failed, self.failure_reason = False, ""
         self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
+        self.numerical_failure = False   # NaN/inf or a stalled clock: no result (failure_reason says why)
         self.corr = None
         self.n_events = 0
         self.initial_bond_stresses = None
@@ -71,7 +81,8 @@ class CreepRun:
         """Largest resultant force on a free body [N], and mean / mean_bond_force (bodies: cells, or the
         spheres of deformable cells)."""
         f = self.scene.O.forces.f
-        res = np.array([f(b.id).norm() for b in self._free_bodies])
+        res = np.array([f(b).norm() for b in self._free_ids])
+        corrosion.check_finite("resultant force", res, self._free_ids, item="body")
         rel = res.mean() / mean_bond_force if mean_bond_force > 0 else math.inf
         return res.max(), rel
 
@@ -79,20 +90,26 @@ class CreepRun:
         idx = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
         sample = idx[:: max(1, len(idx) // 500)]
         fn, fs = self.scene.bond_forces(sample)
+        corrosion.check_finite("bond force", np.hypot(fn, fs), sample)
         return float(np.mean(np.hypot(fn, fs))) if len(sample) else 0.0
 
     def at_equilibrium(self, servo):
         _, rel = self.unbalanced(self.mean_bond_force())
+        _check_value("held axial stress", servo.stress, self.scene.O.iter)
         return rel < self.params.creep.equilibrium_tolerance and \
             abs(servo.stress - self.target) < self.params.creep.stress_tolerance * self.target
 
     def record(self, creep_time, stress=None):
-        self.rows.append({
+        """Append a history row; NumericalFailure (and no row) if a value is NaN or infinite."""
+        row = {
             "creep_time_s": creep_time, "axial_strain": self.platens.axial_strain(),
             "lateral_strain": self.platens.lateral_strain(),
             "axial_stress_pa": self.platens.axial_stress() if stress is None else stress,
             **broken_counts(self.scene), "macrocracks": self.count_macrocracks(creep_time),
-            "dem_steps": int(self.scene.O.iter), "wall_s": time.time() - self.t0})
+            "dem_steps": int(self.scene.O.iter), "wall_s": time.time() - self.t0}
+        for key, value in row.items():
+            _check_value(f"history {key}", value, row["dem_steps"])
+        self.rows.append(row)
 
     def count_macrocracks(self, creep_time):
         """Broken bonds on faces whose every bond is broken and open (cells fully separated).
@@ -126,6 +143,7 @@ class CreepRun:
         while True:
             self.scene.run(steps)
             s = self.platens.axial_stress()
+            _check_value("axial stress during the ramp", s, self.scene.O.iter)
             peak = max(peak, s)
             if s >= self.target:
                 break
@@ -207,6 +225,16 @@ class CreepRun:
             self._vtk_rows = len(self.rows)
 
     def run(self):
+        """Ramp, hold and creep; a NumericalFailure ends the run with ``numerical_failure`` set."""
+        try:
+            return self._run()
+        except NumericalFailure as exc:
+            self.numerical_failure = True
+            self.failure_reason = f"numerical failure: {exc}"
+            self.progress(self.failure_reason)
+            return self
+
+    def _run(self):
         self.ramp()
         self.record(0.0)
         self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp
@@ -239,11 +267,12 @@ def event_clock_loop(holder, corr, clock, sc) -> int:
     ``holder`` relaxes the scene (``relax(creep_time) -> bool``), records rows (``record_now``) and
     reports progress. Returns the number of events (intervals that ended in a failure).
     """
-    n_events = 0
+    n_events = stalled = 0
     if not holder.relax(0.0):
         return n_events
     holder.record_now(0.0)
     while True:
+        broken_before = int(corr.scene.broken.sum())
         idx = corr.intact()
         sigma, tau = corr.stresses(idx)
         jt, jc = corr.law_arrays(idx)
@@ -287,6 +316,11 @@ def event_clock_loop(holder, corr, clock, sc) -> int:
                             f"{int(corr.scene.broken.sum())}  relaxation {holder.last_relaxation_steps} steps")
         if not ok or clock.finished:
             break
+        stalled = stalled + 1 if dt == 0 and int(corr.scene.broken.sum()) == broken_before else 0
+        if stalled >= MAX_STALLED_INTERVALS:
+            raise NumericalFailure(f"{stalled} creep intervals of length 0 in a row broke no bond (creep time "
+                                   f"{clock.creep_time:.6g} s): a bond at its failure point that the contact law "
+                                   "does not break")
     return n_events
 
 
@@ -294,6 +328,10 @@ def event_clock_loop(holder, corr, clock, sc) -> int:
 def paper_clock_loop(holder, corr, clock, sc, cp):
     """Paper clock (Eq. 8): every ``engine_period`` DEM steps advance creep time by the doubled or
     reset step and degrade all intact bonds for it (paper Eq. 7).
+
+    One notion of balance: F_u below the clock's threshold (:meth:`PaperClock.balanced`) both
+    doubles the step and resets the count of DEM steps without balance; more than
+    ``creep.max_relaxation_steps`` such steps in a row is the failure "no equilibrium".
 
     F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
     thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
@@ -313,18 +351,25 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
         corr.degrade_for(dt_b, idx, sigma, tau)
         holder.mark_breaks(clock.creep_time)
         applications += 1
-        balanced = rel < cp.equilibrium_tolerance
-        not_balanced_steps = 0 if balanced else not_balanced_steps + sc.engine_period
+        not_balanced_steps = 0 if clock.balanced(f_u) else not_balanced_steps + sc.engine_period
         if applications % cp.record_period == 0:
             holder.record_now(clock.creep_time)
         if applications % (PROGRESS_EVERY * 100) == 0:
             holder.progress(f"t {clock.creep_time:.4g} s  step {clock.dt:.3g} s  F_u {f_u:.3g}  broken "
                             f"{int(corr.scene.broken.sum())}  applications {applications}")
         if not holder.check_failure() and not_balanced_steps > cp.max_relaxation_steps:
-            holder.failed, holder.failure_reason = True, "no equilibrium at the held load (strain runs away)"
+            holder.failed, holder.failure_reason = True, (
+                f"no equilibrium at the held load (strain runs away): F_u at or above the paper clock's "
+                f"threshold {clock.unbalanced_force_threshold:g} for {not_balanced_steps} DEM steps")
         if holder.failed:
             break
     holder.record_now(clock.creep_time)
+
+
+def _check_value(name, value, dem_step):
+    """NumericalFailure if a measured value is NaN or infinite."""
+    if not math.isfinite(value):
+        raise NumericalFailure(f"{name} is {value} at DEM step {dem_step}")
 
 
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:
