@@ -18,12 +18,12 @@ EVENT_REL_TOL = 1e-12  # bonds whose time to failure is within this relative dis
 MODES = ("strength", "area")  # degradation modes, see grainfrac_yade.corrosion
 
 
-def _number(name, value, fix):
+def _number(name, value, fix, nan_ok=False):
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number (got {value!r}); {fix}") from None
-    if math.isnan(x):
+    if math.isnan(x) and not nan_ok:
         raise ValueError(f"{name} must not be NaN; {fix}")
     return x
 
@@ -120,11 +120,7 @@ class PaperClock:
         unbalanced_force : float
             F_u [N, or relative], >= 0. NaN or inf (the DEM blew up) raises NumericalFailure.
         """
-        try:
-            f = float(unbalanced_force)
-        except (TypeError, ValueError):
-            raise ValueError(f"unbalanced_force must be a number (got {unbalanced_force!r}); "
-                             "pass the DEM's unbalanced force") from None
+        f = _number("unbalanced_force", unbalanced_force, "pass the DEM's unbalanced force", nan_ok=True)
         if not math.isfinite(f):
             raise NumericalFailure(f"unbalanced force is {f} (the DEM blew up)")
         if f < 0:

@@ -487,3 +487,22 @@ def test_yade_bond_never_gets_a_nan_strength():
     with pytest.raises(NumericalFailure, match="^value written to a YADE bond is NaN or infinite at 1 of 1 bond"):
         holder.corr.hand_over_failures([0], [math.nan], [0.0], [corrosion.MODE_SHEAR])
     assert (phys.FnMax, phys.FsMax) == before and all(map(math.isfinite, before))
+
+
+@needs_yade
+@pytest.mark.yade
+@pytest.mark.parametrize("script", ["specimen", "ucs", "creep"])
+def test_every_batch_script_reports_a_misspelt_column_in_one_line(tmp_path, script):
+    import os
+    import shutil
+    from grainfrac_yade.batchrun import write_table
+    table = write_table(tmp_path / "t.table", [{"specimen.widht": 3e-3, "ratio": 0.7, "seed": 1,
+                                                "out": str(tmp_path / "x")}])
+    res = subprocess.run([shutil.which("yade"), "-n", "-x", str(ROOT / "yade_scripts" / f"{script}.py")],
+                         env=dict(os.environ, YADE_BATCH=f"{table}:2", OMP_NUM_THREADS="1"), capture_output=True,
+                         text=True, cwd=ROOT)
+    errors = [line for line in res.stdout.splitlines() if line.startswith("error:")]
+    assert errors == [f"error: batch table {table}:2: unknown column 'specimen.widht'; fix: did you mean "
+                      "specimen.width?"]
+    assert res.returncode == 2 and "Traceback" not in res.stdout + res.stderr
+    assert not (tmp_path / "x").exists()

@@ -52,12 +52,13 @@ def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bo
 def run_specimen_in_yade():
     """Entry of ``yade_scripts/specimen.py``: parameters from the batch table; counts read from YADE."""
     from ..params import load_parameters
-    from ..yade_adapter.batch import read_table, run_folder_name
+    from ..yade_adapter.batch import read_table, row_errors, run_folder_name
     from ..yade_adapter.scene import build_scene
-    overrides, controls = read_table()
-    params = load_parameters(overrides=overrides)
-    out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
-    record = run_specimen(params, int(controls["seed"]), out, overwrite=False)
+    with row_errors():
+        overrides, controls = read_table()
+        params = load_parameters(overrides=overrides)
+        out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
+        record = run_specimen(params, int(controls["seed"]), out, overwrite=False)
     scene = build_scene(build_specimen(params, int(controls["seed"])), params)
     record["n_bonds_yade"] = scene.O.interactions.countReal() - len(scene.links)   # breakable bonds
     record["n_links_yade"] = len(scene.links)   # unbreakable intra-cell links (deformable cells)
