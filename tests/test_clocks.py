@@ -144,10 +144,10 @@ def test_state_of_another_kind_or_version_is_refused():
 
 
 # ------------------------------------------------------------------ EventClock
-def _run_to_first_failure(clock, jt, jc, sigma, tau, tphi, **kw):
+def _run_to_first_failure(clock, jt, jc, sigma, tau, tphi, beta2=B2, **kw):
     while True:
-        dt, failing = clock.next_interval(jt, jc, sigma, tau, tphi, B1, B2, **kw)
-        state = clock.apply(dt, failing, jt, jc, sigma, tau, tphi, B1, B2, **kw)
+        dt, failing = clock.next_interval(jt, jc, sigma, tau, tphi, B1, beta2, **kw)
+        state = clock.apply(dt, failing, jt, jc, sigma, tau, tphi, B1, beta2, **kw)
         clock.advance(dt, failing)
         if kw.get("mode") == "area":
             kw["area_fraction"] = state
@@ -263,3 +263,23 @@ def test_event_clock_refuses_non_finite_stresses(bad):
             clock.apply(1.0, [1], [20e6, 20e6], [52e6, 52e6], [1e6, bad], [0.0, 0.0], TAN55, B1, B2, mode=mode,
                         **extra)
     assert clock.creep_time == 0.0 and clock.n_intervals == 0
+
+
+@pytest.mark.parametrize("mode", ["strength", "area"])
+def test_event_clock_at_beta2_times_stress_of_1e4_has_no_overflow(mode):
+    """beta2 sigma = 1e4 (float warnings are errors here): finite intervals; in strength mode the
+    capped rate RATE_CAP gives the first interval 0.1 J^T / RATE_CAP (loss cap) and the failure at
+    (J^T - sigma) / RATE_CAP of creep time."""
+    beta2 = 1e-3
+    jt, jc, sigma, tau = [2e7, 2e7], [52e6, 52e6], [1e7, 1e3], [0.0, 1e7]   # beta2 sigma = 1e4, beta2 tau = 1e4
+    extra = {"area_fraction": [1.0, 1.0]} if mode == "area" else {}
+    clock = EventClock(0.1)
+    dt, failing = clock.next_interval(jt, jc, sigma, tau, TAN55, B1, beta2, mode=mode, **extra)
+    assert math.isfinite(dt) and dt > 0
+    later = EventClock(0.1)
+    failing, state = _run_to_first_failure(later, jt, jc, sigma, tau, TAN55, mode=mode, beta2=beta2, **extra)
+    assert all(np.all(np.isfinite(x)) for x in np.atleast_2d(state))
+    if mode == "strength":
+        assert dt == pytest.approx(0.1 * 2e7 / c.RATE_CAP, rel=1e-12)
+        assert list(failing) == [0] and c.failed_now(state[0][0], state[1][0], sigma[0], tau[0], TAN55)[0]
+        assert later.creep_time == pytest.approx((2e7 - 1e7) / c.RATE_CAP, rel=1e-9)

@@ -128,6 +128,20 @@ def test_paper_clock_unbalanced_above_its_threshold_fails_after_the_set_steps():
     assert clock.n_steps == 21 and clock.creep_time == pytest.approx(21 * 1e-5, rel=1e-12)
 
 
+def test_paper_clock_loop_with_every_bond_broken_is_a_failure_not_an_infinite_force():
+    """No intact bond: the relative F_u (mean resultant / mean bond force) would be inf, which the clock
+    reads as a blown-up DEM; the loop ends the run as failed instead."""
+    from grainfrac_yade.yade_adapter.creep_test import paper_clock_loop
+    holder = StandInHolder(itertools.repeat(0.0))
+    bonds = StandInBonds([1e6], [5e6], JT, JC)
+    bonds.scene.broken[:] = True
+    clock = PaperClock(1e-5, 1e4, 1e-2)
+    paper_clock_loop(holder, bonds, clock, SimpleNamespace(creep_time_limit=1e5, engine_period=1,
+                                                           unbalanced_force_reference="relative"),
+                     SimpleNamespace(record_period=10**9, max_relaxation_steps=20))
+    assert holder.failed and holder.failure_reason == "every bond broken" and clock.n_steps == 0
+
+
 def test_paper_clock_loop_on_a_nan_unbalanced_force_raises_numerical_failure():
     with pytest.raises(NumericalFailure, match=r"^unbalanced force is nan \(the DEM blew up\)$"):
         _paper_loop(math.nan)

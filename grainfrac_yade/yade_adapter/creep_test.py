@@ -343,8 +343,11 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
     while clock.creep_time < sc.creep_time_limit:
         corr.scene.run(sc.engine_period)
         idx = corr.intact()
+        if not len(idx):   # nothing left to corrode, and no bond force for the relative F_u
+            holder.failed, holder.failure_reason = True, "every bond broken"
+            break
         sigma, tau = corr.stresses(idx)
-        mean_force = float(np.mean(np.hypot(sigma, tau) * corr.area0[idx])) if len(idx) else 0.0
+        mean_force = float(np.mean(np.hypot(sigma, tau) * corr.area0[idx]))
         f_max, rel = holder.unbalanced(mean_force)
         f_u = f_max / scale if sc.unbalanced_force_reference == "absolute" else rel
         dt_b = clock.advance_many([f_u] * sc.engine_period)
