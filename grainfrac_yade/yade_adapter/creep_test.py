@@ -344,7 +344,9 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
         corr.scene.run(sc.engine_period)
         idx = corr.intact()
         if not len(idx):   # nothing left to corrode, and no bond force for the relative F_u
-            holder.failed, holder.failure_reason = True, "every bond broken"
+            holder.mark_breaks(clock.creep_time)
+            if not holder.check_failure():
+                holder.failed, holder.failure_reason = True, "every bond broken"
             break
         sigma, tau = corr.stresses(idx)
         mean_force = float(np.mean(np.hypot(sigma, tau) * corr.area0[idx]))
