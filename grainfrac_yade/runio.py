@@ -143,18 +143,12 @@ def stored_run_differences(folder, params, run_values: dict) -> list:
         return [f"stored run unreadable ({type(exc).__name__}: {exc})"]
     now = comparable_parameters(params.to_dict())
     defaults = comparable_parameters(load_parameters().to_dict())
-    diffs = []
-    for key in sorted(set(stored) | set(now)):
-        old = stored.get(key, defaults.get(key, "(missing)"))
-        new = now.get(key, "(missing)")
-        if not _same(old, new):
-            diffs.append(f"{key}: stored {old!r}, now {new!r}")
-    run_now = flatten(json.loads(json.dumps(_clean(run_values))))
-    for key, new in run_now.items():
-        old = summary.get(key, "(missing)")
-        if not _same(old, new):
-            diffs.append(f"{key}: stored {old!r}, now {new!r}")
-    return diffs
+    missing = "(missing)"
+    pairs = {key: (stored.get(key, defaults.get(key, missing)), now.get(key, missing))
+             for key in sorted(set(stored) | set(now))}
+    pairs.update({key: (summary.get(key, missing), value)
+                  for key, value in flatten(json.loads(json.dumps(_clean(run_values)))).items()})
+    return [f"{key}: stored {old!r}, now {new!r}" for key, (old, new) in pairs.items() if not _same(old, new)]
 
 
 def run_digest(params, run_values: dict) -> str:
