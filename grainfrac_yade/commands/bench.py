@@ -1,0 +1,293 @@
+"""``bench``: what a creep run costs on this machine, every number from one run.
+
+Scenes: the specimen (10 x 20 mm, seed 1; ``--quick`` a smaller one) with rigid cells at 1 and at 8
+spheres per cell and with deformable cells (``params/presets/deformable.toml``), each ramped as a
+creep run ramps it to 0.7 x its own ``calibration.reference_ucs`` (``--ratio``), then held by the
+servo with the stress-corrosion engine in place and relaxed to equilibrium, as in a creep run.
+On each scene, at the held load:
+
+1. DEM steps per second and the engine overhead: the wall time of N DEM steps taken four ways,
+   interleaved in time (their order rotates each repeat) so that each ratio compares neighbouring
+   windows of this shared machine:
+   ``yade_only`` (``O.run(N)`` in YADE's own thread: its engines only, nothing from Python), ``python_stepping``
+   (``O.step()`` N times from Python, no driver), ``drivers`` (:meth:`GrainScene.run`, as a creep run
+   steps: the servo before each step, break bookkeeping after it), ``relaxation_loop`` (as
+   :meth:`CreepRun.relax` steps: ``GrainScene.run`` in chunks of ``creep.check_period`` with the
+   break marking, failure and equilibrium checks between chunks).  Engine overhead = wall(drivers) /
+   wall(yade_only), the median of the per-repeat ratios.
+2. Per-event cost of the event clock over a few events: relaxation DEM steps and wall time per
+   event, the clock's own work between two relaxations (law, bond reads and writes, hand-over,
+   history row), and the time to read the forces of all intact bonds once and to write all their
+   strengths once (:class:`StressCorrosion`), each the median of a few repeats.
+3. Peak memory (``ru_maxrss``, cumulative: scenes run one after the other in one process).
+
+Unless ``--quick``: creep to failure with the event and with the paper clock at 1 sphere per cell,
+same specimen and load, one run each (DEM steps, wall time, lifetime).
+
+No number here is comparable with another run's: the machine is shared and noisy.  Ratios are
+only formed between windows of the same run.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import platform
+import resource
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+#: Where the full bench writes by default.
+DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
+#: The deformable-cells preset.
+DEFORMABLE_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "deformable.toml"
+#: Benchmarked scenes: key, label, extra parameter files, overrides (applied after the user's).
+SCENES = (
+    ("rigid_1", "rigid, 1 sphere/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=1")),
+    ("rigid_8", "rigid, 8 spheres/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=8")),
+    ("deformable", "deformable cells", (DEFORMABLE_PRESET,), ()),
+)
+#: The scene of the clocks-to-failure comparison.
+FAILURE_SCENE = "rigid_1"
+#: Driving-stress ratio of calibration.reference_ucs held in every scene.
+DEFAULT_RATIO = 0.7
+
+
+@dataclass(frozen=True)
+class BenchSettings:
+    """How much of each measurement a bench takes."""
+    width_m: float
+    height_m: float
+    window_s: float       # wall time aimed at per timing window
+    repeats: int          # timing windows per way of stepping (and bond read/write repeats)
+    events: int           # event-clock events timed per scene
+    to_failure: bool      # creep to failure with both clocks (1 sphere per cell)
+
+
+FULL = BenchSettings(width_m=10e-3, height_m=20e-3, window_s=0.5, repeats=15, events=5, to_failure=True)
+#: About a minute on this 2-core machine: a smaller specimen (the deformable scene's ramp and first
+#: relaxation alone take about a minute at 10 x 20 mm; at 6 x 12 mm, seed 1, its ramp takes 170k DEM
+#: steps and the load is not held), short windows, 2 events, no runs to failure.
+QUICK = BenchSettings(width_m=5e-3, height_m=10e-3, window_s=0.2, repeats=5, events=2, to_failure=False)
+
+
+def register(sub, common):
+    p = sub.add_parser("bench", help="benchmark: DEM steps/s, engine overhead, per-event cost, memory, machine "
+                                     "(docs/bench.json and a markdown table)")
+    p.add_argument("--quick", action="store_true",
+                   help=f"about a minute: {QUICK.width_m * 1e3:g} x {QUICK.height_m * 1e3:g} mm, short windows, "
+                        f"{QUICK.events} events per scene, no runs to failure")
+    p.add_argument("--out", help=f"JSON file to write (default {DEFAULT_OUT.relative_to(DEFAULT_OUT.parents[1])}; "
+                                 "with --quick, results/bench_quick.json)")
+    p.add_argument("--seed", type=int, default=1, help="specimen seed (default 1)")
+    p.add_argument("--ratio", type=float, default=DEFAULT_RATIO,
+                   help="creep load as a ratio of each scene's calibration.reference_ucs (default 0.7)")
+    p.add_argument("--params", action="append", default=[], metavar="FILE",
+                   help="TOML file merged over the shipped parameters, under each scene's own settings")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                   help="override one parameter in every scene (a scene's own keys win)")
+    p.set_defaults(func=cmd_bench)
+
+
+def cmd_bench(args) -> int:
+    from ..runio import write_json
+    settings = QUICK if args.quick else FULL
+    out = Path(args.out or ("results/bench_quick.json" if args.quick else DEFAULT_OUT))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    result = run_bench(settings, seed=args.seed, ratio=args.ratio, extra_files=args.params,
+                       overrides=args.overrides, progress=print)
+    write_json(out, result)
+    print(markdown_tables(result))
+    print(f"written: {out}")
+    return 0
+
+
+# ---------------------------------------------------------------------------------------- the run
+def run_bench(settings: BenchSettings, seed=1, ratio=DEFAULT_RATIO, extra_files=(), overrides=(),
+              progress=None) -> dict:
+    """Every measurement of the bench, as the JSON stores it."""
+    from ..errors import GrainfracError
+    from ..runio import code_version
+    progress = progress or (lambda msg: None)
+    if not 0 < ratio < 1:
+        raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")
+    t0 = time.perf_counter()
+    load_start = os.getloadavg()[0]
+    user_overrides = [f"specimen.width={settings.width_m}", f"specimen.height={settings.height_m}", *overrides]
+
+    def params_of(key, *more):
+        _, _, files, own = next(s for s in SCENES if s[0] == key)
+        return scene_params(extra_files, files, user_overrides, [*own, *more])
+
+    result = {
+        "bench": {"quick": settings is QUICK, "settings": asdict(settings), "seed": seed, "load_ratio": ratio,
+                  "load_refers_to": "calibration.reference_ucs of each scene's parameters",
+                  "code_version": code_version(), "argv": list(sys.argv),
+                  "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")},
+        "machine": machine(),
+        "scenes": {},
+    }
+    for key, label, _, _ in SCENES:
+        s = result["scenes"][key] = {"label": label, **bench_scene(params_of(key), seed, ratio, settings)}
+        progress(f"{label}: {s['steps_per_s']:.0f} DEM steps/s, engine overhead {s['engine_overhead']:.3f}, "
+                 f"{_num(s['events'].get('relaxation_steps_median'), '.0f')} relaxation steps per event")
+    if settings.to_failure:
+        result["clocks_to_failure"] = {
+            "scene": FAILURE_SCENE,
+            **clocks_to_failure(lambda clock: params_of(FAILURE_SCENE, f"stress_corrosion.clock={clock}"), seed,
+                                ratio, progress=progress)}
+    result["peak_rss_mb"] = peak_rss_mb()
+    result["bench"]["wall_s"] = time.perf_counter() - t0
+    result["machine"]["load_average_1min"] = f"{load_start:.2f} at the start, {os.getloadavg()[0]:.2f} at the end"
+    return result
+
+
+def scene_params(user_files, scene_files, user_overrides, scene_overrides):
+    """Parameters of one scene: the shipped files, the user's files, the scene's files, then the
+    user's overrides and the scene's own (which win)."""
+    from ..params import load_parameters, require_plane
+    params = load_parameters(extra_files=[*user_files, *scene_files], overrides=[*user_overrides, *scene_overrides])
+    require_plane(params, "bench")
+    return params
+
+
+def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
+    """Ramp, hold and relax one scene as a creep run does; time its stepping, bond I/O and a few events."""
+    from ..errors import GrainfracError
+    from ..specimen import build_specimen
+    from ..yade_adapter.bench_timing import TimedCreepRun, time_bond_io, time_stepping
+    stress = ratio * params.calibration.reference_ucs
+    specimen = build_specimen(params, seed)
+    run = TimedCreepRun(specimen, params, stress, max_events=settings.events,
+                        at_hold=lambda r: {**time_stepping(r, settings.window_s, settings.repeats),
+                                           **time_bond_io(r.corr, settings.repeats)})
+    run.run()
+    if run.measured is None:
+        raise GrainfracError(f"bench: the scene ({params.resolution.grain_model} cells, "
+                             f"{params.resolution.spheres_per_cell} spheres/cell) did not reach the creep phase at "
+                             f"{stress / 1e6:.1f} MPa ({run.failure_reason}); fix: a lower --ratio")
+    sc = run.scene
+    return {
+        "grain_model": params.resolution.grain_model, "spheres_per_cell": params.resolution.spheres_per_cell,
+        "stress_pa": stress, "n_cells": specimen.n_cells, "n_bodies": len(sc.O.bodies),
+        "n_bonds": sc.n_bonds, "n_interactions": len(sc.O.interactions), "dem_timestep_s": sc.O.dt,
+        "ramp_steps": run.rows[0]["dem_steps"], "ramp_wall_s": run.ramp_wall_s,
+        "steps_to_first_equilibrium": run.hold_steps, "equilibrium_at_hold": run.initial_bond_stresses is not None,
+        **run.measured,
+        "events": run.event_costs(),
+        "peak_rss_mb_after": peak_rss_mb(),
+    }
+
+
+def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
+    """Creep to failure with the event and with the paper clock, one run each, same specimen and load.
+
+    ``params_for_clock(clock)`` gives the parameters with ``stress_corrosion.clock`` set."""
+    from ..specimen import build_specimen
+    from ..yade_adapter.bench_timing import TimedCreepRun
+    out = {}
+    for clock in ("event", "paper"):
+        params = params_for_clock(clock)
+        stress = out["stress_pa"] = ratio * params.calibration.reference_ucs
+        t0 = time.perf_counter()
+        run = TimedCreepRun(build_specimen(params, seed), params, stress)
+        run.run()
+        wall = time.perf_counter() - t0
+        first, last = run.rows[0], run.rows[-1]
+        creep_steps, creep_wall = last["dem_steps"] - first["dem_steps"], last["wall_s"] - first["wall_s"]
+        out[clock] = {
+            "failed": bool(run.failed), "numerical_failure": bool(run.numerical_failure),
+            "failure_reason": run.failure_reason or "not failed",
+            ("lifetime_s" if run.failed else "creep_time_end_s"): last["creep_time_s"],
+            "n_events": run.n_events, "dem_steps": int(run.scene.O.iter), "wall_s": wall,
+            "creep_dem_steps": creep_steps, "creep_wall_s": creep_wall, "creep_steps_per_s": creep_steps / creep_wall,
+        }
+        if clock == "event":
+            out[clock]["events"] = run.event_costs()
+        progress(f"to failure, {clock} clock: {run.failure_reason or 'not failed'} at {last['creep_time_s']:.4g} s "
+                 f"creep time, {out[clock]['dem_steps']} DEM steps, {wall:.1f} s")
+    event, paper = out["event"], out["paper"]
+    out["paper_over_event_dem_steps"] = paper["dem_steps"] / event["dem_steps"]
+    out["paper_over_event_wall"] = paper["wall_s"] / event["wall_s"]
+    if event.get("lifetime_s") and paper.get("lifetime_s"):
+        out["paper_over_event_lifetime"] = paper["lifetime_s"] / event["lifetime_s"]
+    return out
+
+
+def peak_rss_mb() -> float:
+    """Peak resident memory of this process so far [MB] (Linux reports kB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def machine() -> dict:
+    import numpy
+    from ..yade_adapter import load_yade
+    yade = load_yade()
+    return {"cpu_model": cpu_model(), "cores": os.cpu_count(), "cores_usable": len(os.sched_getaffinity(0)),
+            "omp_num_threads": os.environ.get("OMP_NUM_THREADS", "unset"), "python": platform.python_version(),
+            "yade": yade.config.version, "numpy": numpy.__version__, "platform": platform.platform()}
+
+
+# ------------------------------------------------------------------------------------------- table
+def markdown_tables(result: dict) -> str:
+    """The bench as markdown: the machine line, one row per scene, and the clocks to failure."""
+    b, m = result["bench"], result["machine"]
+    st = b["settings"]
+    lines = [f"{'Quick bench' if b['quick'] else 'Bench'} ({b['date']}, {b['code_version']}): {m['cpu_model']}, "
+             f"{m['cores']} cores, Python {m['python']}, YADE {m['yade']}, numpy {m['numpy']}, OMP_NUM_THREADS "
+             f"{m['omp_num_threads']}; load average {m['load_average_1min']}. Specimen {st['width_m'] * 1e3:g} x "
+             f"{st['height_m'] * 1e3:g} mm, seed {b['seed']}, held at {b['load_ratio']:g} x calibration.reference_ucs;"
+             f" {st['repeats']} interleaved windows per way of stepping; peak memory {result['peak_rss_mb']:.0f} MB; "
+             f"bench wall time {b['wall_s']:.0f} s.", "",
+             "| scene | bodies / bonds | load [MPa] | DEM step [s] | DEM steps/s, creep run | YADE only | "
+             "engine overhead (range) | O.step() loop alone | with equilibrium checks | relaxation steps/event, "
+             "median (events) | clock work/event [ms] | read all bonds [ms] | write all strengths [ms] |",
+             "|" + "---|" * 13]
+    for s in result["scenes"].values():
+        ev = s["events"]
+        lo, hi = s["engine_overhead_range"]
+        lines.append(
+            f"| {s['label']} | {s['n_bodies']} / {s['n_bonds']} | {s['stress_pa'] / 1e6:.1f} | "
+            f"{s['dem_timestep_s']:.3g} | {s['steps_per_s']:.0f} | {s['steps_per_s_yade_only']:.0f} | "
+            f"{s['engine_overhead']:.3f} ({lo:.2f}-{hi:.2f}) | {s['python_stepping_overhead']:.3f} | "
+            f"{s['relaxation_loop_overhead']:.3f} | {_num(ev.get('relaxation_steps_median'), '.0f')} "
+            f"({ev['n_events_timed']}) | {_num(_ms(ev.get('clock_work_s_median')), '.2f')} | "
+            f"{s['read_all_bonds_s'] * 1e3:.2f} | {s['write_all_strengths_s'] * 1e3:.2f} |")
+    c = result.get("clocks_to_failure")
+    if c:
+        lines += ["", f"Creep to failure, {result['scenes'][c['scene']]['label']}, {c['stress_pa'] / 1e6:.1f} MPa, "
+                      "one run per clock:", "",
+                  "| clock | lifetime [s] | events | DEM steps | wall [s] | creep-phase DEM steps/s | "
+                  "relaxation steps/event, median (max) | final wait [steps] |", "|" + "---|" * 8]
+        for clock in ("event", "paper"):
+            r = c[clock]
+            ev = r.get("events", {})
+            life = f"{r['lifetime_s']:.4g}" if r["failed"] else f"not failed by {r['creep_time_end_s']:.4g}"
+            relax = (f"{ev['relaxation_steps_median']:.0f} ({ev['relaxation_steps_max']:.0f})"
+                     if "relaxation_steps_median" in ev else "-")
+            lines.append(f"| {clock} | {life} | {r['n_events']} | {r['dem_steps']} | {r['wall_s']:.1f} | "
+                         f"{r['creep_steps_per_s']:.0f} | {relax} | {_num(ev.get('final_relaxation_steps'), 'd')} |")
+        ratios = f"paper / event: DEM steps x{c['paper_over_event_dem_steps']:.2f}, wall x{c['paper_over_event_wall']:.2f}"
+        if "paper_over_event_lifetime" in c:
+            ratios += f", lifetime x{c['paper_over_event_lifetime']:.3f}"
+        lines += ["", ratios + "."]
+    return "\n".join(lines)
+
+
+def _ms(seconds):
+    return None if seconds is None else seconds * 1e3
+
+
+def _num(value, fmt: str) -> str:
+    return "-" if value is None else format(value, fmt)

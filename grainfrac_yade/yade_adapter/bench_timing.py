@@ -1,0 +1,147 @@
+"""Timing of creep scenes for the ``bench`` command: a creep run that times itself, and the
+ways of taking DEM steps and of reading and writing bonds that a creep run uses."""
+from __future__ import annotations
+
+import statistics
+import time
+
+from .. import corrosion
+from .creep_test import CreepRun
+
+#: DEM steps of the probe that sizes the timing windows.
+PROBE_STEPS = 200
+#: Ways of taking N DEM steps (see :func:`time_stepping`); engine overhead is "drivers" over "yade_only".
+STEPPING_WAYS = ("yade_only", "python_stepping", "drivers", "relaxation_loop")
+#: Polling interval [s] while YADE steps in its own thread: ``O.run(n, True)`` waits in quanta of
+#: 40 ms (measured: 100 and 1000 DEM steps of a small scene both took 40.2 ms, 5000 took 201 ms),
+#: too coarse for timing windows of 0.1-0.5 s.
+POLL_S = 1e-3
+
+
+class TimedCreepRun(CreepRun):
+    """A creep run that times its ramp and relaxations, measures the held scene (``at_hold``) before the
+    event clock's first interval, and stops after ``max_events`` event-clock intervals (None: runs to
+    the end, as a creep run)."""
+
+    def __init__(self, specimen, params, target_stress, max_events=None, at_hold=None, progress=None):
+        super().__init__(specimen, params, target_stress, progress=progress)
+        self.max_events, self.at_hold = max_events, at_hold
+        self.measured = None
+        self.ramp_wall_s = self.hold_steps = None
+        self.relaxations = []   # (DEM steps, wall s, reached equilibrium) after each event-clock interval
+        self.clock_work = []    # wall s from the end of one relaxation to the start of the next (event clock)
+        self._loop_calls = None  # relaxations inside the event-clock loop so far (None: not in it)
+        self._last_end = None
+
+    def ramp(self):
+        t = time.perf_counter()
+        super().ramp()
+        self.ramp_wall_s = time.perf_counter() - t
+
+    def run_event_clock(self):
+        if self.at_hold is not None:
+            self.measured = self.at_hold(self)
+        self._loop_calls = 0
+        super().run_event_clock()
+
+    def relax(self, creep_time):
+        start = time.perf_counter()
+        ok = super().relax(creep_time)
+        end = time.perf_counter()
+        if self.hold_steps is None:
+            self.hold_steps = self.last_relaxation_steps
+        if self._loop_calls is None:
+            return ok
+        if self._loop_calls:   # the loop's first relaxation precedes its first interval
+            self.clock_work.append(start - self._last_end)
+            self.relaxations.append((self.last_relaxation_steps, end - start, ok))
+        self._loop_calls += 1
+        self._last_end = end
+        if self.max_events is not None and len(self.relaxations) >= self.max_events:
+            return False   # enough events timed (not a failure: ``failed`` stays as it is)
+        return ok
+
+    def event_costs(self) -> dict:
+        """Relaxation DEM steps and wall time per event-clock interval that reached equilibrium, the
+        clock's own work per interval, and the final wait of a run that failed."""
+        done = [(steps, wall) for steps, wall, ok in self.relaxations if ok]
+        out = {"n_events_timed": len(done)}
+        if done:
+            steps = [s for s, _ in done]
+            out.update(relaxation_steps_median=statistics.median(steps), relaxation_steps_mean=statistics.mean(steps),
+                       relaxation_steps_max=max(steps),
+                       relaxation_wall_s_median=statistics.median(w for _, w in done),
+                       clock_work_s_median=statistics.median(self.clock_work))
+        failing = [steps for steps, _, ok in self.relaxations if not ok]
+        if failing:
+            out["final_relaxation_steps"] = failing[-1]
+        return out
+
+
+def time_stepping(run, window_s: float, repeats: int) -> dict:
+    """DEM steps per second of the held scene taken four ways (:data:`STEPPING_WAYS`), interleaved;
+    the overheads are medians of per-repeat ratios to ``yade_only``."""
+    scene, O = run.scene, run.scene.O
+    period = run.params.creep.check_period
+    t = time.perf_counter()
+    scene.run(PROBE_STEPS)
+    probe = time.perf_counter() - t
+    n = max(1, round(window_s / probe * PROBE_STEPS / period)) * period
+
+    def python_stepping():
+        for _ in range(n):
+            O.step()
+
+    def relaxation_loop():   # as CreepRun.relax steps, without stopping at equilibrium
+        for _ in range(n // period):
+            scene.run(period)
+            run.mark_breaks(0.0)
+            run.check_failure()
+            run.at_equilibrium(run.servo)
+
+    def yade_only():
+        O.run(n)
+        while O.running:
+            time.sleep(POLL_S)
+
+    ways = {"yade_only": yade_only, "python_stepping": python_stepping,
+            "drivers": lambda: scene.run(n), "relaxation_loop": relaxation_loop}
+    walls = {way: [] for way in STEPPING_WAYS}
+    for r in range(repeats):
+        k = r % len(STEPPING_WAYS)
+        for way in STEPPING_WAYS[k:] + STEPPING_WAYS[:k]:
+            t = time.perf_counter()
+            ways[way]()
+            walls[way].append(time.perf_counter() - t)
+    out = {"timing_window_steps": n, "timing_repeats": repeats}
+    for way in STEPPING_WAYS:
+        out[f"steps_per_s_{way}"] = n / statistics.median(walls[way])
+    out["steps_per_s"] = out["steps_per_s_drivers"]
+    for way, name in (("drivers", "engine_overhead"), ("python_stepping", "python_stepping_overhead"),
+                      ("relaxation_loop", "relaxation_loop_overhead")):
+        ratios = [a / b for a, b in zip(walls[way], walls["yade_only"])]
+        out[name] = statistics.median(ratios)
+        out[f"{name}_range"] = [min(ratios), max(ratios)]
+    return out
+
+
+def time_bond_io(corr, repeats: int) -> dict:
+    """Wall time to read the forces of all intact bonds once, to write all their strengths once, and to
+    evaluate the law's time to failure for all of them (medians of ``repeats``)."""
+    idx = corr.intact()
+    read, write, law = [], [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        sigma, tau = corr.stresses(idx)
+        t1 = time.perf_counter()
+        corr.write(idx)   # the current strengths: writing them changes nothing
+        t2 = time.perf_counter()
+        jt, jc = corr.law_arrays(idx)
+        corrosion.time_to_failure(jt, jc, sigma, tau, corr.tan_phi[idx], corr.p.beta1, corr.p.beta2)
+        law.append(time.perf_counter() - t2)
+        read.append(t1 - t0)
+        write.append(t2 - t1)
+    n = len(idx)
+    return {"n_intact_bonds": n, "read_all_bonds_s": statistics.median(read),
+            "write_all_strengths_s": statistics.median(write), "time_to_failure_all_bonds_s": statistics.median(law),
+            "read_per_bond_s": statistics.median(read) / n, "write_per_bond_s": statistics.median(write) / n}

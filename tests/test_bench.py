@@ -1,0 +1,75 @@
+"""The quick benchmark: one run writes the JSON with every key, every number finite and positive.
+
+No timing thresholds: the machine is shared, and the bench's ratios are only meaningful within a run.
+"""
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT, needs_yade
+
+pytestmark = [needs_yade, pytest.mark.yade]
+
+SCENE_KEYS = {"label", "grain_model", "spheres_per_cell", "stress_pa", "n_cells", "n_bodies", "n_bonds",
+              "n_interactions", "dem_timestep_s", "ramp_steps", "ramp_wall_s", "steps_to_first_equilibrium",
+              "equilibrium_at_hold", "timing_window_steps", "timing_repeats", "steps_per_s",
+              "steps_per_s_yade_only", "steps_per_s_python_stepping", "steps_per_s_drivers",
+              "steps_per_s_relaxation_loop", "engine_overhead", "engine_overhead_range", "python_stepping_overhead",
+              "python_stepping_overhead_range", "relaxation_loop_overhead", "relaxation_loop_overhead_range",
+              "n_intact_bonds", "read_all_bonds_s", "write_all_strengths_s", "time_to_failure_all_bonds_s",
+              "read_per_bond_s", "write_per_bond_s", "events", "peak_rss_mb_after"}
+EVENT_KEYS = {"n_events_timed", "relaxation_steps_median", "relaxation_steps_mean", "relaxation_steps_max",
+              "relaxation_wall_s_median", "clock_work_s_median"}
+MACHINE_KEYS = {"cpu_model", "cores", "cores_usable", "omp_num_threads", "python", "yade", "numpy", "platform",
+                "load_average_1min"}
+
+
+def numbers(tree, path="") -> list:
+    """(path, value) of every leaf that is not text or a yes/no flag (None included: a NaN written as null)."""
+    if isinstance(tree, dict):
+        return [pair for key, value in tree.items() for pair in numbers(value, f"{path}.{key}")]
+    if isinstance(tree, list):
+        return [pair for n, value in enumerate(tree) for pair in numbers(value, f"{path}[{n}]")]
+    return [] if isinstance(tree, (str, bool)) else [(path, tree)]
+
+
+@pytest.fixture(scope="module")
+def quick_bench(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bench") / "bench.json"
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "bench", "--quick", "--out", str(out)],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert res.returncode == 0, res.stderr
+    return json.loads(out.read_text()), res.stdout
+
+
+def test_quick_bench_writes_every_key(quick_bench):
+    data, _ = quick_bench
+    assert set(data) == {"bench", "machine", "scenes", "peak_rss_mb"}   # no runs to failure in --quick
+    assert data["bench"]["quick"] is True
+    assert MACHINE_KEYS <= set(data["machine"])
+    assert set(data["scenes"]) == {"rigid_1", "rigid_8", "deformable"}
+    for key, scene in data["scenes"].items():
+        assert SCENE_KEYS <= set(scene), key
+        assert EVENT_KEYS <= set(scene["events"]), key
+        assert scene["equilibrium_at_hold"] is True, key
+    assert [s["spheres_per_cell"] for s in data["scenes"].values()][:2] == [1, 8]
+    assert data["scenes"]["deformable"]["grain_model"] == "deformable"
+
+
+def test_quick_bench_numbers_are_finite_and_positive(quick_bench):
+    data, _ = quick_bench
+    found = numbers(data)
+    assert len(found) > 100
+    bad = [(path, value) for path, value in found
+           if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0]
+    assert not bad
+
+
+def test_quick_bench_prints_its_table(quick_bench):
+    data, stdout = quick_bench
+    for scene in data["scenes"].values():
+        assert f"| {scene['label']} |" in stdout
+    assert "engine overhead" in stdout
