@@ -478,14 +478,21 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
 
 
 def _check_grain_size(sp: SpecimenParams, origins: Mapping):
-    """A grain must be smaller than the specimen's width and height: at or above, the specimen is a few
-    cells at most (a lone cell has no face to bond). The 3D box depth may be thinner (one layer)."""
+    """A grain must be smaller than the specimen's width and height (at or above, the specimen is a few
+    cells at most) and leave at least two cells (a lone cell has no face to bond). The 3D box depth may
+    be thinner (one layer)."""
     name, side = min([("width", sp.width), ("height", sp.height)], key=lambda s: s[1])
     if sp.grain_size >= side:
         raise ParameterError(origins.get("specimen.grain_size", "parameters"), "specimen.grain_size",
                              f"{sp.grain_size:g} m is at or above the specimen's {name} ({side:g} m)",
                              f"make specimen.grain_size smaller than specimen.{name} (paper: 1 mm in a 31.7 mm "
                              f"wide specimen) or enlarge the specimen")
+    from .tessellation import n_cells_for
+    box = [sp.width, sp.height] + ([sp.thickness] if sp.dimension == 3 else [])
+    if n_cells_for(box, sp.grain_size) < 2:
+        raise ParameterError(origins.get("specimen.grain_size", "parameters"), "specimen.grain_size",
+                             f"{sp.grain_size:g} m gives a specimen of one cell (a lone cell has no face to bond)",
+                             "make specimen.grain_size smaller or enlarge the specimen")
 
 
 def require_plane(params: Parameters, command: str):
