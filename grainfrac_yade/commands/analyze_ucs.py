@@ -16,6 +16,8 @@ def register(sub, common):
 
 
 def cmd_analyze_ucs(args) -> int:
+    import pandas as pd
+
     from ..analysis import collect_runs, group_stats
     from ..analysis.study import fill_missing_params
     from ..errors import GrainfracError
@@ -40,6 +42,11 @@ def cmd_analyze_ucs(args) -> int:
             f"| {r['crack_initiation_pa_mean'] / r['ucs_pa_mean']:.2f} "
             f"| {r['crack_damage_pa_mean'] / r['ucs_pa_mean']:.2f} "
             f"| {r['dem_steps_mean']:.0f} | {r['wall_s_mean']:.1f} |")
+    failed = runs[runs.get("numerical_failure", pd.Series(False, index=runs.index)).eq(True)]
+    if len(failed):   # no UCS (null): left out of n and of every mean
+        lines.append("")
+        lines += [f"numerical failure (no result, not counted): {r['run']}: {r['end_reason']}"
+                  for _, r in failed.iterrows()]
     (folder / "ucs_stats.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0

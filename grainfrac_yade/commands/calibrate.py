@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import GrainfracError
+
 #: UCS target [Pa]: the paper's simulated UCS, section 3.1 (shared/reference/paper_values.csv).
 TARGET_UCS = 234.5e6
 #: Young's modulus target [Pa]: LdB lab value 69 +- 5.8 GPa (shared/reference/ldb_lab_properties.csv).
@@ -52,6 +54,9 @@ def cmd_calibrate(args) -> int:
             ("calibration.strength_scale", strength), ("calibration.stiffness_scale", stiffness)])
         folders = [out / f"round{rnd}_seed{seed}" for seed in args.seeds]
         for seed, s in zip(args.seeds, _run_seeds(p, args.seeds, folders, args.jobs)):
+            if s["numerical_failure"]:
+                raise GrainfracError(f"calibration round {rnd} seed {seed}: no UCS ({s['end_reason']}); fix: lower "
+                                     "numerics.timestep_safety or check the specimen and parameters")
             rows.append({"round": rnd, "seed": seed, "strength_scale": strength, "stiffness_scale": stiffness,
                          "ucs_pa": s["ucs_pa"], "young_pa": s["young_pa"], "poisson": s["poisson"],
                          "crack_initiation_pa": s["crack_initiation_pa"], "crack_damage_pa": s["crack_damage_pa"],

@@ -124,6 +124,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     write_crack_list(out / "cracks.csv", run)
     summary = {
         "lifetime_s": lifetime, "failed": None if numerical else run.failed, "failure_reason": run.failure_reason,
+        "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
         "clock": params.stress_corrosion.clock, "mode": params.stress_corrosion.mode,
@@ -151,6 +152,19 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                         f"{'lifetime' if lifetime else 'run'})")
     write_json(out / "summary.json", summary)   # last: marks the run finished
     return summary
+
+
+def end_reason(run, params, t_end) -> str:
+    """Why the run ended: its failure or numerical failure, else why it stopped without failing."""
+    sc = params.stress_corrosion
+    if run.failed or run.numerical_failure:
+        return run.failure_reason
+    if not sc.enabled:
+        return "load held without stress corrosion (stress_corrosion.enabled = false): not failed"
+    if t_end >= sc.creep_time_limit:
+        return (f"creep time reached stress_corrosion.creep_time_limit = {sc.creep_time_limit:g} s: not failed, "
+                "the lifetime is a lower bound")
+    return "no intact bond can fail under the held stresses (Eq. 7 gives an infinite time): not failed"
 
 
 def _row_before_history(run, counts) -> dict:

@@ -70,8 +70,9 @@ def cmd_demo(args) -> int:
     table = write_table(out / "ucs.table", ucs_rows, "UCS rows of the demo")
     run_batch(table, repo / "yade_scripts" / "ucs.py", args.jobs, out / "logs_ucs",
               watch=[r["out"] for r in ucs_rows], repo=repo,
-              progress=lambda w: _say(t0, f"UCS {w.name}: {_read(w)['ucs_pa'] / 1e6:.1f} MPa"))
+              progress=lambda w: _say(t0, f"UCS {w.name}: {_ucs_line(_read(w))}"))
     ucs = [_read(Path(r["out"]))["ucs_pa"] for r in ucs_rows if (Path(r["out"]) / "summary.json").exists()]
+    ucs = [u for u in ucs if u is not None]   # a numerical failure has no UCS
     if not ucs:
         raise GrainfracError(f"no UCS run finished; see the logs in {out / 'logs_ucs'}")
     ucs_mean = sum(ucs) / len(ucs)
@@ -106,6 +107,12 @@ def _flat_overrides(files, overrides) -> dict:
 
 def _read(folder: Path) -> dict:
     return json.loads((folder / "summary.json").read_text())
+
+
+def _ucs_line(summary: dict) -> str:
+    if summary.get("ucs_pa") is None:
+        return f"no result ({summary.get('end_reason', 'no UCS')})"
+    return f"{summary['ucs_pa'] / 1e6:.1f} MPa"
 
 
 def _creep_line(folder: Path) -> str:

@@ -19,11 +19,24 @@ def cmd_ucs(args) -> int:
     require_plane(params, "ucs")
     out = args.out or f"results/ucs_seed{args.seed}"
     summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
-    print(f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {summary['young_pa'] / 1e9:.1f} GPa, "
-          f"nu {summary['poisson']:.3f}, CI {summary['crack_initiation_pa'] / 1e6:.1f} MPa, "
-          f"CD {summary['crack_damage_pa'] / 1e6:.1f} MPa, broken {summary['broken_total']} of {summary['n_bonds']} "
-          f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s) -> {out}")
+    if summary["numerical_failure"]:
+        print(f"UCS: no result ({summary['end_reason']}) -> {out}")
+        return 0
+    print(f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
+          f"nu {_fmt(summary['poisson'], 1, 3)}, CI {_fmt(summary['crack_initiation_pa'])} MPa, "
+          f"CD {_fmt(summary['crack_damage_pa'])} MPa, broken {summary['broken_total']} of {summary['n_bonds']} "
+          f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
     return 0
+
+
+def _fmt(value, unit=1e6, digits=1) -> str:
+    """``value / unit`` with ``digits`` decimals (MPa by default); "-" if not measured (None or NaN)."""
+    return "-" if value is None or not np.isfinite(value) else f"{value / unit:.{digits}f}"
+
+
+#: summary.json keys measured from the stress-strain curve: null when a numerical failure ended the run.
+MEASURES = ("ucs_pa", "peak_axial_strain", "young_pa", "young_method", "poisson", "crack_initiation_pa",
+            "crack_damage_pa")
 
 
 def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
@@ -39,15 +52,18 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)
-    summary = ucs_summary(history)
+    # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
+    summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else ucs_summary(history)
     summary.update(result)
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
     stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
+    at = "the largest stress before the numerical failure" if result["numerical_failure"] else \
+        f"peak ({summary['ucs_pa'] / 1e6:.0f} MPa)"
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
-              title=f"cracks at peak ({summary['ucs_pa'] / 1e6:.0f} MPa), seed {seed}")
+              title=f"cracks at {at}, seed {seed}")
     write_json(out / "summary.json", summary)   # last: marks the run finished
     return summary
 
@@ -78,13 +94,14 @@ def stress_strain_figure(history, summary, path):
     ax.plot(el, s, label="lateral strain")
     ax.plot(ea + el, s, "--", lw=0.8, label="volumetric strain (plane)")
     for key, label in (("crack_initiation_pa", "CI"), ("crack_damage_pa", "CD")):
-        if np.isfinite(summary.get(key, np.nan)):
+        if summary.get(key) is not None and np.isfinite(summary[key]):
             ax.axhline(summary[key] / 1e6, color="grey", lw=0.6, ls=":")
             ax.text(ax.get_xlim()[0], summary[key] / 1e6, f" {label}", va="bottom", fontsize=7)
     ax.set_xlabel("strain [%] (compression positive)")
     ax.set_ylabel("axial stress [MPa]")
-    ax.set_title(f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {summary['young_pa'] / 1e9:.1f} GPa, "
-                 f"nu {summary['poisson']:.2f}")
+    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
+                 f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
+                 f"nu {_fmt(summary['poisson'], 1, 2)}")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=150)
@@ -106,4 +123,5 @@ def run_ucs_in_yade():
         print(f"UCS row already finished, skipped: {out}")
         return
     s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists())
-    print(f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {s['young_pa'] / 1e9:.1f} GPa -> {out}")
+    print(f"UCS: no result ({s['end_reason']}) -> {out}" if s["numerical_failure"] else
+          f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(s['young_pa'], 1e9)} GPa -> {out}")

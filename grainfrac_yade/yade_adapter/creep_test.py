@@ -31,7 +31,7 @@ from ..errors import NumericalFailure
 from ..params import unbalanced_threshold
 from .corrosion_engine import StressCorrosion
 from .platens import Platens, StressServo
-from .scene import broken_counts, build_scene
+from .scene import broken_counts, build_scene, check_value
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
 #: is per metre of thickness; it is scaled by the layer thickness here.
@@ -103,7 +103,7 @@ class CreepRun:
 
     def at_equilibrium(self, servo):
         _, rel = self.unbalanced(self.mean_bond_force())
-        _check_value("held axial stress", servo.stress, self.scene.O.iter)
+        check_value("held axial stress", servo.stress, self.scene.O.iter)
         return rel < self.params.creep.equilibrium_tolerance and \
             abs(servo.stress - self.target) < self.params.creep.stress_tolerance * self.target
 
@@ -116,7 +116,7 @@ class CreepRun:
             **broken_counts(self.scene), "macrocracks": self.count_macrocracks(creep_time),
             "dem_steps": int(self.scene.O.iter), "wall_s": time.time() - self.t0}
         for key, value in row.items():
-            _check_value(f"history {key}", value, row["dem_steps"])
+            check_value(f"history {key}", value, row["dem_steps"])
         self.rows.append(row)
 
     def count_macrocracks(self, creep_time):
@@ -151,7 +151,7 @@ class CreepRun:
         while True:
             self.scene.run(steps)
             s = self.platens.axial_stress()
-            _check_value("axial stress during the ramp", s, self.scene.O.iter)
+            check_value("axial stress during the ramp", s, self.scene.O.iter)
             peak = max(peak, s)
             if s >= self.target:
                 break
@@ -378,12 +378,6 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
         if holder.failed:
             break
     holder.record_now(clock.creep_time)
-
-
-def _check_value(name, value, dem_step):
-    """NumericalFailure if a measured value is NaN or infinite."""
-    if not math.isfinite(value):
-        raise NumericalFailure(f"{name} is {value} at DEM step {dem_step}")
 
 
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import GrainfracError
+from ..errors import GrainfracError, NumericalFailure
 from ..layout import BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for
 from ..params import Parameters
 from ..specimen import Specimen
@@ -96,6 +96,9 @@ class GrainScene:
     break_mode: np.ndarray = None
     break_step: np.ndarray = None
     tan_residual: np.ndarray = None
+    #: conservative critical DEM step of the scene [s] (:func:`critical_timestep`); :meth:`run` refuses
+    #: to step with a larger ``O.dt`` (an unstable step blows up or, before it does, gives nonsense)
+    dt_critical: float = math.inf
     _cracks_seen: int = 0
 
     def __post_init__(self):
@@ -139,8 +142,14 @@ class GrainScene:
 
     # ------------------------------------------------------------------ stepping
     def run(self, n_steps: int):
-        """Advance ``n_steps`` DEM steps; drivers act before each step, breaks are synced after."""
+        """Advance ``n_steps`` DEM steps; drivers act before each step, breaks are synced after.
+
+        NumericalFailure, before any step, if ``O.dt`` is not within (0, ``dt_critical``].
+        """
         O = self.O
+        if not 0 < O.dt <= self.dt_critical:
+            raise NumericalFailure(f"DEM step {O.dt:.4g} s is not within (0, {self.dt_critical:.4g} s], the critical "
+                                   "step of this scene (numerics.timestep_safety <= 1 keeps it there)")
         law = self.law
         drivers = self.drivers
         for _ in range(n_steps):
@@ -228,6 +237,12 @@ class GrainScene:
         """(n, 3) resultant interaction force on each cell (summed over its bodies) from the last step [N]."""
         f = self.O.forces.f
         return np.array([np.sum([tuple(f(int(b))) for b in self.bodies_of([c])], axis=0) for c in cells])
+
+
+def check_value(name, value, dem_step):
+    """NumericalFailure if a measured value is NaN or infinite."""
+    if not math.isfinite(value):
+        raise NumericalFailure(f"{name} is {value} at DEM step {dem_step}")
 
 
 def broken_counts(scene) -> dict:
@@ -469,7 +484,10 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
     links = _create_links(utils, specimen, layout, params, sphere_body)
     dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating="Z" not in blocked,
                                 ratcheting_guard=geometry.avoidGranularRatcheting)
+    if not 0 < dt_crit < math.inf:
+        raise GrainfracError(f"the scene's critical DEM step is {dt_crit:g} s (a cell without mass, or no bond "
+                             "at all); fix: check the specimen's cells and faces")
     O.dt = params.numerics.timestep_safety * dt_crit
     return GrainScene(specimen=specimen, layout=layout, props=props, params=params, O=O,
                       cell_body=cell_body, cell_bodies=cell_bodies, sphere_body=sphere_body,
-                      interactions=interactions, law=law, newton=newton, links=links)
+                      interactions=interactions, law=law, newton=newton, links=links, dt_critical=dt_crit)
