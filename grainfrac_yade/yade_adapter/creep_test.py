@@ -349,13 +349,18 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
     scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
     holder.record_now(0.0)
     applications, not_balanced_steps = 0, 0
-    while clock.creep_time < sc.creep_time_limit:
+    while True:
         corr.scene.run(sc.engine_period)
+        # a bond breaks in these DEM steps because the last creep step took it past its failure point
+        # (or its neighbours' did): it broke at the creep time that step reached, not at the next one;
+        # the steps run after the last creep step too, so no bond ends the run past its failure point
+        holder.mark_breaks(clock.creep_time)
         idx = corr.intact()
         if not len(idx):   # nothing left to corrode, and no bond force for the relative F_u
-            holder.mark_breaks(clock.creep_time)
             if not holder.check_failure():
                 holder.failed, holder.failure_reason = True, "every bond broken"
+            break
+        if clock.creep_time >= sc.creep_time_limit:
             break
         sigma, tau = corr.stresses(idx)
         mean_force = float(np.mean(np.hypot(sigma, tau) * corr.area0[idx]))
@@ -363,7 +368,6 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
         f_u = f_max / scale if sc.unbalanced_force_reference == "absolute" else rel
         dt_b = clock.advance_many([f_u] * sc.engine_period)
         corr.degrade_for(dt_b, idx, sigma, tau)
-        holder.mark_breaks(clock.creep_time)
         applications += 1
         not_balanced_steps = 0 if clock.balanced(f_u) else not_balanced_steps + sc.engine_period
         if applications % cp.record_period == 0:
