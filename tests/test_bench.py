@@ -1,4 +1,5 @@
-"""The quick benchmark: one run writes the JSON with every key, every number finite and positive.
+"""The benchmark: the quick one (a YADE run) writes the JSON with every key, every number finite and
+positive; the stored full one (docs/bench.json) has the runs to failure too and renders as tables.
 
 No timing thresholds: the machine is shared, and the bench's ratios are only meaningful within a run.
 """
@@ -10,15 +11,15 @@ import sys
 import pytest
 
 from conftest import ROOT, needs_yade
-
-pytestmark = [needs_yade, pytest.mark.yade]
+from grainfrac_yade.commands.bench import markdown_tables
 
 SCENE_KEYS = {"label", "grain_model", "spheres_per_cell", "stress_pa", "n_cells", "n_bodies", "n_bonds",
               "n_interactions", "dem_timestep_s", "ramp_steps", "ramp_wall_s", "steps_to_first_equilibrium",
               "equilibrium_at_hold", "timing_window_steps", "timing_repeats", "steps_per_s",
               "steps_per_s_yade_only", "steps_per_s_python_stepping", "steps_per_s_drivers",
-              "steps_per_s_relaxation_loop", "engine_overhead", "engine_overhead_range", "python_stepping_overhead",
-              "python_stepping_overhead_range", "relaxation_loop_overhead", "relaxation_loop_overhead_range",
+              "steps_per_s_relaxation_loop", "engine_overhead", "engine_overhead_range", "engine_overhead_cpu",
+              "python_stepping_overhead", "python_stepping_overhead_range", "python_stepping_overhead_cpu",
+              "relaxation_loop_overhead", "relaxation_loop_overhead_range", "relaxation_loop_overhead_cpu",
               "n_intact_bonds", "read_all_bonds_s", "write_all_strengths_s", "time_to_failure_all_bonds_s",
               "read_per_bond_s", "write_per_bond_s", "events", "peak_rss_mb_after"}
 EVENT_KEYS = {"n_events_timed", "relaxation_steps_median", "relaxation_steps_mean", "relaxation_steps_max",
@@ -45,6 +46,8 @@ def quick_bench(tmp_path_factory):
     return json.loads(out.read_text()), res.stdout
 
 
+@needs_yade
+@pytest.mark.yade
 def test_quick_bench_writes_every_key(quick_bench):
     data, _ = quick_bench
     assert set(data) == {"bench", "machine", "scenes", "peak_rss_mb"}   # no runs to failure in --quick
@@ -59,6 +62,8 @@ def test_quick_bench_writes_every_key(quick_bench):
     assert data["scenes"]["deformable"]["grain_model"] == "deformable"
 
 
+@needs_yade
+@pytest.mark.yade
 def test_quick_bench_numbers_are_finite_and_positive(quick_bench):
     data, _ = quick_bench
     found = numbers(data)
@@ -68,8 +73,26 @@ def test_quick_bench_numbers_are_finite_and_positive(quick_bench):
     assert not bad
 
 
+@needs_yade
+@pytest.mark.yade
 def test_quick_bench_prints_its_table(quick_bench):
     data, stdout = quick_bench
     for scene in data["scenes"].values():
         assert f"| {scene['label']} |" in stdout
     assert "engine overhead" in stdout
+
+
+def test_stored_full_bench_has_the_clocks_to_failure_and_renders():
+    """docs/bench.json (the full bench, README's table): same keys as the quick one plus the runs to
+    failure; its numbers finite and positive; the tables render."""
+    data = json.loads((ROOT / "docs" / "bench.json").read_text())
+    assert data["bench"]["quick"] is False
+    for scene in data["scenes"].values():
+        assert SCENE_KEYS <= set(scene) and EVENT_KEYS <= set(scene["events"])
+    runs = data["clocks_to_failure"]
+    for clock in ("event", "paper"):
+        assert {"failed", "n_events", "dem_steps", "wall_s", "cpu_s", "creep_steps_per_s"} <= set(runs[clock])
+    assert not [(path, value) for path, value in numbers(data)
+                if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0]
+    text = markdown_tables(data)
+    assert "Creep to failure" in text and "| paper |" in text and "| event |" in text

@@ -14,7 +14,8 @@ On each scene, at the held load:
    steps: the servo before each step, break bookkeeping after it), ``relaxation_loop`` (as
    :meth:`CreepRun.relax` steps: ``GrainScene.run`` in chunks of ``creep.check_period`` with the
    break marking, failure and equilibrium checks between chunks).  Engine overhead = wall(drivers) /
-   wall(yade_only), the median of the per-repeat ratios.
+   wall(yade_only), the median of the per-repeat ratios; ``*_cpu``: the same ratio of the process's
+   CPU time, which other jobs on the shared cores do not inflate.
 2. Per-event cost of the event clock over a few events: relaxation DEM steps and wall time per
    event, the clock's own work between two relaxations (law, bond reads and writes, hand-over,
    history row), and the time to read the forces of all intact bonds once and to write all their
@@ -190,17 +191,17 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
     for clock in ("event", "paper"):
         params = params_for_clock(clock)
         stress = out["stress_pa"] = ratio * params.calibration.reference_ucs
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         run = TimedCreepRun(build_specimen(params, seed), params, stress)
         run.run()
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         first, last = run.rows[0], run.rows[-1]
         creep_steps, creep_wall = last["dem_steps"] - first["dem_steps"], last["wall_s"] - first["wall_s"]
         out[clock] = {
             "failed": bool(run.failed), "numerical_failure": bool(run.numerical_failure),
             "failure_reason": run.failure_reason or "not failed",
             ("lifetime_s" if run.failed else "creep_time_end_s"): last["creep_time_s"],
-            "n_events": run.n_events, "dem_steps": int(run.scene.O.iter), "wall_s": wall,
+            "n_events": run.n_events, "dem_steps": int(run.scene.O.iter), "wall_s": wall, "cpu_s": cpu,
             "creep_dem_steps": creep_steps, "creep_wall_s": creep_wall, "creep_steps_per_s": creep_steps / creep_wall,
         }
         if clock == "event":
@@ -210,6 +211,7 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
     event, paper = out["event"], out["paper"]
     out["paper_over_event_dem_steps"] = paper["dem_steps"] / event["dem_steps"]
     out["paper_over_event_wall"] = paper["wall_s"] / event["wall_s"]
+    out["paper_over_event_cpu"] = paper["cpu_s"] / event["cpu_s"]
     if event.get("lifetime_s") and paper.get("lifetime_s"):
         out["paper_over_event_lifetime"] = paper["lifetime_s"] / event["lifetime_s"]
     return out
@@ -241,9 +243,10 @@ def machine() -> dict:
 
 # ------------------------------------------------------------------------------------------- table
 def markdown_tables(result: dict) -> str:
-    """The bench as markdown: the machine line, one row per scene, and the clocks to failure."""
+    """The bench as markdown: the machine line, stepping and per-event tables, the clocks to failure."""
     b, m = result["bench"], result["machine"]
     st = b["settings"]
+    scenes = result["scenes"].values()
     lines = [f"{'Quick bench' if b['quick'] else 'Bench'} ({b['date']}, {b['code_version']}): {m['cpu_model']}, "
              f"{m['cores']} cores, Python {m['python']}, YADE {m['yade']}, numpy {m['numpy']}, OMP_NUM_THREADS "
              f"{m['omp_num_threads']}; load average {m['load_average_1min']}. Specimen {st['width_m'] * 1e3:g} x "
@@ -251,38 +254,50 @@ def markdown_tables(result: dict) -> str:
              f" {st['repeats']} interleaved windows per way of stepping; peak memory {result['peak_rss_mb']:.0f} MB; "
              f"bench wall time {b['wall_s']:.0f} s.", "",
              "| scene | bodies / bonds | load [MPa] | DEM step [s] | DEM steps/s, creep run | YADE only | "
-             "engine overhead (range) | O.step() loop alone | with equilibrium checks | relaxation steps/event, "
-             "median (events) | clock work/event [ms] | read all bonds [ms] | write all strengths [ms] |",
-             "|" + "---|" * 13]
-    for s in result["scenes"].values():
-        ev = s["events"]
+             "engine overhead, wall (range) | CPU time | O.step() loop alone | with equilibrium checks |",
+             "|" + "---|" * 10]
+    for s in scenes:
         lo, hi = s["engine_overhead_range"]
         lines.append(
             f"| {s['label']} | {s['n_bodies']} / {s['n_bonds']} | {s['stress_pa'] / 1e6:.1f} | "
             f"{s['dem_timestep_s']:.3g} | {s['steps_per_s']:.0f} | {s['steps_per_s_yade_only']:.0f} | "
-            f"{s['engine_overhead']:.3f} ({lo:.2f}-{hi:.2f}) | {s['python_stepping_overhead']:.3f} | "
-            f"{s['relaxation_loop_overhead']:.3f} | {_num(ev.get('relaxation_steps_median'), '.0f')} "
-            f"({ev['n_events_timed']}) | {_num(_ms(ev.get('clock_work_s_median')), '.2f')} | "
-            f"{s['read_all_bonds_s'] * 1e3:.2f} | {s['write_all_strengths_s'] * 1e3:.2f} |")
+            f"{s['engine_overhead']:.3f} ({lo:.2f}-{hi:.2f}) | {s['engine_overhead_cpu']:.3f} | "
+            f"{s['python_stepping_overhead']:.3f} | {s['relaxation_loop_overhead']:.3f} |")
+    lines += ["", "| scene | relaxation steps/event: median, mean, max (events) | relaxation wall/event [s] | "
+                  "clock work/event [ms] | read all bonds [ms] | write all strengths [ms] | law, all bonds [ms] | "
+                  "peak memory so far [MB] |", "|" + "---|" * 8]
+    for s in scenes:
+        lines.append(f"| {s['label']} | {_event_steps(s['events'])} | "
+                     f"{_num(s['events'].get('relaxation_wall_s_median'), '.3f')} | "
+                     f"{_num(_ms(s['events'].get('clock_work_s_median')), '.2f')} | {s['read_all_bonds_s'] * 1e3:.2f} | "
+                     f"{s['write_all_strengths_s'] * 1e3:.2f} | {s['time_to_failure_all_bonds_s'] * 1e3:.2f} | "
+                     f"{s['peak_rss_mb_after']:.0f} |")
     c = result.get("clocks_to_failure")
     if c:
         lines += ["", f"Creep to failure, {result['scenes'][c['scene']]['label']}, {c['stress_pa'] / 1e6:.1f} MPa, "
                       "one run per clock:", "",
-                  "| clock | lifetime [s] | events | DEM steps | wall [s] | creep-phase DEM steps/s | "
-                  "relaxation steps/event, median (max) | final wait [steps] |", "|" + "---|" * 8]
+                  "| clock | lifetime [s] | events | DEM steps | wall [s] | CPU [s] | creep-phase DEM steps/s | "
+                  "relaxation steps/event: median, mean, max (events) | final wait [DEM steps] |", "|" + "---|" * 9]
         for clock in ("event", "paper"):
             r = c[clock]
             ev = r.get("events", {})
             life = f"{r['lifetime_s']:.4g}" if r["failed"] else f"not failed by {r['creep_time_end_s']:.4g}"
-            relax = (f"{ev['relaxation_steps_median']:.0f} ({ev['relaxation_steps_max']:.0f})"
-                     if "relaxation_steps_median" in ev else "-")
             lines.append(f"| {clock} | {life} | {r['n_events']} | {r['dem_steps']} | {r['wall_s']:.1f} | "
-                         f"{r['creep_steps_per_s']:.0f} | {relax} | {_num(ev.get('final_relaxation_steps'), 'd')} |")
-        ratios = f"paper / event: DEM steps x{c['paper_over_event_dem_steps']:.2f}, wall x{c['paper_over_event_wall']:.2f}"
+                         f"{r['cpu_s']:.1f} | {r['creep_steps_per_s']:.0f} | {_event_steps(ev) if ev else '-'} | "
+                         f"{_num(ev.get('final_relaxation_steps'), 'd')} |")
+        ratios = (f"paper / event: DEM steps x{c['paper_over_event_dem_steps']:.2f}, wall x{c['paper_over_event_wall']:.2f}, "
+                  f"CPU x{c['paper_over_event_cpu']:.2f}")
         if "paper_over_event_lifetime" in c:
             ratios += f", lifetime x{c['paper_over_event_lifetime']:.3f}"
         lines += ["", ratios + "."]
     return "\n".join(lines)
+
+
+def _event_steps(events: dict) -> str:
+    if "relaxation_steps_median" not in events:
+        return f"- ({events['n_events_timed']})"
+    return (f"{events['relaxation_steps_median']:.0f}, {events['relaxation_steps_mean']:.0f}, "
+            f"{events['relaxation_steps_max']:.0f} ({events['n_events_timed']})")
 
 
 def _ms(seconds):
