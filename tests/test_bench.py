@@ -18,8 +18,9 @@ SCENE_KEYS = {"label", "grain_model", "spheres_per_cell", "stress_pa", "n_cells"
               "equilibrium_at_hold", "timing_window_steps", "timing_repeats", "steps_per_s",
               "steps_per_s_yade_only", "steps_per_s_python_stepping", "steps_per_s_drivers",
               "steps_per_s_relaxation_loop", "engine_overhead", "engine_overhead_range", "engine_overhead_cpu",
-              "python_stepping_overhead", "python_stepping_overhead_range", "python_stepping_overhead_cpu",
-              "relaxation_loop_overhead", "relaxation_loop_overhead_range", "relaxation_loop_overhead_cpu",
+              "engine_overhead_quartiles", "python_stepping_overhead", "python_stepping_overhead_range",
+              "python_stepping_overhead_cpu", "python_stepping_overhead_quartiles", "relaxation_loop_overhead",
+              "relaxation_loop_overhead_range", "relaxation_loop_overhead_cpu", "relaxation_loop_overhead_quartiles",
               "n_intact_bonds", "read_all_bonds_s", "write_all_strengths_s", "time_to_failure_all_bonds_s",
               "read_per_bond_s", "write_per_bond_s", "events", "peak_rss_mb_after"}
 EVENT_KEYS = {"n_events_timed", "relaxation_steps_median", "relaxation_steps_mean", "relaxation_steps_max",

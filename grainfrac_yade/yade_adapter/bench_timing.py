@@ -80,7 +80,11 @@ class TimedCreepRun(CreepRun):
 
 def time_stepping(run, window_s: float, repeats: int) -> dict:
     """DEM steps per second of the held scene taken four ways (:data:`STEPPING_WAYS`), interleaved;
-    the overheads are medians of per-repeat ratios to ``yade_only``."""
+    the overheads are medians of per-repeat ratios to ``yade_only``, with their quartiles and range.
+
+    Adjacent windows of 0.1-0.5 s on this machine differ by up to 2 x in either direction, in CPU
+    time as in wall time (measured: per-repeat ratios 0.47-2.2 around a median of 1.15): only the
+    median of many repeats means something."""
     scene, O = run.scene, run.scene.O
     period = run.params.creep.check_period
     t = time.perf_counter()
@@ -122,7 +126,9 @@ def time_stepping(run, window_s: float, repeats: int) -> dict:
     for way, name in (("drivers", "engine_overhead"), ("python_stepping", "python_stepping_overhead"),
                       ("relaxation_loop", "relaxation_loop_overhead")):
         ratios = [a / b for a, b in zip(walls[way], walls["yade_only"])]
-        out[name] = statistics.median(ratios)
+        q1, median, q3 = statistics.quantiles(ratios, n=4)
+        out[name] = median
+        out[f"{name}_quartiles"] = [q1, q3]
         out[f"{name}_range"] = [min(ratios), max(ratios)]
         # CPU time of the process (all threads): what other jobs on the shared cores do not inflate
         out[f"{name}_cpu"] = statistics.median(a / b for a, b in zip(cpus[way], cpus["yade_only"]))
