@@ -15,7 +15,7 @@ from grainfrac_yade.commands.bench import markdown_tables
 
 SCENE_KEYS = {"label", "grain_model", "spheres_per_cell", "stress_pa", "n_cells", "n_bodies", "n_bonds",
               "n_interactions", "dem_timestep_s", "ramp_steps", "ramp_wall_s", "steps_to_first_equilibrium",
-              "equilibrium_at_hold", "timing_window_steps", "timing_repeats", "steps_per_s",
+              "equilibrium_at_hold", "held_after_events", "timing_window_steps", "timing_repeats", "steps_per_s",
               "steps_per_s_yade_only", "steps_per_s_python_stepping", "steps_per_s_drivers",
               "steps_per_s_relaxation_loop", "engine_overhead", "engine_overhead_range", "engine_overhead_cpu",
               "engine_overhead_quartiles", "python_stepping_overhead", "python_stepping_overhead_range",
@@ -58,7 +58,7 @@ def test_quick_bench_writes_every_key(quick_bench):
     for key, scene in data["scenes"].items():
         assert SCENE_KEYS <= set(scene), key
         assert EVENT_KEYS <= set(scene["events"]), key
-        assert scene["equilibrium_at_hold"] is True, key
+        assert scene["equilibrium_at_hold"] is True and scene["held_after_events"] is True, key
     assert [s["spheres_per_cell"] for s in data["scenes"].values()][:2] == [1, 8]
     assert data["scenes"]["deformable"]["grain_model"] == "deformable"
 

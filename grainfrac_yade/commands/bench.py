@@ -3,8 +3,8 @@
 Scenes: the specimen (10 x 20 mm, seed 1; ``--quick`` a smaller one) with rigid cells at 1 and at 8
 spheres per cell and with deformable cells (``params/presets/deformable.toml``), each ramped as a
 creep run ramps it to 0.7 x its own ``calibration.reference_ucs`` (``--ratio``), then held by the
-servo with the stress-corrosion engine in place and relaxed to equilibrium, as in a creep run.
-On each scene, at the held load:
+servo with the stress-corrosion engine in place and relaxed to equilibrium, as in a creep run; then
+a few events of the event clock are timed, and the scene is measured at the held load after them:
 
 1. DEM steps per second and the engine overhead: the wall time of N DEM steps taken four ways,
    interleaved in time (their order rotates each repeat) so that each ratio compares neighbouring
@@ -14,8 +14,9 @@ On each scene, at the held load:
    steps: the servo before each step, break bookkeeping after it), ``relaxation_loop`` (as
    :meth:`CreepRun.relax` steps: ``GrainScene.run`` in chunks of ``creep.check_period`` with the
    break marking, failure and equilibrium checks between chunks).  Engine overhead = wall(drivers) /
-   wall(yade_only), the median of the per-repeat ratios (with quartiles and range); ``*_cpu``: the same ratio of the process's
-   CPU time, which other jobs on the shared cores do not inflate.
+   wall(yade_only), the median of the per-repeat ratios (with quartiles and range); ``*_cpu``: the
+   same ratio of the process's CPU time, which waiting for a core does not inflate (on this VM it
+   follows the wall time: the spread between windows is in the CPU's speed, not in waiting).
 2. Per-event cost of the event clock over a few events: relaxation DEM steps and wall time per
    event, the clock's own work between two relaxations (law, bond reads and writes, hand-over,
    history row), and the time to read the forces of all intact bonds once and to write all their
@@ -154,7 +155,7 @@ def scene_params(user_files, scene_files, user_overrides, scene_overrides):
 
 
 def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
-    """Ramp, hold and relax one scene as a creep run does; time its stepping, bond I/O and a few events."""
+    """Ramp, hold and relax one scene as a creep run does; time a few events, then its stepping and bond I/O."""
     from ..errors import GrainfracError
     from ..specimen import build_specimen
     from ..yade_adapter.bench_timing import TimedCreepRun, time_bond_io, time_stepping
@@ -175,6 +176,7 @@ def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
         "n_bonds": sc.n_bonds, "n_interactions": len(sc.O.interactions), "dem_timestep_s": sc.O.dt,
         "ramp_steps": run.rows[0]["dem_steps"], "ramp_wall_s": run.ramp_wall_s,
         "steps_to_first_equilibrium": run.hold_steps, "equilibrium_at_hold": run.initial_bond_stresses is not None,
+        "held_after_events": not run.failed,
         **run.measured,
         "events": run.event_costs(),
         "peak_rss_mb_after": peak_rss_mb(),

@@ -19,9 +19,11 @@ POLL_S = 2e-3
 
 
 class TimedCreepRun(CreepRun):
-    """A creep run that times its ramp and relaxations, measures the held scene (``at_hold``) before the
-    event clock's first interval, and stops after ``max_events`` event-clock intervals (None: runs to
-    the end, as a creep run)."""
+    """A creep run that times its ramp and relaxations, stops after ``max_events`` event-clock intervals
+    (None: runs to the end, as a creep run), then measures the held scene (``at_hold(run)``).
+
+    Measuring after the events, not before, keeps the events independent of the timing: the
+    timing windows' lengths follow the machine's speed and their DEM steps move the scene."""
 
     def __init__(self, specimen, params, target_stress, max_events=None, at_hold=None, progress=None):
         super().__init__(specimen, params, target_stress, progress=progress)
@@ -39,10 +41,10 @@ class TimedCreepRun(CreepRun):
         self.ramp_wall_s = time.perf_counter() - t
 
     def run_event_clock(self):
-        if self.at_hold is not None:
-            self.measured = self.at_hold(self)
         self._loop_calls = 0
         super().run_event_clock()
+        if self.at_hold is not None:
+            self.measured = self.at_hold(self)
 
     def relax(self, creep_time):
         start = time.perf_counter()
@@ -99,7 +101,7 @@ def time_stepping(run, window_s: float, repeats: int) -> dict:
     def relaxation_loop():   # as CreepRun.relax steps, without stopping at equilibrium
         for _ in range(n // period):
             scene.run(period)
-            run.mark_breaks(0.0)
+            run.mark_breaks(run.corr.creep_time)
             run.check_failure()
             run.at_equilibrium(run.servo)
 
@@ -130,7 +132,7 @@ def time_stepping(run, window_s: float, repeats: int) -> dict:
         out[name] = median
         out[f"{name}_quartiles"] = [q1, q3]
         out[f"{name}_range"] = [min(ratios), max(ratios)]
-        # CPU time of the process (all threads): what other jobs on the shared cores do not inflate
+        # CPU time of the process (all threads): waiting for a core does not count
         out[f"{name}_cpu"] = statistics.median(a / b for a, b in zip(cpus[way], cpus["yade_only"]))
     return out
 
