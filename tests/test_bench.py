@@ -21,6 +21,7 @@ SCENE_KEYS = {"label", "grain_model", "spheres_per_cell", "stress_pa", "n_cells"
               "engine_overhead_quartiles", "python_stepping_overhead", "python_stepping_overhead_range",
               "python_stepping_overhead_cpu", "python_stepping_overhead_quartiles", "relaxation_loop_overhead",
               "relaxation_loop_overhead_range", "relaxation_loop_overhead_cpu", "relaxation_loop_overhead_quartiles",
+              "drivers", "drivers_s_per_step", "engine_overhead_from_driver_cost",
               "n_intact_bonds", "read_all_bonds_s", "write_all_strengths_s", "time_to_failure_all_bonds_s",
               "read_per_bond_s", "write_per_bond_s", "events", "peak_rss_mb_after"}
 EVENT_KEYS = {"n_events_timed", "relaxation_steps_median", "relaxation_steps_mean", "relaxation_steps_max",

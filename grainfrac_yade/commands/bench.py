@@ -17,6 +17,8 @@ a few events of the event clock are timed, and the scene is measured at the held
    wall(yade_only), the median of the per-repeat ratios (with quartiles and range); ``*_cpu``: the
    same ratio of the process's CPU time, which waiting for a core does not inflate (on this VM it
    follows the wall time: the spread between windows is in the CPU's speed, not in waiting).
+   ``drivers_s_per_step``: one call of the drivers (the servo) timed alone, and the overhead it
+   implies, 1 + that x the YADE-only steps per second.
 2. Per-event cost of the event clock over a few events: relaxation DEM steps and wall time per
    event, the clock's own work between two relaxations (law, bond reads and writes, hand-over,
    history row), and the time to read the forces of all intact bonds once and to write all their
@@ -256,14 +258,16 @@ def markdown_tables(result: dict) -> str:
              f" {st['repeats']} interleaved windows per way of stepping; peak memory {result['peak_rss_mb']:.0f} MB; "
              f"bench wall time {b['wall_s']:.0f} s.", "",
              "| scene | bodies / bonds | load [MPa] | DEM step [s] | DEM steps/s, creep run | YADE only | "
-             "engine overhead, wall (quartiles) | CPU time | O.step() loop alone | with equilibrium checks |",
-             "|" + "---|" * 10]
+             "engine overhead, wall (quartiles) | CPU time | from the servo's cost [us/step] | O.step() loop alone "
+             "| with equilibrium checks |",
+             "|" + "---|" * 11]
     for s in scenes:
         lo, hi = s["engine_overhead_quartiles"]
         lines.append(
             f"| {s['label']} | {s['n_bodies']} / {s['n_bonds']} | {s['stress_pa'] / 1e6:.1f} | "
             f"{s['dem_timestep_s']:.3g} | {s['steps_per_s']:.0f} | {s['steps_per_s_yade_only']:.0f} | "
             f"{s['engine_overhead']:.3f} ({lo:.2f}-{hi:.2f}) | {s['engine_overhead_cpu']:.3f} | "
+            f"{s['engine_overhead_from_driver_cost']:.3f} ({s['drivers_s_per_step'] * 1e6:.0f}) | "
             f"{s['python_stepping_overhead']:.3f} | {s['relaxation_loop_overhead']:.3f} |")
     lines += ["", "| scene | relaxation steps/event: median, mean, max (events) | relaxation wall/event [s] | "
                   "clock work/event [ms] | read all bonds [ms] | write all strengths [ms] | law, all bonds [ms] | "

@@ -134,7 +134,24 @@ def time_stepping(run, window_s: float, repeats: int) -> dict:
         out[f"{name}_range"] = [min(ratios), max(ratios)]
         # CPU time of the process (all threads): waiting for a core does not count
         out[f"{name}_cpu"] = statistics.median(a / b for a, b in zip(cpus[way], cpus["yade_only"]))
+    out.update(time_drivers(scene, n, repeats))
+    # the overhead the drivers' own cost implies: less noisy than the ratio of two noisy windows
+    out["engine_overhead_from_driver_cost"] = 1.0 + out["drivers_s_per_step"] * out["steps_per_s_yade_only"]
     return out
+
+
+def time_drivers(scene, calls: int, repeats: int) -> dict:
+    """Wall time of one call of every driver's ``before_step`` (what :meth:`GrainScene.run` adds to
+    each DEM step besides the break check), the median of ``repeats`` loops of ``calls`` calls
+    without DEM steps in between (a servo sets the same platen speed again each time)."""
+    walls = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        for _ in range(calls):
+            for d in scene.drivers:
+                d.before_step(scene)
+        walls.append((time.perf_counter() - t) / calls)
+    return {"drivers": ", ".join(d.name for d in scene.drivers), "drivers_s_per_step": statistics.median(walls)}
 
 
 def time_bond_io(corr, repeats: int) -> dict:
