@@ -100,7 +100,8 @@ def _cluster_geometry(specimen: Specimen, params: Parameters, inset: float):
     return mesh, pos, pairs, np.bincount(inverse.ravel(), weights=k.T.ravel())
 
 
-def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_INSET) -> float:
+def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_INSET,
+               unscaled: ClumpLayout | None = None) -> float:
     """Factor on every link so that the specimen has the deformable-block reference's stiffness [1].
 
     Dropping the coupling terms of the edge stiffness (:func:`edge_springs`) makes a cluster too
@@ -110,7 +111,8 @@ def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_IN
     real contacts, the factor is refined by the secant method until the lattice's Young's modulus
     equals the mesh reference's (:func:`grainfrac_yade.elastic.deformable_network`, same contact
     nodes, same platens) within ``LINK_SCALE_TOLERANCE``.  Poisson's ratio and the contact stress
-    tail are not fitted: they validate the lattice.
+    tail are not fitted: they validate the lattice.  ``unscaled``: the specimen's layout before
+    scaling (:func:`_layout`), when the caller has it.
     """
     from .elastic import deformable_network, lattice_network, solve_uniaxial
     from .specimen import specimen_from_tessellation
@@ -121,11 +123,12 @@ def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_IN
     one = specimen_from_tessellation(specimen.tessellation, np.full(specimen.n_cells, main),
                                      specimen.mineral_names, specimen.thickness, specimen.seed)
     guess = (solve_uniaxial(deformable_network(one, stiff, k), one).young
-             / solve_uniaxial(lattice_network(one, stiff, _layout(one, stiff, inset, 1.0)), one).young)
+             / solve_uniaxial(lattice_network(one, stiff, _layout(one, stiff, inset)), one).young)
     target = solve_uniaxial(deformable_network(specimen, params, k), specimen).young
+    unscaled = unscaled or _layout(specimen, params, inset)
 
     def misfit(scale):
-        lattice = lattice_network(specimen, params, _layout(specimen, params, inset, scale))
+        lattice = lattice_network(specimen, params, _scaled(unscaled, scale))
         return solve_uniaxial(lattice, specimen).young / target - 1.0
 
     a, b = guess, 1.2 * guess
@@ -141,7 +144,8 @@ def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_IN
 def build_deformable_layout(specimen: Specimen, params: Parameters, inset: float = DEFAULT_INSET) -> ClumpLayout:
     """Deformable cells of ``specimen`` at ``resolution.nodes_per_face`` contact nodes per face
     (see module doc), links scaled by :func:`link_scale`."""
-    layout = _layout(specimen, params, inset, link_scale(specimen, params, inset))
+    unscaled = _layout(specimen, params, inset)
+    layout = _scaled(unscaled, link_scale(specimen, params, inset, unscaled))
     return dataclasses.replace(layout, sphere_area=stiffness_lumped_area(specimen, params, layout))
 
 
@@ -162,9 +166,15 @@ def stiffness_lumped_area(specimen: Specimen, params: Parameters, layout: ClumpL
     return specimen.tessellation.cell_measure[layout.sphere_cell] * k_sphere / k_cell[layout.sphere_cell]
 
 
-def _layout(specimen: Specimen, params: Parameters, inset: float, scale: float) -> ClumpLayout:
+def _scaled(layout: ClumpLayout, scale: float) -> ClumpLayout:
+    """``layout`` with every link's springs multiplied by ``scale``."""
+    link_k = layout.link_normal_stiffness * scale
+    return dataclasses.replace(layout, link_normal_stiffness=link_k, link_shear_stiffness=LINK_SHEAR_FRACTION * link_k)
+
+
+def _layout(specimen: Specimen, params: Parameters, inset: float) -> ClumpLayout:
+    """The deformable layout with unscaled links (scale 1) and the triangles' lumped areas."""
     mesh, pos, link_pairs, link_k = _cluster_geometry(specimen, params, inset)
-    link_k = link_k * scale
     area = mesh.triangle_areas()
     sphere_area = np.bincount(mesh.triangles.ravel(), weights=np.repeat(area / 3, 3), minlength=mesh.n_nodes)
     dist, _ = cKDTree(pos).query(pos, k=2)
