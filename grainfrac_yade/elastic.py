@@ -374,10 +374,8 @@ def deformable_network(specimen: Specimen, params: Parameters, nodes_per_face: i
 def contact_stiffness(specimen: Specimen, params: Parameters, faces: np.ndarray):
     """Table 2 normal and shear stiffness [Pa/m] of the mineral pair of each face (mixed pairs
     averaged), times ``calibration.stiffness_scale``."""
-    names = specimen.mineral_names
-    pair = [[params.contact(a, b) for b in names] for a in names]
-    kn = np.array([[c.normal_stiffness for c in row] for row in pair])
-    ks = np.array([[c.shear_stiffness for c in row] for row in pair])
+    from .layout import mineral_pair_table
+    kn, ks = (mineral_pair_table(specimen.mineral_names, params, a) for a in ("normal_stiffness", "shear_stiffness"))
     fm = specimen.mineral[specimen.tessellation.face_cells[faces]]
     scale = params.calibration.stiffness_scale
     return kn[fm[:, 0], fm[:, 1]] * scale, ks[fm[:, 0], fm[:, 1]] * scale

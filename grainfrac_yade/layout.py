@@ -154,6 +154,11 @@ def _face_lined_layout(specimen: Specimen, spheres_per_cell: int) -> ClumpLayout
         bond_point=_to3d(np.array(points), z))
 
 
+def mineral_pair_table(names, params: Parameters, attr: str) -> np.ndarray:
+    """(m, m) Table 2 value ``attr`` of every pair of the minerals ``names`` (mixed pairs averaged)."""
+    return np.array([[getattr(params.contact(a, b), attr) for b in names] for a in names])
+
+
 @dataclass(frozen=True)
 class BondProperties:
     """Per-bond elastic and strength properties (arrays of length n_bonds)."""
@@ -190,12 +195,9 @@ def bond_properties(specimen: Specimen, layout: ClumpLayout, params: Parameters)
     grains = [params.grains[m] for m in names]
     e_mod = np.array([g.young / (1 - g.poisson**2) if plane_strain else g.young for g in grains])
     g_mod = np.array([g.shear_modulus for g in grains])
-    nm = len(names)
-    table = {}
-    for attr in ("normal_stiffness", "shear_stiffness", "tensile_strength", "cohesion", "friction_angle",
-                 "residual_friction_angle", "residual_tensile_strength", "residual_cohesion"):
-        table[attr] = np.array([[getattr(params.contact(names[i], names[j]), attr) for j in range(nm)]
-                                for i in range(nm)])
+    table = {attr: mineral_pair_table(names, params, attr)
+             for attr in ("normal_stiffness", "shear_stiffness", "tensile_strength", "cohesion", "friction_angle",
+                          "residual_friction_angle", "residual_tensile_strength", "residual_cohesion")}
     face = layout.bond_face
     cells = t.face_cells[face]
     ma, mb = specimen.mineral[cells[:, 0]], specimen.mineral[cells[:, 1]]
