@@ -21,7 +21,7 @@ The cluster is an image of the static reference's mesh
 The spheres translate only and the scene takes the plain relative displacement
 of two spheres as the shear displacement (the adapter sets both), so every link
 and bond is a two-node spring: the model that
-:func:`grainfrac_yade.elastic.lattice_network` solves statically.  Rotating
+:func:`grainfrac_yade.elastic.cluster_network` solves statically.  Rotating
 spheres, whose shear lever arms in YADE are the sphere radii, tripled the
 contact shear tail of the static solve.
 
@@ -45,11 +45,6 @@ from .layout import ClumpLayout, bond_properties
 from .params import Parameters
 from .specimen import Specimen
 
-#: Fraction of the way from a face node to its cell's centroid by which each sphere is moved in [1].
-#: Static solves, 10 x 20 mm seeds 1, 3, 5, 2 nodes per face, E matched, normal-only links: insets
-#: 0.01 / 0.02 / 0.03 / 0.05 gave a contact shear p99 of +12 / +8 / +3 / -2 % and a per-face p99 of
-#: +2 / -4 / -10 / -17 % against the mesh reference (means over seeds); 0.03 balances the two.
-DEFAULT_INSET = 0.03
 #: Shear stiffness of the links as a fraction of their normal stiffness [1].  The spheres do not
 #: rotate, so a link's shear spring acts on the relative translation of its ends and resists the
 #: rigid rotation of its edge: a cell with such links resists turning as a whole, which no grain
@@ -82,13 +77,19 @@ def edge_springs(corners: np.ndarray, target: np.ndarray) -> np.ndarray:
     return np.diag(m_inv.T @ target @ m_inv).copy()
 
 
-def _cluster_geometry(specimen: Specimen, params: Parameters, inset: float):
-    """Mesh, sphere centres (the mesh shrunk by 1 - inset about each centroid), link pairs and their
-    unscaled springs [N/m] (one link per mesh edge, :func:`edge_springs` summed over its triangles)."""
+def _shrunk_mesh(specimen: Specimen, params: Parameters, inset: float):
+    """The reference's mesh (contacts at the face corners) and its node positions shrunk by
+    1 - inset about each cell's centroid [m]."""
     t = specimen.tessellation
     mesh = grain_mesh(specimen, params.resolution.nodes_per_face, "corners")
     centroid = t.cell_centroid[mesh.node_cell]
-    pos = centroid + (1.0 - inset) * (mesh.node_pos - centroid)
+    return mesh, centroid + (1.0 - inset) * (mesh.node_pos - centroid)
+
+
+def _cluster_geometry(specimen: Specimen, params: Parameters, inset: float):
+    """Mesh, sphere centres (the mesh shrunk by 1 - inset about each centroid), link pairs and their
+    unscaled springs [N/m] (one link per mesh edge, :func:`edge_springs` summed over its triangles)."""
+    mesh, pos = _shrunk_mesh(specimen, params, inset)
     names = specimen.mineral_names
     d_min = plane_strain_matrix([params.grains[m].young for m in names],
                                 [params.grains[m].poisson for m in names]) * specimen.thickness
@@ -100,7 +101,7 @@ def _cluster_geometry(specimen: Specimen, params: Parameters, inset: float):
     return mesh, pos, pairs, np.bincount(inverse.ravel(), weights=k.T.ravel())
 
 
-def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_INSET,
+def link_scale(specimen: Specimen, params: Parameters, inset: float,
                unscaled: ClumpLayout | None = None) -> float:
     """Factor on every link so that the specimen has the deformable-block reference's stiffness [1].
 
@@ -114,7 +115,7 @@ def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_IN
     tail are not fitted: they validate the lattice.  ``unscaled``: the specimen's layout before
     scaling (:func:`_layout`), when the caller has it.
     """
-    from .elastic import deformable_network, lattice_network, solve_uniaxial
+    from .elastic import deformable_network, cluster_network, solve_uniaxial
     from .specimen import specimen_from_tessellation
     k = params.resolution.nodes_per_face
     stiff = dataclasses.replace(params, calibration=dataclasses.replace(
@@ -123,12 +124,12 @@ def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_IN
     one = specimen_from_tessellation(specimen.tessellation, np.full(specimen.n_cells, main),
                                      specimen.mineral_names, specimen.thickness, specimen.seed)
     guess = (solve_uniaxial(deformable_network(one, stiff, k), one).young
-             / solve_uniaxial(lattice_network(one, stiff, _layout(one, stiff, inset)), one).young)
+             / solve_uniaxial(cluster_network(one, stiff, _layout(one, stiff, inset)), one).young)
     target = solve_uniaxial(deformable_network(specimen, params, k), specimen).young
     unscaled = unscaled or _layout(specimen, params, inset)
 
     def misfit(scale):
-        lattice = lattice_network(specimen, params, _scaled(unscaled, scale))
+        lattice = cluster_network(specimen, params, _scaled(unscaled, scale))
         return solve_uniaxial(lattice, specimen).young / target - 1.0
 
     a, b = guess, 1.2 * guess
@@ -141,9 +142,10 @@ def link_scale(specimen: Specimen, params: Parameters, inset: float = DEFAULT_IN
     return float(b)
 
 
-def build_deformable_layout(specimen: Specimen, params: Parameters, inset: float = DEFAULT_INSET) -> ClumpLayout:
-    """Deformable cells of ``specimen`` at ``resolution.nodes_per_face`` contact nodes per face
-    (see module doc), links scaled by :func:`link_scale`."""
+def build_deformable_layout(specimen: Specimen, params: Parameters) -> ClumpLayout:
+    """Deformable cells of ``specimen`` at ``resolution.nodes_per_face`` contact nodes per face and
+    ``resolution.contact_inset`` (see module doc), links scaled by :func:`link_scale`."""
+    inset = params.resolution.contact_inset
     unscaled = _layout(specimen, params, inset)
     layout = _scaled(unscaled, link_scale(specimen, params, inset, unscaled))
     return dataclasses.replace(layout, sphere_area=stiffness_lumped_area(specimen, params, layout))
@@ -172,9 +174,53 @@ def _scaled(layout: ClumpLayout, scale: float) -> ClumpLayout:
     return dataclasses.replace(layout, link_normal_stiffness=link_k, link_shear_stiffness=LINK_SHEAR_FRACTION * link_k)
 
 
+def build_fem_layout(specimen: Specimen, params: Parameters) -> ClumpLayout:
+    """Finite-element cells (``grain_model = "fem"``): the spheres and bonds of
+    :func:`build_deformable_layout`, and in place of links each triangle of the shrunk mesh a
+    constant-strain element with its mineral's Table 1 moduli (plane strain), so that the cluster
+    is the reference's mesh itself: no fitted factor, Poisson's coupling included.
+
+    Masses: each cell's area shared among its spheres in proportion to their Gershgorin stiffness
+    (:func:`grainfrac_yade.elastic.node_stiffness`), so that every sphere of a cell has the same
+    bound on its oscillation period (the reasoning of :func:`stiffness_lumped_area`).
+    """
+    from .elastic import cluster_network, node_stiffness
+    inset = params.resolution.contact_inset
+    mesh, pos = _shrunk_mesh(specimen, params, inset)
+    layout = _sphere_layout(specimen, mesh, pos, inset, None, None)
+    layout = dataclasses.replace(layout, element_spheres=mesh.triangles.copy())
+    k_sphere = node_stiffness(cluster_network(specimen, params, layout))
+    k_cell = np.bincount(layout.sphere_cell, weights=k_sphere, minlength=specimen.n_cells)
+    area = specimen.tessellation.cell_measure[layout.sphere_cell] * k_sphere / k_cell[layout.sphere_cell]
+    return dataclasses.replace(layout, sphere_area=area)
+
+
+def element_apex(triangles: np.ndarray) -> np.ndarray:
+    """(e,) for each triangle one of its nodes, the fewest distinct nodes that cover all triangles
+    (greedy: the node in most uncovered triangles first; a fan mesh's centroid covers its cell).
+
+    YADE's elements are tetrahedra: each triangle becomes one, its fourth node lifted out of the
+    plane above the apex and moving with it (see the adapter), which needs one lifted node per apex.
+    """
+    tri = np.asarray(triangles)
+    apex = np.full(len(tri), -1, dtype=np.int64)
+    while (apex < 0).any():
+        open_tri = np.flatnonzero(apex < 0)
+        counts = np.bincount(tri[open_tri].ravel())
+        node = int(np.argmax(counts))
+        apex[open_tri[(tri[open_tri] == node).any(axis=1)]] = node
+    return apex
+
+
 def _layout(specimen: Specimen, params: Parameters, inset: float) -> ClumpLayout:
     """The deformable layout with unscaled links (scale 1) and the triangles' lumped areas."""
     mesh, pos, link_pairs, link_k = _cluster_geometry(specimen, params, inset)
+    return _sphere_layout(specimen, mesh, pos, inset, link_pairs, link_k)
+
+
+def _sphere_layout(specimen: Specimen, mesh, pos: np.ndarray, inset: float, link_pairs, link_k) -> ClumpLayout:
+    """One sphere per node of ``mesh`` at ``pos``, bonds between contact pairs, links if given, the
+    triangles' areas lumped on their corners."""
     area = mesh.triangle_areas()
     sphere_area = np.bincount(mesh.triangles.ravel(), weights=np.repeat(area / 3, 3), minlength=mesh.n_nodes)
     dist, _ = cKDTree(pos).query(pos, k=2)
@@ -188,4 +234,5 @@ def _layout(specimen: Specimen, params: Parameters, inset: float) -> ClumpLayout
         bond_area=mesh.contact_share * specimen.face_area[faces],
         bond_point=np.column_stack([points, np.full(len(points), z)]),
         rigid_cells=False, link_spheres=link_pairs, link_normal_stiffness=link_k,
-        link_shear_stiffness=LINK_SHEAR_FRACTION * link_k, sphere_area=sphere_area, series_fraction=inset)
+        link_shear_stiffness=None if link_k is None else LINK_SHEAR_FRACTION * link_k, sphere_area=sphere_area,
+        series_fraction=inset)

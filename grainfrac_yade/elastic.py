@@ -21,10 +21,11 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
     trapezoid share (K = 2: UDEC's corner sub-contacts, each half the face);
     ``contacts="midpoints"`` puts them at the centres of K equal sub-segments,
     each carrying 1/K of the face (as the DEM's deformable cells do).
-``lattice``
+``lattice`` and ``fem``
     The YADE deformable cells (:mod:`grainfrac_yade.deformable`) solved
-    statically: every sphere a body (translation only), links and bonds as
-    YADE springs.
+    statically: every sphere a body (translation only), bonds as YADE springs,
+    and the cell's interior as links (``grain_model = "deformable"``) or as
+    the constant-strain triangles on which the spheres sit (``"fem"``).
 
 Loading: the cells with a face on the top (bottom) wall form rigid-in-y
 platens closing by ``strain`` x height (rotation blocked, lateral motion free,
@@ -320,30 +321,54 @@ def rigid_network(specimen: Specimen, params: Parameters, layout=None) -> Networ
                    spring_torque_arm=torque_arm, spring_shear_translation_scale=shear_scale)
 
 
-def lattice_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
+def cluster_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
     """The YADE deformable cells: every sphere a body that translates only (rotations blocked, see
-    :mod:`grainfrac_yade.deformable`), bonds and links as YADE springs."""
+    :mod:`grainfrac_yade.deformable`), bonds and links as YADE springs, finite elements as
+    constant-strain triangles of the cell's mineral (plane strain, Table 1)."""
     from .layout import bond_properties, layout_for
     _require_2d(specimen.tessellation)
     layout = layout or layout_for(specimen, params)
     if layout.rigid_cells:
-        raise GrainfracError("elastic --grains lattice needs resolution.grain_model = \"deformable\"; "
-                             "fix: add --set resolution.grain_model=deformable")
+        raise GrainfracError("elastic --grains lattice|fem needs resolution.grain_model = \"deformable\" or "
+                             "\"fem\"; fix: add --set resolution.grain_model=deformable (or fem)")
     props = bond_properties(specimen, layout, params)
     c2, r = layout.sphere_center[:, :2], layout.sphere_radius
-    pairs = np.concatenate([layout.bond_spheres, layout.link_spheres])
+    link_spheres = layout.link_spheres if layout.n_links else np.empty((0, 2), dtype=np.int64)
+    link_kn = layout.link_normal_stiffness if layout.n_links else np.empty(0)
+    link_ks = layout.link_shear_stiffness if layout.n_links else np.empty(0)
+    pairs = np.concatenate([layout.bond_spheres, link_spheres])
     # spheres translate only and the scene takes the plain relative displacement (no ratcheting
     # guard): the arms play no part
     normal, arm, _, _ = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
                                          c2[pairs[:, 0]], c2[pairs[:, 1]])
     n_links = layout.n_links
+    if layout.n_elements:
+        tri = layout.element_spheres
+        names = specimen.mineral_names
+        d_min = plane_strain_matrix([params.grains[m].young for m in names],
+                                    [params.grains[m].poisson for m in names]) * specimen.thickness
+        tri_stiffness = d_min[specimen.mineral[layout.sphere_cell[tri[:, 0]]]]
+    else:
+        tri, tri_stiffness = np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3, 3))
     return Network(node_pos=c2.copy(), node_rotates=np.zeros(layout.n_spheres, dtype=bool),
                    node_cell=layout.sphere_cell.copy(), spring_nodes=pairs, spring_normal=normal, spring_arm=arm,
-                   spring_kn=np.concatenate([props.normal_stiffness, layout.link_normal_stiffness]),
-                   spring_ks=np.concatenate([props.shear_stiffness, layout.link_shear_stiffness]),
+                   spring_kn=np.concatenate([props.normal_stiffness, link_kn]),
+                   spring_ks=np.concatenate([props.shear_stiffness, link_ks]),
                    spring_area=np.concatenate([layout.bond_area, np.full(n_links, np.nan)]),
                    spring_face=np.concatenate([layout.bond_face, np.full(n_links, -1)]),
-                   tri_nodes=np.zeros((0, 3), dtype=np.int64), tri_stiffness=np.zeros((0, 3, 3)))
+                   tri_nodes=tri, tri_stiffness=tri_stiffness)
+
+
+def node_stiffness(net: Network) -> np.ndarray:
+    """(n,) largest absolute row sum of the stiffness matrix over each node's degrees of freedom [N/m].
+
+    Gershgorin's bound: with lumped masses m, no mode of the network oscillates faster than
+    omega^2 = max over nodes of node_stiffness / m, whatever couples the nodes (springs or elements).
+    """
+    k, dofs = stiffness_matrix(net)
+    row = np.asarray(abs(k).sum(axis=1)).ravel()
+    per_dof = np.where(dofs >= 0, row[np.maximum(dofs, 0)], 0.0)
+    return per_dof.max(axis=1)
 
 
 def _require_2d(t):
@@ -381,7 +406,7 @@ def contact_stiffness(specimen: Specimen, params: Parameters, faces: np.ndarray)
     return kn[fm[:, 0], fm[:, 1]] * scale, ks[fm[:, 0], fm[:, 1]] * scale
 
 
-GRAIN_MODELS = ("rigid", "deformable", "lattice")
+GRAIN_MODELS = ("rigid", "deformable", "lattice", "fem")
 
 
 def build_network(specimen: Specimen, params: Parameters, grains: str, nodes_per_face: int = 2,
@@ -391,8 +416,8 @@ def build_network(specimen: Specimen, params: Parameters, grains: str, nodes_per
         return rigid_network(specimen, params)
     if grains == "deformable":
         return deformable_network(specimen, params, nodes_per_face, contacts, rings)
-    if grains == "lattice":
-        return lattice_network(specimen, params)
+    if grains in ("lattice", "fem"):
+        return cluster_network(specimen, params)
     raise GrainfracError(f"elastic: grains {grains!r} unknown; fix: use one of {list(GRAIN_MODELS)}")
 
 

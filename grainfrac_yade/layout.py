@@ -47,6 +47,9 @@ class ClumpLayout:
     link_normal_stiffness: np.ndarray | None = None  # (m,) [N/m]
     link_shear_stiffness: np.ndarray | None = None   # (m,) [N/m]
     sphere_area: np.ndarray | None = None            # (s,) cell area lumped on each sphere [m^2] (mass share)
+    #: (e, 3) sphere triangles of finite-element cells (``grain_model = "fem"``): each a constant-strain
+    #: element of its cell's mineral (plane strain, Table 1), the mesh on which the spheres sit
+    element_spheres: np.ndarray | None = None
     #: fraction of the centroid-to-face distance of grain in series with each bond (1: rigid cells,
     #: whose elasticity lives in the bonds; the inset of deformable cells, whose links carry the rest)
     series_fraction: float = 1.0
@@ -54,6 +57,10 @@ class ClumpLayout:
     @property
     def n_links(self) -> int:
         return 0 if self.link_spheres is None else len(self.link_spheres)
+
+    @property
+    def n_elements(self) -> int:
+        return 0 if self.element_spheres is None else len(self.element_spheres)
 
     @property
     def n_spheres(self) -> int:
@@ -80,6 +87,9 @@ def layout_for(specimen: Specimen, params: Parameters) -> ClumpLayout:
     if params.resolution.grain_model == "deformable":
         from .deformable import build_deformable_layout
         return build_deformable_layout(specimen, params)
+    if params.resolution.grain_model == "fem":
+        from .deformable import build_fem_layout
+        return build_fem_layout(specimen, params)
     return build_layout(specimen, params.resolution.spheres_per_cell)
 
 

@@ -97,9 +97,14 @@ class ResolutionParams:
     """How finely a Voronoi cell is resolved by spheres."""
     spheres_per_cell: int = _spec("1", "positive_int", "target spheres per cell clump; 1 = one sphere")
     grain_model: str = _spec("", "choice", "rigid: each cell one rigid body; deformable: each cell a cluster of "
-                             "spheres held together by unbreakable elastic links", ("rigid", "deformable"))
-    nodes_per_face: int = _spec("1", "positive_int", "deformable cells: breakable bonds per Voronoi face "
-                                "(ignored by rigid cells)")
+                             "spheres held together by unbreakable elastic links; fem: each cell a cluster of "
+                             "spheres at the nodes of constant-strain finite elements with its mineral's Table 1 "
+                             "moduli", ("rigid", "deformable", "fem"))
+    nodes_per_face: int = _spec("1", "positive_int", "deformable and fem cells: breakable bonds per "
+                                "Voronoi face (ignored by rigid cells)")
+    contact_inset: float = _spec("1", "unit_interval_open", "deformable and fem cells: fraction of the way from a "
+                                 "face node to its cell's centroid at which the node's sphere sits (the two "
+                                 "spheres of a bond are distinct bodies a short gap apart)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -171,6 +176,9 @@ class CreepParams:
                                       "no equilibrium at the held load within this many steps = failure")
     failure_strain: float = _spec("1", "positive", "axial strain at which a run counts as failed (safety cap)")
     record_period: int = _spec("1", "positive_int", "paper clock: law applications between history rows")
+    checkpoint_interval: float = _spec("s", "nonnegative",
+                                       "wall time between checkpoints of a creep run (for creep --resume); "
+                                       "0 = only at the end of the ramp; does not change results")
 
 
 @dataclass(frozen=True, kw_only=True)

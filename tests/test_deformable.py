@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from grainfrac_yade.deformable import build_deformable_layout, edge_springs, link_scale, stiffness_lumped_area
-from grainfrac_yade.elastic import elastic_summary, lattice_network, plane_strain_matrix, solve_uniaxial
+from grainfrac_yade.elastic import elastic_summary, cluster_network, plane_strain_matrix, solve_uniaxial
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
 
@@ -48,10 +48,10 @@ def test_link_scale_matches_the_young_modulus_of_the_reference():
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 2)
     layout = build_deformable_layout(s, p)
-    lattice = solve_uniaxial(lattice_network(s, p, layout), s)
+    lattice = solve_uniaxial(cluster_network(s, p, layout), s)
     reference, _, _ = elastic_summary(s, p, "deformable", p.resolution.nodes_per_face)
     assert lattice.young == pytest.approx(reference["young_pa"], rel=1e-3)
-    assert 0 < link_scale(s, p) < 1     # dropping the coupling terms stiffens a cluster
+    assert 0 < link_scale(s, p, p.resolution.contact_inset) < 1     # dropping the coupling terms stiffens a cluster
 
 
 def test_layout_bookkeeping():

@@ -142,8 +142,8 @@ def _assert_yade_ramp_matches_static_solve(p, network, relax_steps):
 def test_deformable_scene_agrees_with_the_lattice_solve_after_a_small_elastic_ramp():
     """The YADE scene of deformable cells is the spring lattice that the static solve models:
     after a slow ramp to a strain of 2e-4 and relaxation, the platen stress and every bond's
-    forces agree with :func:`lattice_network`'s solution (the same check as for rigid cells)."""
-    from grainfrac_yade.elastic import lattice_network
+    forces agree with :func:`cluster_network`'s solution (the same check as for rigid cells)."""
+    from grainfrac_yade.elastic import cluster_network
     p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.damping=0.7",
                                    "resolution.grain_model=deformable"])
-    _assert_yade_ramp_matches_static_solve(p, lattice_network, relax_steps=40000)
+    _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=40000)

@@ -108,7 +108,7 @@ def test_bad_file_gives_one_clear_line(tmp_path, old, new, key, words):
 
 
 @pytest.mark.parametrize("old,new,key,words", [
-    ('grain_model = "rigid"', 'grain_model = "soft"', "resolution.grain_model", "not one of ['rigid', 'deformable']"),
+    ('grain_model = "rigid"', 'grain_model = "soft"', "resolution.grain_model", "not one of ['rigid', 'deformable', 'fem']"),
     ("nodes_per_face = 2", "nodes_per_face = 0", "resolution.nodes_per_face", "must be >= 1"),
 ])
 def test_bad_grain_model_gives_one_clear_line(tmp_path, old, new, key, words):

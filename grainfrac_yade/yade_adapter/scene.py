@@ -25,7 +25,7 @@ cracks see only the breakable bonds.  Code that acts on cells uses
 only (``DEFORMABLE_BLOCKED_DOFS``) and their contact geometry takes the plain
 relative displacement (``DEFORMABLE_RATCHETING_GUARD``): every bond and link is a
 two-node spring, the model :mod:`grainfrac_yade.deformable` fits and
-:func:`grainfrac_yade.elastic.lattice_network` solves statically.
+:func:`grainfrac_yade.elastic.cluster_network` solves statically.
 """
 from __future__ import annotations
 
@@ -66,6 +66,10 @@ DEFORMABLE_BLOCKED_DOFS = "zXYZ"
 #: them); the DEM then gives the static lattice solve's E and Poisson's ratio (tested; 85.5 GPa,
 #: nu 0.227 with the default).  Rigid cells keep YADE's default.
 DEFORMABLE_RATCHETING_GUARD = False
+#: Height of the lifted fourth node of finite-element cells over the cell's plane, in specimen
+#: thicknesses [1]: 3, so that each tetrahedron's volume (area x height / 3) is the triangle's area
+#: x the specimen's thickness, and its stiffness the plane-strain triangle's.
+FEM_LIFT = 3.0
 
 
 @dataclass
@@ -328,6 +332,16 @@ def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Spec
     return _oscillation_step(layout.n_spheres, ends, k, lever_sq, mass, inertia if rotating else None)
 
 
+def fem_critical_timestep(specimen: Specimen, params: Parameters, layout: ClumpLayout, mass: np.ndarray) -> float:
+    """Conservative critical DEM step of finite-element cells [s]: min over spheres of sqrt(m / K),
+    K the Gershgorin bound of the sphere's stiffness row (elements and bonds,
+    :func:`grainfrac_yade.elastic.node_stiffness`)."""
+    from ..elastic import cluster_network, node_stiffness
+    k = node_stiffness(cluster_network(specimen, params, layout))
+    with np.errstate(divide="ignore"):
+        return float(np.sqrt(mass / k).min())
+
+
 def _cell_spheres(layout: ClumpLayout, n_cells: int) -> list:
     """Sphere indices of each cell, ascending."""
     order = np.argsort(layout.sphere_cell, kind="stable")
@@ -402,6 +416,64 @@ def _append_deformable_cells(O, utils, Vector3, specimen, layout, mats, mass, in
     return sphere_body, sphere_body[nearest], [sphere_body[m] for m in members]
 
 
+def fem_element_material(young: float, poisson: float) -> dict:
+    """Arguments of YADE's ``LinIsoRayleighDampElastMat`` that make ``Lin4NodeTetra`` an exact linear
+    tetrahedron of Young's modulus ``young`` [Pa] and Poisson's ratio ``poisson`` (3D isotropic).
+
+    YADE 2023.02a's ``If2_Lin4NodeTetra_LinIsoRayleighDampElast`` applies the force
+    -(M^-1 K) u, M its consistent mass matrix 0.05 x density x (material Poisson's ratio) x
+    (I_4 + 1 1^T) (x) I_3, and builds K with the elasticity matrix E/((1+nu)(1-nu)) [[1-nu, nu, nu], ...;
+    shear (1-2nu)/2] instead of E/((1+nu)(1-2nu)) [...].  K has the rigid translations in its null
+    space, so M^-1 K = 20 / (density x nu) K: density 20/nu makes the force -K u, and
+    E (1-nu)/(1-2nu) restores the elasticity matrix.  No damping (alpha = beta = 0): the scene's
+    NewtonIntegrator damps.  Tested against a hand-built tetrahedron (tests/test_fem_scene.py).
+    """
+    return {"youngmodulus": young * (1 - poisson) / (1 - 2 * poisson), "poissonratio": poisson,
+            "density": 20.0 / poisson, "alpha": 0.0, "beta": 0.0}
+
+
+def _append_fem_elements(O, w, utils, Vector3, specimen, params, layout, sphere_body, mats, mass) -> dict:
+    """YADE finite elements for the triangles of ``layout.element_spheres``; returns {sphere: clump id}.
+
+    A triangle (a, b, c) of the plane becomes the tetrahedron (a, b, c, a'), a' a node lifted by
+    ``FEM_LIFT`` x thickness above its apex a (:func:`grainfrac_yade.deformable.element_apex`) and
+    clumped with a, so that a' moves with a in the plane: the tetrahedron's displacement field is
+    then the triangle's, constant in z, its strain the triangle's (plane strain, the z motion of
+    every sphere being blocked), its volume area x thickness.  The lifted node has no bound (no
+    contact); the clump of a and a' is the body that moves, with a's mass.
+    """
+    from ..deformable import element_apex
+    tri = layout.element_spheres
+    apex = element_apex(tri)
+    lift = FEM_LIFT * specimen.thickness
+    clump_of = {}
+    clump_material = w.ElastMat()   # YADE's FEM engine asserts that every body has a material
+    for s in np.unique(apex):
+        sphere = O.bodies[int(sphere_body[s])]
+        ghost = utils.sphere(sphere.state.pos + Vector3(0, 0, lift), float(layout.sphere_radius[s]),
+                             material=sphere.material)
+        ghost.bounded = False
+        ghost_id = O.bodies.append(ghost)
+        clump_id = O.bodies.clump([int(sphere_body[s]), ghost_id])
+        clump = O.bodies[clump_id]
+        clump.material = clump_material
+        clump.state.mass = float(mass[s])
+        clump.state.inertia = sphere.state.inertia
+        clump.state.blockedDOFs = DEFORMABLE_BLOCKED_DOFS
+        clump_of[int(s)] = (clump_id, ghost_id)
+    fem_mats = [w.LinIsoRayleighDampElastMat(**fem_element_material(params.grains[m].young, params.grains[m].poisson))
+                for m in specimen.mineral_names]
+    for (a, b, c), top in zip(tri, apex):
+        element = w.Lin4NodeTetra()
+        body = w.Body(shape=element, material=fem_mats[specimen.mineral[layout.sphere_cell[a]]])
+        body.dynamic, body.bounded = False, False
+        O.bodies.append(body)
+        for node in (a, b, c):
+            element.addNode(O.bodies[int(sphere_body[node])])
+        element.addNode(O.bodies[clump_of[int(top)][1]])
+    return {s: ids[0] for s, ids in clump_of.items()}
+
+
 def _create_links(utils, specimen, layout, params, sphere_body) -> list:
     """Unbreakable JCFpm bonds between spheres of one cell (k_n, k_s from the layout, friction of the
     cell's mineral, strengths ``LINK_STRENGTH``)."""
@@ -451,11 +523,14 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
     if not layout.rigid_cells:
         geometry.avoidGranularRatcheting = DEFORMABLE_RATCHETING_GUARD
     newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
+    # finite-element cells: their elements' internal forces, before the integrator
+    elements = [w.FEInternalForceEngine([w.If2_Lin4NodeTetra_LinIsoRayleighDampElast()])] if layout.n_elements else []
     O.engines = [
         w.ForceResetter(),
         w.InsertionSortCollider([w.Bo1_Sphere_Aabb()]),
         w.InteractionLoop([geometry],
                           [w.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)], [law]),
+        *elements,
         newton,
     ]
     blocked = _blocked_dofs(dim) if layout.rigid_cells else DEFORMABLE_BLOCKED_DOFS
@@ -482,8 +557,18 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         ph.crossSection = area
         interactions.append(inter)
     links = _create_links(utils, specimen, layout, params, sphere_body)
-    dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating="Z" not in blocked,
-                                ratcheting_guard=geometry.avoidGranularRatcheting)
+    if layout.n_elements:
+        clump_of = _append_fem_elements(O, w, utils, Vector3, specimen, params, layout, sphere_body, mats, mass)
+        # the bodies that move: a clump in place of each apex sphere
+        moving = sphere_body.copy()
+        for s, clump_id in clump_of.items():
+            moving[s] = clump_id
+        cell_body = np.array([moving[np.flatnonzero(sphere_body == b)[0]] for b in cell_body], dtype=np.int64)
+        cell_bodies = [moving[m] for m in _cell_spheres(layout, specimen.n_cells)]
+        dt_crit = fem_critical_timestep(specimen, params, layout, mass)
+    else:
+        dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating="Z" not in blocked,
+                                    ratcheting_guard=geometry.avoidGranularRatcheting)
     if not 0 < dt_crit < math.inf:
         raise GrainfracError(f"the scene's critical DEM step is {dt_crit:g} s (a cell without mass, or no bond "
                              "at all); fix: check the specimen's cells and faces")

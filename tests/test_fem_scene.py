@@ -1,0 +1,148 @@
+"""Finite-element cells (``resolution.grain_model = "fem"``): static solve, YADE elements, scene.
+
+The cluster of each cell is the reference's triangle mesh, shrunk by ``contact_inset``: the static
+solve of that cluster must converge to the mesh reference as the inset goes to zero, and the YADE
+scene must be that cluster (a slow elastic ramp agrees with the static solve, as for rigid cells).
+"""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from conftest import needs_yade
+from grainfrac_yade.deformable import build_fem_layout, element_apex
+from grainfrac_yade.elastic import (cluster_network, contact_statistics, deformable_network, node_stiffness,
+                                    solve_uniaxial, stiffness_matrix)
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.specimen import build_specimen
+
+SMALL = ["specimen.width=4e-3", "specimen.height=8e-3", "resolution.grain_model=fem"]
+
+
+def _with_inset(p, inset):
+    return dataclasses.replace(p, resolution=dataclasses.replace(p.resolution, contact_inset=inset))
+
+
+def test_element_apex_covers_every_triangle_with_one_node_per_fan():
+    p = load_parameters(overrides=SMALL)
+    s = build_specimen(p, 1)
+    lay = build_fem_layout(s, p)
+    tri = lay.element_spheres
+    apex = element_apex(tri)
+    assert (tri == apex[:, None]).any(axis=1).all()          # every apex is a node of its triangle
+    # a fan mesh (one ring): the centroid node of each cell is in all its triangles
+    assert len(np.unique(apex)) == s.n_cells
+    assert np.array_equal(np.unique(lay.sphere_cell[apex]), np.arange(s.n_cells))
+
+
+def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes():
+    """E and nu of the shrunk mesh approach the reference's linearly in the inset (static solves,
+    10 x 20 mm seed 1: E -3.0 / -1.0 / -0.1 % at insets 0.03 / 0.01 / 0.001, nu within 0.3 %)."""
+    p = load_parameters(overrides=SMALL)
+    s = build_specimen(p, 1)
+    ref = solve_uniaxial(deformable_network(s, p, p.resolution.nodes_per_face), s)
+    errors = []
+    for inset in (0.03, 0.01, 0.001):
+        q = _with_inset(p, inset)
+        sol = solve_uniaxial(cluster_network(s, q, build_fem_layout(s, q)), s)
+        errors.append((abs(sol.young / ref.young - 1), abs(sol.poisson / ref.poisson - 1)))
+    e_young, e_nu = np.array(errors).T
+    assert e_young[0] > e_young[1] > e_young[2] and e_young[2] < 2e-3
+    assert e_nu.max() < 1e-2
+
+
+def test_fem_masses_keep_each_cell_whole_and_equalise_the_sphere_periods():
+    p = load_parameters(overrides=SMALL)
+    s = build_specimen(p, 1)
+    lay = build_fem_layout(s, p)
+    per_cell = np.bincount(lay.sphere_cell, weights=lay.sphere_area, minlength=s.n_cells)
+    assert np.allclose(per_cell, s.tessellation.cell_measure, rtol=1e-12)
+    k = node_stiffness(cluster_network(s, p, lay))
+    ratio = lay.sphere_area / k                              # m / K up to the areal density
+    for c in range(3):
+        r = ratio[lay.sphere_cell == c]
+        assert np.allclose(r, r[0], rtol=1e-12)
+
+
+def test_node_stiffness_bounds_the_fastest_mode():
+    """Gershgorin: the largest eigenvalue of K (unit masses) is at most the largest row sum."""
+    p = load_parameters(overrides=SMALL)
+    s = build_specimen(p, 1)
+    net = cluster_network(s, p, build_fem_layout(s, p))
+    k, _ = stiffness_matrix(net)
+    from scipy.sparse.linalg import eigsh
+    lam = eigsh(k, k=1, which="LA", return_eigenvectors=False)[0]
+    bound = node_stiffness(net).max()
+    assert 0.2 * bound < lam <= bound
+
+
+@needs_yade
+@pytest.mark.yade
+def test_yade_element_material_gives_an_exact_linear_tetrahedron():
+    """One Lin4NodeTetra with :func:`fem_element_material`: nodal forces = -K u of a tetrahedron
+    built by hand from the shape-function gradients and the 3D isotropic elasticity matrix."""
+    from grainfrac_yade.yade_adapter import load_yade
+    from grainfrac_yade.yade_adapter.scene import fem_element_material
+    load_yade()
+    from yade import O, utils, Vector3
+    from yade import wrapper as w
+    young, nu = 50e9, 0.3
+    pos = np.array([[0, 0, 0], [1e-3, 0, 0], [0.2e-3, 0.9e-3, 0], [0.3e-3, 0.2e-3, 0.8e-3]])
+    O.reset()
+    ids = [O.bodies.append(utils.sphere(Vector3(*x), 1e-5)) for x in pos]
+    element = w.Lin4NodeTetra()
+    body = w.Body(shape=element, material=w.LinIsoRayleighDampElastMat(**fem_element_material(young, nu)))
+    body.dynamic, body.bounded = False, False
+    O.bodies.append(body)
+    for i in ids:
+        element.addNode(O.bodies[i])
+    u = np.random.default_rng(1).normal(size=(4, 3)) * 1e-6
+    for i, du in zip(ids, u):
+        O.bodies[i].state.pos = Vector3(*(pos[i] + du))
+    O.engines = [w.ForceResetter(), w.FEInternalForceEngine([w.If2_Lin4NodeTetra_LinIsoRayleighDampElast()])]
+    O.dt = 1e-12
+    O.step()
+    force = np.array([tuple(O.forces.f(i)) for i in ids])
+    grad = np.linalg.inv(np.c_[np.ones(4), pos])[1:, :]          # (3, 4) shape-function gradients
+    b = np.zeros((6, 12))
+    for a in range(4):
+        gx, gy, gz = grad[:, a]
+        b[:, 3 * a:3 * a + 3] = [[gx, 0, 0], [0, gy, 0], [0, 0, gz], [gy, gx, 0], [0, gz, gy], [gz, 0, gx]]
+    lam, mu = young * nu / ((1 + nu) * (1 - 2 * nu)), young / (2 * (1 + nu))
+    d = np.zeros((6, 6))
+    d[:3, :3] = lam
+    d[range(3), range(3)] += 2 * mu
+    d[3:, 3:] = mu * np.eye(3)
+    volume = abs(np.linalg.det(np.c_[np.ones(4), pos])) / 6
+    expected = -(volume * b.T @ d @ b @ u.ravel()).reshape(4, 3)
+    assert np.abs(force - expected).max() < 1e-6 * np.abs(expected).max()
+
+
+@needs_yade
+@pytest.mark.yade
+def test_fem_scene_agrees_with_the_static_solve_after_a_small_elastic_ramp():
+    """The YADE scene of finite-element cells is the shrunk mesh that the static solve models:
+    platen stress and every bond's forces agree (measured on 4 x 8 mm seed 1: 7e-6 on the stress,
+    3.8e-4 of the largest bond force)."""
+    from test_elastic import _assert_yade_ramp_matches_static_solve
+    p = load_parameters(overrides=SMALL + ["numerics.damping=0.7"])
+    _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=20000)
+
+
+@needs_yade
+@pytest.mark.yade
+def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
+    from grainfrac_yade.yade_adapter.scene import build_scene
+    p = load_parameters(overrides=SMALL)
+    s = build_specimen(p, 1)
+    scene = build_scene(s, p)
+    assert scene.engine_names() == ["ForceResetter", "InsertionSortCollider", "InteractionLoop",
+                                    "FEInternalForceEngine", "NewtonIntegrator"]
+    O = scene.O
+    # each cell's bodies: its spheres, the apex sphere replaced by the clump that moves it
+    clumps = [b for c in range(s.n_cells) for b in scene.bodies_of([c]) if O.bodies[int(b)].isClump]
+    assert len(clumps) == s.n_cells
+    assert 0 < O.dt <= scene.dt_critical
+    # plain deformable scenes carry no element engine
+    q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=deformable"])
+    assert "FEInternalForceEngine" not in build_scene(build_specimen(q, 1), q).engine_names()
