@@ -341,6 +341,8 @@ def cluster_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
     # guard): the arms play no part
     normal, arm, _, _ = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
                                          c2[pairs[:, 0]], c2[pairs[:, 1]])
+    if layout.bond_normal is not None:       # bonds acting on their face's plane
+        normal[:layout.n_bonds] = layout.bond_normal
     n_links = layout.n_links
     if layout.n_elements:
         tri = layout.element_spheres

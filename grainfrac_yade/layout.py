@@ -50,6 +50,10 @@ class ClumpLayout:
     #: (e, 3) sphere triangles of finite-element cells (``grain_model = "fem"``): each a constant-strain
     #: element of its cell's mineral (plane strain, Table 1), the mesh on which the spheres sit
     element_spheres: np.ndarray | None = None
+    #: (b, 2) unit normal of each bond's face (from the face's cell a to b) where bonds act on their
+    #: face's plane (YADE's smooth-joint kinematics: opening and sliding measured along and across the
+    #: face, as the reference's contacts); None: along the line of the two sphere centres
+    bond_normal: np.ndarray | None = None
     #: fraction of the centroid-to-face distance of grain in series with each bond (1: rigid cells,
     #: whose elasticity lives in the bonds; the inset of deformable cells, whose links carry the rest)
     series_fraction: float = 1.0

@@ -51,6 +51,26 @@ def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes():
     assert e_nu.max() < 1e-2
 
 
+def test_contact_radii_leave_unbonded_spheres_of_different_cells_apart():
+    from grainfrac_yade.deformable import CONTACT_RADIUS_FRACTION, contact_radii
+    from scipy.spatial.distance import cdist
+    p = load_parameters(overrides=SMALL)
+    s = build_specimen(p, 1)
+    lay = build_fem_layout(s, p)
+    pos, r, cell = lay.sphere_center[:, :2], lay.sphere_radius, lay.sphere_cell
+    assert np.array_equal(r, contact_radii(pos, cell, lay.bond_spheres))
+    d = cdist(pos, pos)
+    other = cell[:, None] != cell[None, :]
+    other[lay.bond_spheres[:, 0], lay.bond_spheres[:, 1]] = False
+    other[lay.bond_spheres[:, 1], lay.bond_spheres[:, 0]] = False
+    gap = d - (r[:, None] + r[None, :])
+    assert gap[other].min() >= (1 - CONTACT_RADIUS_FRACTION) * d[other].min() - 1e-15
+    # each sphere's radius is set by one such neighbour: no sphere could be larger
+    assert np.allclose((np.where(other, d, np.inf).min(axis=1)) * 0.5 * CONTACT_RADIUS_FRACTION, r)
+    # bonds act on their faces' planes
+    assert np.allclose(lay.bond_normal, s.tessellation.face_normal[lay.bond_face])
+
+
 def test_fem_masses_keep_each_cell_whole_and_equalise_the_sphere_periods():
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 1)
@@ -121,9 +141,10 @@ def test_yade_element_material_gives_an_exact_linear_tetrahedron():
 @needs_yade
 @pytest.mark.yade
 def test_fem_scene_agrees_with_the_static_solve_after_a_small_elastic_ramp():
-    """The YADE scene of finite-element cells is the shrunk mesh that the static solve models:
-    platen stress and every bond's forces agree (measured on 4 x 8 mm seed 1: 7e-6 on the stress,
-    3.8e-4 of the largest bond force)."""
+    """The YADE scene of finite-element cells is the shrunk mesh that the static solve models, bonds
+    acting along their faces' normals (smooth joints): platen stress and every bond's forces agree
+    (measured on 4 x 8 mm seed 1: 8e-10 on the stress, 5e-9 of the largest bond force; with the
+    bonds along the lines of sphere centres and the static solve along the face normals, 6 %)."""
     from test_elastic import _assert_yade_ramp_matches_static_solve
     p = load_parameters(overrides=SMALL + ["numerics.damping=0.7"])
     _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=20000)
@@ -143,6 +164,10 @@ def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
     clumps = [b for c in range(s.n_cells) for b in scene.bodies_of([c]) if O.bodies[int(b)].isClump]
     assert len(clumps) == s.n_cells
     assert 0 < O.dt <= scene.dt_critical
+    # bonds on their faces' planes: none open at the start, and the law uses smooth joints
+    scene.run(1)
+    assert scene.law.smoothJoint and not scene.bond_separated(range(scene.n_bonds)).any()
+    assert all(i.phys.isOnJoint for i in scene.interactions)
     # plain deformable scenes carry no element engine
     q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=deformable"])
     assert "FEInternalForceEngine" not in build_scene(build_specimen(q, 1), q).engine_names()

@@ -4,6 +4,10 @@ from __future__ import annotations
 import numpy as np
 
 
+#: Static models of the YADE deformable cells and the grain model each one solves.
+CLUSTER_MODELS = {"lattice": "deformable", "fem": "fem"}
+
+
 def register(sub, common):
     from ..elastic import GRAIN_MODELS
     from ..grainmesh import CONTACT_PLACEMENTS
@@ -12,10 +16,10 @@ def register(sub, common):
     common(p)
     p.add_argument("--grains", choices=GRAIN_MODELS, default="deformable",
                    help="rigid: the project's rigid cells and bonds; deformable: triangle-mesh cells with "
-                        "Table 1 moduli (the paper's deformable blocks); lattice: the YADE deformable cells "
-                        "solved statically (default: deformable)")
+                        "Table 1 moduli (the paper's deformable blocks); lattice and fem: the YADE deformable "
+                        "cells (links or finite elements) solved statically (default: deformable)")
     p.add_argument("--nodes-per-face", type=int,
-                   help="deformable and lattice: contact nodes per face (resolution.nodes_per_face, default 2 = "
+                   help="deformable, lattice and fem: contact nodes per face (resolution.nodes_per_face, default 2 = "
                         "UDEC's corner sub-contacts)")
     p.add_argument("--contacts", choices=CONTACT_PLACEMENTS, default="corners",
                    help="deformable: contact nodes at the face ends (trapezoid shares) or sub-segment centres")
@@ -31,8 +35,8 @@ def cmd_elastic(args) -> int:
     from ..params import require_plane
     if args.nodes_per_face is not None:
         args.overrides.append(f"resolution.nodes_per_face={args.nodes_per_face}")
-    if args.grains == "lattice":
-        args.overrides.append("resolution.grain_model=deformable")
+    if args.grains in CLUSTER_MODELS:
+        args.overrides.append(f"resolution.grain_model={CLUSTER_MODELS[args.grains]}")
     params = load_params_from_args(args)
     require_plane(params, "elastic")
     out = args.out or f"results/elastic_seed{args.seed}"
@@ -61,17 +65,17 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     models, ratios = {}, {}
-    # the lattice is always compared with the mesh reference at the same contact nodes per face
-    names = [grains, "rigid"] + (["deformable"] if grains == "lattice" else [])
+    # the YADE cells are always compared with the mesh reference at the same contact nodes per face
+    names = [grains, "rigid"] + (["deformable"] if grains in CLUSTER_MODELS else [])
     for name in dict.fromkeys(names):
         s, net, sol = elastic_summary(specimen, params, name, nodes_per_face, contacts, rings,
                                       platens=platens if name != "rigid" else "cells")
         models[name] = s
         ratios[name] = contact_ratios(net, sol)
     summary = dict(models[grains])
-    if grains == "lattice":
+    if grains in CLUSTER_MODELS:
         ref = models["deformable"]
-        summary["relative_error_vs_reference"] = {k: v / ref[k] - 1.0 for k, v in models["lattice"].items()
+        summary["relative_error_vs_reference"] = {k: v / ref[k] - 1.0 for k, v in models[grains].items()
                                                   if isinstance(v, float) and k in ref and ref[k]}
     summary.update(models=models, seed=seed, n_cells=specimen.n_cells, platens=platens,
                    stiffness_scale=params.calibration.stiffness_scale, code_version=code_version())

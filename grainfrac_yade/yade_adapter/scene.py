@@ -66,6 +66,23 @@ DEFORMABLE_BLOCKED_DOFS = "zXYZ"
 #: them); the DEM then gives the static lattice solve's E and Poisson's ratio (tested; 85.5 GPa,
 #: nu 0.227 with the default).  Rigid cells keep YADE's default.
 DEFORMABLE_RATCHETING_GUARD = False
+#: Collision mask bit shared by every sphere of a scene with per-cell masks (and the collider's
+#: ``avoidSelfInteractionMask``): YADE makes no contact between two bodies of equal masks that
+#: carry this bit, and lets bodies of different masks that share it meet.
+CELL_MASK_BIT = 1
+#: Largest cell index a per-cell mask can hold (YADE's masks are 32-bit signed integers).
+MAX_MASKED_CELLS = 2**30 - 2
+
+
+def cell_mask(cell: int) -> int:
+    """Collision mask of the spheres of ``cell``: unique per cell, with ``CELL_MASK_BIT``, so that
+    spheres of one cell never touch and spheres of different cells do."""
+    if not 0 <= cell <= MAX_MASKED_CELLS:
+        raise GrainfracError(f"cell_mask: cell {cell} beyond the {MAX_MASKED_CELLS} cells a YADE mask can tell "
+                             "apart; fix: use a smaller specimen")
+    return ((cell + 1) << 1) | CELL_MASK_BIT
+
+
 #: Height of the lifted fourth node of finite-element cells over the cell's plane, in specimen
 #: thicknesses [1]: 3, so that each tetrahedron's volume (area x height / 3) is the triangle's area
 #: x the specimen's thickness, and its stiffness the plane-strain triangle's.
@@ -181,8 +198,7 @@ class GrainScene:
             elif tens_new == 0:
                 mode = SHEAR
             else:  # both kinds in one step: an opening bond broke in tension
-                geom = self.interactions[k].geom
-                mode = TENSION if geom.penetrationDepth - phys.initD < 0 else SHEAR
+                mode = TENSION if self.bond_separated([k])[0] else SHEAR
             self.break_mode[k] = mode
             phys.tanFrictionAngle = float(self.tan_residual[k])
         self.broken[new] = True
@@ -210,19 +226,35 @@ class GrainScene:
     def bond_forces(self, indices=None):
         """Normal force (tension positive) and shear force magnitude [N] of bonds.
 
-        Reads ``kn * (penetrationDepth - initD)`` (the law's own normal force,
-        compression positive) and ``|shearForce|``; about 2-3 us per bond.
+        Reads the law's normal force (along the line of centres, or along the face normal for
+        bonds on their face's plane) and ``|shearForce|``; about 2-3 us per bond.
         """
         idx = np.arange(self.n_bonds) if indices is None else np.asarray(indices)
         fn = np.empty(len(idx))
         fs = np.empty(len(idx))
         inter = self.interactions
+        on_face = self.layout.bond_normal is not None
         for n, k in enumerate(idx):
             i = inter[k]
             phys = i.phys
-            fn[n] = -phys.normalForce.dot(i.geom.normal)
+            fn[n] = -phys.normalForce.dot(phys.jointNormal if on_face else i.geom.normal)
             fs[n] = phys.shearForce.norm()
         return fn, fs
+
+    def bond_separated(self, indices) -> np.ndarray:
+        """(n,) True where a bond's spheres are further apart than when it was made (an open crack):
+        along the line of centres (penetration below its initial value), or across the face for bonds
+        on their face's plane (YADE's smooth joint: |(x_b - x_a) . n| above its initial value)."""
+        inter = self.interactions
+        if self.layout.bond_normal is None:
+            return np.array([inter[k].geom.penetrationDepth - inter[k].phys.initD < 0 for k in indices], dtype=bool)
+        bodies = self.O.bodies
+        out = []
+        for k in indices:
+            i = inter[k]
+            gap = abs((bodies[i.id2].state.pos - bodies[i.id1].state.pos).dot(i.phys.jointNormal))
+            out.append(i.phys.initD - gap < 0)
+        return np.array(out, dtype=bool)
 
     def cell_positions(self, cells=None) -> np.ndarray:
         """(n, 3) current positions of cells [m]: the body (rigid), the mass centre of the spheres (deformable)."""
@@ -416,6 +448,26 @@ def _append_deformable_cells(O, utils, Vector3, specimen, layout, mats, mass, in
     return sphere_body, sphere_body[nearest], [sphere_body[m] for m in members]
 
 
+def _without_native_stdout(make):
+    """``make()`` with the process's standard output sent to /dev/null (YADE's FEInternalForceEngine
+    constructor prints two debugging lines from C++)."""
+    import ctypes
+    import os
+    import sys
+    libc = ctypes.CDLL(None)
+    sys.stdout.flush()
+    libc.fflush(None)
+    saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    try:
+        return make()
+    finally:
+        libc.fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
+
 def fem_element_material(young: float, poisson: float) -> dict:
     """Arguments of YADE's ``LinIsoRayleighDampElastMat`` that make ``Lin4NodeTetra`` an exact linear
     tetrahedron of Young's modulus ``young`` [Pa] and Poisson's ratio ``poisson`` (3D isotropic).
@@ -518,16 +570,20 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             young=g.young, poisson=g.poisson, density=g.density, type=COHESIVE_TYPE,
             frictionAngle=c.friction_angle, residualFrictionAngle=c.residual_friction_angle,
             tensileStrength=1.0, cohesion=1.0)))
-    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True)
+    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True,
+                                                               smoothJoint=layout.bond_normal is not None)
     geometry = w.Ig2_Sphere_Sphere_ScGeom()
     if not layout.rigid_cells:
         geometry.avoidGranularRatcheting = DEFORMABLE_RATCHETING_GUARD
     newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
+    # spheres larger than their bond gaps (bonds on face planes): one collision mask per cell
+    per_cell_masks = layout.bond_normal is not None
     # finite-element cells: their elements' internal forces, before the integrator
-    elements = [w.FEInternalForceEngine([w.If2_Lin4NodeTetra_LinIsoRayleighDampElast()])] if layout.n_elements else []
+    elements = ([_without_native_stdout(lambda: w.FEInternalForceEngine([w.If2_Lin4NodeTetra_LinIsoRayleighDampElast()]))]
+                if layout.n_elements else [])
     O.engines = [
         w.ForceResetter(),
-        w.InsertionSortCollider([w.Bo1_Sphere_Aabb()]),
+        w.InsertionSortCollider([w.Bo1_Sphere_Aabb()], avoidSelfInteractionMask=CELL_MASK_BIT if per_cell_masks else 0),
         w.InteractionLoop([geometry],
                           [w.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)], [law]),
         *elements,
@@ -555,8 +611,14 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         ph.FsMax = float(props.cohesion[k]) * area
         ph.tanFrictionAngle = float(tan_phi[k])
         ph.crossSection = area
+        if layout.bond_normal is not None:
+            ph.isOnJoint = True
+            ph.jointNormal = Vector3(*layout.bond_normal[k], 0.0)
         interactions.append(inter)
     links = _create_links(utils, specimen, layout, params, sphere_body)
+    if per_cell_masks:
+        for m, body in enumerate(sphere_body):
+            O.bodies[int(body)].mask = cell_mask(int(layout.sphere_cell[m]))
     if layout.n_elements:
         clump_of = _append_fem_elements(O, w, utils, Vector3, specimen, params, layout, sphere_body, mats, mass)
         # the bodies that move: a clump in place of each apex sphere
