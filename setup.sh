@@ -2,8 +2,10 @@
 # Installs what grainfrac-yade needs on Debian bookworm, if missing. Idempotent.
 # YADE and the scientific stack all come from Debian, so they share one numpy
 # and run on Debian's /usr/bin/python3 (whatever python3 is first on PATH).
+# slurm-wlm and munge: SLURM's daemons and clients for `submit` / `status`; their tests start their
+# own single-node cluster from a generated slurm.conf (nothing is configured here).
 set -euo pipefail
-PACKAGES="yade python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest git"
+PACKAGES="yade python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest git slurm-wlm munge"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

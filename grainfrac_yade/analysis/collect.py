@@ -1,4 +1,4 @@
-"""Collect run folders into one pandas DataFrame (one row per run; unfinished and unreadable runs kept)."""
+"""Collect run folders into one pandas DataFrame (one row per run; unfinished, failed and unreadable runs kept)."""
 from __future__ import annotations
 
 import json
@@ -41,20 +41,26 @@ def _read_json(path: Path) -> dict:
 
 
 def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
-    """One row per folder under ``root`` holding a run.json.
+    """One row per folder under ``root`` holding a run.json or a failed.json, plus, in a SLURM study
+    (``root/slurm/study.json``, :mod:`grainfrac_yade.slurm`), one per row without such a folder yet.
 
-    ``status`` is ``finished`` (summary.json present), ``unfinished`` (no summary.json yet) or
+    ``status`` is ``finished`` (summary.json present), ``unfinished`` (no summary.json yet),
+    ``failed`` (no summary.json, and a failed.json holding the error line of a batch task that ended
+    without one: ``problem``), ``pending`` (a SLURM row not started or without a folder yet) or
     ``unreadable`` (a JSON file that cannot be parsed; ``problem`` says which). ``folder`` is the
     run folder's path. With ``all_params`` every parameter of params.json becomes a column
     (dotted name); otherwise only :data:`PARAM_COLUMNS`.
     """
+    from ..slurm import FAILED, rows_without_runs
     root = Path(root)
     rows = []
-    for run_json in sorted(root.rglob("run.json")):
-        folder = run_json.parent
+    folders = sorted({p.parent for p in root.rglob("run.json")} | {p.parent for p in root.rglob(FAILED)})
+    for folder in folders:
+        run_json = folder / "run.json"
         row = {"run": str(folder.relative_to(root)) if folder != root else ".", "folder": str(folder)}
         try:
-            run = _read_json(run_json)
+            failed = _read_json(folder / FAILED) if (folder / FAILED).exists() else None
+            run = _read_json(run_json) if run_json.exists() else {k: failed.get(k) for k in ("command", "seed")}
             row.update({"command": run.get("command"), "seed": run.get("seed")})
             params_file = folder / "params.json"
             if params_file.exists():
@@ -65,11 +71,15 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
                 summary = _read_json(summary_file)
                 row.update({k: v for k, v in summary.items() if not isinstance(v, (dict, list))})
                 row["status"] = "finished"
+            elif failed is not None:
+                row.update(status="failed", problem=f"run failed: {failed.get('error') or 'no error line recorded'}"
+                           + (f" (log {failed['log']})" if failed.get("log") else ""))
             else:
                 row["status"] = "unfinished"
         except ValueError as exc:
             row.update(status="unreadable", problem=str(exc))
         rows.append(row)
+    rows += rows_without_runs(root, folders)
     return pd.DataFrame(rows)
 
 

@@ -8,7 +8,8 @@ Outcome of each run folder (column ``outcome``):
   lifetime, drawn but not fitted;
 - ``numerical failure``: the run stopped on NaN/inf numbers or a stalled clock (summary key
   ``numerical_failure``): no result, listed with its reason, never a lifetime or a lower bound;
-- ``unfinished``: no summary.json yet (running, killed or crashed);
+- ``unfinished``: no summary.json yet (running, killed or crashed, or a SLURM row not started yet);
+- ``run error``: no summary.json, and the batch task that ran it recorded an error (failed.json);
 - ``unreadable``: a JSON file that cannot be parsed, or a summary that contradicts itself;
 - ``not creep``: another command's run in the same folder (e.g. a UCS test), ignored.
 """
@@ -39,6 +40,8 @@ def outcome(row) -> str:
         return "unreadable"
     if row.get("command") != "creep":
         return "not creep"
+    if row.get("status") == "failed":
+        return "run error"
     if row.get("status") != "finished":
         return "unfinished"
     if row.get("numerical_failure") in (True, 1):

@@ -115,13 +115,16 @@ def render_report(c: ReportContent) -> str:
             lines += ([">"] if k else []) + [f"> {t}"]
         lines.append("")
     lines += ["## Runs", "",
-             "Every folder holding a run.json is listed. Outcomes: *failed* (lifetime = creep time at failure, "
+             "Every folder holding a run.json or failed.json is listed, and every SLURM row without one. "
+             "Outcomes: *failed* (lifetime = creep time at failure, "
              "fitted), *failed at load* (failed at creep time 0: no creep life, not in the log fit), "
              "*not failed* (the run ended without failure: its end time is a lower bound of the lifetime, drawn "
              "as an open marker with an arrow and **not used in the fit**), *numerical failure* (the run stopped on NaN or "
              "infinite numbers or a stalled creep clock, reason in failure_reason: no result, neither a lifetime "
              "nor a lower bound), *unfinished* (no summary.json: "
-             "running, stopped or crashed), *unreadable* (a JSON file that cannot be parsed, or a failed run without a "
+             "running, stopped or crashed, or a SLURM row not started yet), *run error* (no summary.json; the batch "
+             "task that ran it failed and recorded its error line in failed.json, shown as problem), "
+             "*unreadable* (a JSON file that cannot be parsed, or a failed run without a "
              "valid lifetime).", "",
              markdown_table(_runs_for_table(c), RUN_COLUMNS), ""]
     lines += ["## Lifetime vs driving-stress ratio (paper Fig. 4)", "",

@@ -29,7 +29,7 @@ MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
 #: Parameters that do not make a different model (a longer time limit is the same model).
 VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",)
 #: Outcomes of creep runs that belong to a model variant.
-CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "unfinished")
+CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "unfinished", "run error")
 #: Columns of runs.csv (those present).
 RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
              "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "mode", "n_events",
@@ -44,18 +44,31 @@ def _fmt_value(v) -> str:
     return f"{v:g}" if isinstance(v, float) else str(v)
 
 
+#: Variant of creep rows without parameters yet (a SLURM row not started, a task that failed before its
+#: run folder held params.json) in a study of several variants.
+NO_PARAMS_VARIANT = "parameters not written yet"
+
+
 def variant_labels(runs: pd.DataFrame) -> pd.Series:
-    """Label per run naming the parameters that differ among the creep runs ("model" if none)."""
+    """Label per run naming the parameters that differ among the creep runs ("model" if none).
+
+    Rows without parameters (no params.json yet) name no variant: they join the study's only one, or
+    :data:`NO_PARAMS_VARIANT` when there are several."""
     creep = runs["outcome"].isin(CREEP_OUTCOMES)
+    has = runs["specimen.width"].notna() if "specimen.width" in runs else pd.Series(False, index=runs.index)
+    basis = creep & has if (creep & has).any() else creep
     keys = [c for c in runs.columns if "." in c and c not in VARIANT_IGNORE
-            and runs.loc[creep, c].astype(str).nunique() > 1]
+            and runs.loc[basis, c].astype(str).nunique() > 1]
     if not keys:
         return pd.Series(np.where(creep, "model", ""), index=runs.index)
     short = {k: k.split(".")[-1] for k in keys}
     if len(set(short.values())) < len(keys):
         short = {k: k for k in keys}
     labels = [", ".join(f"{short[k]}={_fmt_value(r[k])}" for k in keys) if ok else ""
-              for ok, r in zip(creep, runs.to_dict("records"))]
+              for ok, r in zip(basis, runs.to_dict("records"))]
+    known = sorted({lab for lab, ok in zip(labels, basis) if ok})
+    fill = known[0] if len(known) == 1 else NO_PARAMS_VARIANT
+    labels = [fill if c and not b else lab for lab, c, b in zip(labels, creep, basis)]
     return pd.Series(labels, index=runs.index)
 
 
@@ -110,11 +123,13 @@ def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
         if col not in runs:
             runs[col] = np.nan if col != "problem" else None
     runs["problem"] = runs["problem"].astype(object)
-    for i in runs.index[runs["outcome"] == "unfinished"]:
+    for i in runs.index[runs["outcome"].isin(("unfinished", "run error"))]:
         hist = read_history(runs.at[i, "folder"], runs.at[i, "time_factor"])
         reach = f"; history.csv reaches t = {hist['creep_time_s'].iloc[-1]:.4g} s" if hist is not None and len(hist) \
             else ""
-        runs.at[i, "problem"] = "no summary.json (running, stopped or crashed)" + reach
+        known = runs.at[i, "problem"]   # a failed task's error, a SLURM row not started yet
+        runs.at[i, "problem"] = (known if isinstance(known, str) and known else
+                                 "no summary.json (running, stopped or crashed)") + reach
     for i in runs.index[runs["outcome"] == "numerical failure"]:
         runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else "numerical failure"
     runs.attrs["filled"] = filled
@@ -354,6 +369,8 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         note += f"; {n_load} failed at load (t = 0, not in the log fit)" if n_load else ""
         n_num = int((g["outcome"] == "numerical failure").sum())
         note += f"; {n_num} numerical failure(s) (no result: not fitted, not a lower bound)" if n_num else ""
+        n_err = int((g["outcome"] == "run error").sum())
+        note += f"; {n_err} run error(s) (the task failed, error in problem: not used)" if n_err else ""
         note += f"; {int((g['outcome'] == 'unfinished').sum())} unfinished (not used)."
         content.fit_notes.append(note)
     lab_set = None

@@ -108,6 +108,23 @@ def run_folder_name(controls: dict, overrides) -> str:
     return re.sub(r"[^A-Za-z0-9_.=+-]+", "_", desc).strip("_") or f"seed{controls['seed']}"
 
 
+#: Environment variable naming a JSON file in which a row records the run folder it chose (set by the SLURM
+#: task wrapper, :mod:`grainfrac_yade.slurmtask`; the same name as ``grainfrac_yade.slurm.ROW_FOLDER_ENV``).
+ROW_FOLDER_ENV = "GRAINFRAC_ROW_FOLDER_FILE"
+
+
+def record_row_folder(out: Path) -> Path:
+    """Write ``{"folder": <absolute out>}`` to the file named by :data:`ROW_FOLDER_ENV`, if set; return ``out``.
+
+    A SLURM task learns this way where its row runs (to mark it failed there, and to tell finished rows)."""
+    target = os.environ.get(ROW_FOLDER_ENV)
+    if target:
+        from ..runio import write_json
+        Path(target).parent.mkdir(parents=True, exist_ok=True)
+        write_json(target, {"folder": str(Path(out).resolve())})
+    return out
+
+
 def row_folder(out, params, controls: dict, run_values: dict) -> tuple:
     """(folder, done): the folder a batch row runs into, and whether it already holds this row's finished run.
 
@@ -118,10 +135,10 @@ def row_folder(out, params, controls: dict, run_values: dict) -> tuple:
     """
     out = Path(out)
     if not (out / SUMMARY).exists():
-        return out, False
+        return record_row_folder(out), False
     diffs = stored_run_differences(out, params, run_values)
     if not diffs:
-        return out, True
+        return record_row_folder(out), True
     if controls.get("on_change") == "new_folder":
         new = out.with_name(f"{out.name}_{run_digest(params, run_values)}")
         return row_folder(new, params, dict(controls, on_change="stop"), run_values)
