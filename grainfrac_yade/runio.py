@@ -28,6 +28,16 @@ RUN_MARKERS = ("run.json",)
 SUMMARY = "summary.json"
 #: Parameter-tree entries that record provenance, not the model: never compared between runs.
 PROVENANCE_KEYS = ("sources",)
+#: Parameters that do not change what a run computes (how often it is checkpointed): never compared
+#: between runs, and not part of :func:`run_digest`.
+RESULT_NEUTRAL_KEYS = ("creep.checkpoint_interval",)
+#: Checkpoint of an unfinished run (creep ``--resume``): ``<run>/checkpoint/`` holds the DEM scene and
+#: :data:`CHECKPOINT_STATE`, the driver's state, written last.  A new checkpoint is written into
+#: ``checkpoint.tmp/`` and renamed; the previous one is moved aside to ``checkpoint.old/`` for the
+#: instant between the two renames (:func:`checkpoint_folder` picks the complete one).
+CHECKPOINT = "checkpoint"
+CHECKPOINT_STATE = "state.json"
+CHECKPOINT_TMP, CHECKPOINT_OLD = CHECKPOINT + ".tmp", CHECKPOINT + ".old"
 
 
 def code_version() -> str:
@@ -105,6 +115,7 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
                              "or pass --overwrite to replace it")
     out.mkdir(parents=True, exist_ok=True)
     (out / SUMMARY).unlink(missing_ok=True)
+    remove_checkpoints(out)   # a checkpoint of the replaced run must never be resumed into this one
     write_json(out / "params.json", params.to_dict())
     write_json(out / "run.json", {
         "command": command, "argv": list(sys.argv if argv is None else argv), "seed": seed,
@@ -114,12 +125,78 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
     return out
 
 
+def remove_checkpoints(folder) -> None:
+    """Delete a run folder's checkpoint folders (a finished or replaced run has nothing to resume)."""
+    import shutil
+    for name in (CHECKPOINT, CHECKPOINT_TMP, CHECKPOINT_OLD):
+        shutil.rmtree(Path(folder) / name, ignore_errors=True)
+
+
+def checkpoint_folder(folder) -> Path | None:
+    """The complete checkpoint of run ``folder``, or None.
+
+    ``checkpoint/`` if present (it only ever appears by renaming a complete one); else, after a
+    kill between the two renames of a rewrite, ``checkpoint.tmp/`` if its state file (written last)
+    is there, else ``checkpoint.old/``.
+    """
+    folder = Path(folder)
+    for name in (CHECKPOINT, CHECKPOINT_TMP, CHECKPOINT_OLD):
+        if (folder / name / CHECKPOINT_STATE).is_file():
+            return folder / name
+    return None
+
+
+def read_checkpoint_state(folder) -> dict | None:
+    """The driver state of run ``folder``'s checkpoint (JSON), or None if it has none or it is unreadable."""
+    where = checkpoint_folder(folder)
+    if where is None:
+        return None
+    try:
+        state = json.loads((where / CHECKPOINT_STATE).read_text())
+    except (OSError, ValueError):
+        return None
+    return state if isinstance(state, dict) else None
+
+
+def checkpoint_differences(folder, params, run_values: dict) -> list | None:
+    """What differs between the checkpoint in run ``folder`` and a run of ``params`` with ``run_values``.
+
+    None if the folder holds no readable checkpoint; else "key: stored X, now Y" strings ([] if the
+    checkpoint continues exactly this run: the folder's params.json and the checkpoint's run values
+    equal the given ones).
+    """
+    state = read_checkpoint_state(folder)
+    if state is None:
+        return None
+    try:
+        stored = comparable_parameters(json.loads((Path(folder) / "params.json").read_text()))
+    except (OSError, ValueError) as exc:
+        return [f"stored parameters unreadable ({type(exc).__name__}: {exc})"]
+    now = comparable_parameters(params.to_dict())
+    missing = "(missing)"
+    diffs = [f"{key}: stored {stored.get(key, missing)!r}, now {now.get(key, missing)!r}"
+             for key in sorted(set(stored) | set(now)) if not _same(stored.get(key, missing), now.get(key, missing))]
+    stored_values = state.get("run_values", {})
+    for key, value in flatten_values(run_values).items():
+        old = flatten_values(stored_values).get(key, missing)
+        if not _same(old, value):
+            diffs.append(f"{key}: stored {old!r}, now {value!r}")
+    return diffs
+
+
+def flatten_values(values: dict) -> dict:
+    """``run_values`` as JSON stores them, flattened to dotted keys."""
+    from .params import flatten
+    return flatten(json.loads(json.dumps(_clean(values))))
+
+
 def comparable_parameters(tree: dict) -> dict:
     """A parameter tree (``Parameters.to_dict()`` or a params.json) as {dotted key: value} as JSON
-    stores it, without the provenance entries (:data:`PROVENANCE_KEYS`)."""
+    stores it, without the provenance entries (:data:`PROVENANCE_KEYS`) and the parameters that do
+    not change results (:data:`RESULT_NEUTRAL_KEYS`)."""
     from .params import flatten
     tree = json.loads(json.dumps(_clean({k: v for k, v in tree.items() if k not in PROVENANCE_KEYS})))
-    return flatten(tree)
+    return {k: v for k, v in flatten(tree).items() if k not in RESULT_NEUTRAL_KEYS}
 
 
 def _same(a, b) -> bool:

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
-from ..runio import write_csv
+from ..runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crackmaps, figures, rescale
 from .collect import collect_runs, flatten
 from .figures import Curve, LifetimeSet
@@ -26,8 +26,9 @@ from .runparams import default_tree, rebuild_specimen
 
 #: Fractions of the lifetime (or of the run's end time) at which crack maps are drawn (paper Fig. 7).
 MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
-#: Parameters that do not make a different model (a longer time limit is the same model).
-VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",)
+#: Parameters that do not make a different model (a longer time limit is the same model; how often a run
+#: was checkpointed changes nothing it computes).
+VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
 #: Outcomes of creep runs that belong to a model variant.
 CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "unfinished", "run error")
 #: Columns of runs.csv (those present).

@@ -15,7 +15,7 @@ MAP_FRACTIONS = (0.0, 0.5, 0.9, 1.0)
 def register(sub, common):
     p = sub.add_parser("creep", help="constant-load creep test to failure with stress corrosion")
     common(p)
-    load = p.add_mutually_exclusive_group(required=True)
+    load = p.add_mutually_exclusive_group()
     load.add_argument("--stress", type=float, help="creep stress [Pa], e.g. 160e6")
     load.add_argument("--ratio", type=float, help="driving-stress ratio sigma/sigma_c (sigma_c: --ucs, else "
                                                   "calibration.reference_ucs, the calibrated mean UCS)")
@@ -24,6 +24,10 @@ def register(sub, common):
     p.add_argument("--vtk-times", type=_times, default=None, metavar="T1,T2,...",
                    help="write VTK files of cells and bonds (state, remaining strength) for ParaView at these "
                         "creep times [s] and at the end, into DIR/vtk/ (e.g. --vtk-times 0,1e7)")
+    p.add_argument("--resume", metavar="DIR",
+                   help="go on with the interrupted creep run in DIR from its last checkpoint (DIR/checkpoint/, "
+                        "written at the end of the ramp and every creep.checkpoint_interval s); load, seed and "
+                        "parameters come from DIR")
     p.set_defaults(func=cmd_creep)
 
 
@@ -68,9 +72,29 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None):
     return stress, stress / ref, ref
 
 
+#: Options that shape a run: refused with --resume (the run folder holds them).
+RESUME_CONFLICTS = (("stress", "--stress"), ("ratio", "--ratio"), ("ucs", "--ucs"), ("clock", "--clock"),
+                    ("overrides", "--set"), ("params", "--params"), ("width", "--width"), ("height", "--height"),
+                    ("grain_size", "--grain-size"), ("spheres_per_cell", "--spheres-per-cell"),
+                    ("vtk_times", "--vtk-times"), ("out", "--out"), ("overwrite", "--overwrite"))
+
+
 def cmd_creep(args) -> int:
     from ..cli import load_params_from_args
     from ..params import require_plane
+    if args.resume:
+        given = [flag for attr, flag in RESUME_CONFLICTS if getattr(args, attr, None) not in (None, [], False)]
+        if given:
+            raise GrainfracError(f"--resume {args.resume} takes the load, seed and parameters from the run folder; "
+                                 f"fix: drop {', '.join(given)}")
+        s = resume_creep_folder(args.resume, progress=print)
+        if s is None:
+            print(f"creep run already finished (summary.json): {args.resume}; nothing to resume")
+            return 0
+        print(f"creep {s['stress_pa'] / 1e6:.1f} MPa (ratio {s['driving_stress_ratio']:.3f}), {s['clock']} clock, "
+              f"resumed: {outcome(s)}, {s['n_events']} events, {s['broken_creep']} creep cracks, {s['dem_steps']} "
+              f"DEM steps -> {args.resume}")
+        return 0
     if args.clock:
         args.overrides.append(f"stress_corrosion.clock={args.clock}")
     params = load_params_from_args(args)
@@ -84,9 +108,45 @@ def cmd_creep(args) -> int:
     return 0
 
 
+def resume_creep_folder(folder, progress=None) -> dict | None:
+    """Go on with the interrupted creep run in ``folder`` from its checkpoint; its summary, or None if
+    the run is already finished.  Parameters (params.json), seed and load (the checkpoint) are the
+    run's own; GrainfracError (one line) if the folder holds no creep run or no checkpoint."""
+    import json
+
+    from ..analysis.runparams import load_run_parameters
+    from ..runio import CHECKPOINT, SUMMARY, read_checkpoint_state
+    folder = Path(folder)
+    try:
+        command = json.loads((folder / "run.json").read_text()).get("command")
+    except (OSError, ValueError, AttributeError):
+        raise GrainfracError(f"{folder}: no run here (run.json missing or unreadable); fix: give the --out folder "
+                             "of a creep run") from None
+    if command != "creep":
+        raise GrainfracError(f"{folder}: holds a {command!r} run, not a creep run; fix: give the folder of a creep run")
+    if (folder / SUMMARY).exists():
+        return None
+    state = read_checkpoint_state(folder)
+    if state is None:
+        raise GrainfracError(f"{folder}: no checkpoint to resume from ({CHECKPOINT}/ missing: the run stopped before "
+                             "the end of its ramp, or was started by code without checkpoints); fix: start it again "
+                             "with the same command (run.json) and --overwrite")
+    values = state.get("run_values") or {}
+    if not all(k in values for k in ("seed", "stress_pa", "driving_stress_ratio", "ucs_pa")):
+        raise GrainfracError(f"{folder}: the checkpoint lacks the run's seed and load; fix: start the run again "
+                             "with --overwrite")
+    params = load_run_parameters(folder).params
+    return run_creep_to_folder(params, int(values["seed"]), folder, values["stress_pa"],
+                               values["driving_stress_ratio"], values["ucs_pa"], progress=progress, resume=True)
+
+
 def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None,
-                        vtk_times=None) -> dict:
+                        vtk_times=None, resume=False) -> dict:
     """Run a creep test into ``out``; summary.json is written last (it marks the run finished).
+
+    Checkpoints go to ``out/checkpoint/`` during the run (end of the ramp, then every
+    ``creep.checkpoint_interval`` s) and are removed once summary.json is written.  ``resume``: go on
+    from the checkpoint in ``out`` instead of starting (``out`` keeps its run.json and params.json).
 
     A numerical failure (NaN/inf, a stalled clock) gives ``numerical_failure: true``, ``failed:
     null`` (unknown) and ``lifetime_s: null``, with the reason in ``failure_reason``.
@@ -96,18 +156,27 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..creep_analysis import creep_stages, damage_index
     from ..plotting import crack_map
     from ..params import require_plane
-    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
+    from ..runio import (prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
+                         write_json)
     from ..specimen import build_specimen
-    from ..yade_adapter.creep_test import run_creep
+    from ..yade_adapter.creep_test import resume_creep, run_creep
     from ..yade_adapter.scene import bond_segments, broken_counts
     t0 = time.time()
     require_plane(params, "creep")
-    out = prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
+    out = Path(out) if resume else prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
-    outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", history_columns(rows))}
-    if vtk_times is not None:
-        outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
-    run = run_creep(specimen, params, stress, progress=progress, **outputs)
+    outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", history_columns(rows)),
+               "run_values": {"seed": seed, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs}}
+    if resume:
+        state = read_checkpoint_state(out) or {}
+        if state.get("run", {}).get("vtk"):
+            outputs.update(vtk_folder=out / "vtk")
+        run = resume_creep(specimen, params, stress, out, progress=progress, **outputs)
+        t0 -= state.get("wall_s", 0.0)   # wall time of the run up to its checkpoint
+    else:
+        if vtk_times is not None:
+            outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
+        run = run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
     numerical = bool(run.numerical_failure)
     rows = run.rows or [_row_before_history(run, broken_counts(run.scene))]
     hist = history_columns(rows)
@@ -135,6 +204,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "vtk_creep_times_s": run.vtk_written,
         **summary_header(params, seed),
     }
+    if getattr(run, "resumes", None):
+        summary["resumed_from"] = run.resumes   # checkpoints this run went on from (only in resumed runs)
     if run.initial_bond_stresses is not None:
         write_csv(out / "bond_stresses_start.csv", run.initial_bond_stresses)
         bond_stress_figure(run.initial_bond_stresses, stress, out / "bond_stresses_start.png")
@@ -151,6 +222,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                   title=f"{stress / 1e6:.0f} MPa: cracks at t = {t:.4g} s ({frac:.0%} of "
                         f"{'lifetime' if lifetime else 'run'})")
     write_json(out / "summary.json", summary)   # last: marks the run finished
+    remove_checkpoints(out)                     # a finished run has nothing to resume
     return summary
 
 
@@ -257,10 +329,11 @@ def run_creep_in_yade():
     parameter path.  A row whose folder already holds a summary.json is skipped (a study can be
     rerun to complete it) if its stored parameters, seed and load equal the row's, else the row
     stops with one line (see :mod:`grainfrac_yade.yade_adapter.batch`, column ``on_change``); an
-    unfinished folder is started again.
+    unfinished folder goes on from its checkpoint if that is of this row (same parameters, seed and
+    load), else it is started again.
     """
     from ..params import load_parameters, require_plane
-    from ..yade_adapter.batch import read_table, row_errors, row_folder, run_folder_name
+    from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
     with row_errors():
         overrides, controls = read_table(CREEP_ROW_COLUMNS)
         params = load_parameters(overrides=overrides)
@@ -270,11 +343,15 @@ def run_creep_in_yade():
         name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
         name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
         name = run_folder_name(controls, name_parts + overrides)
-        out, done = row_folder(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
-                               {"seed": int(controls["seed"]), "stress_pa": stress})
-    if done:
+        out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
+                                     {"seed": int(controls["seed"]), "stress_pa": stress})
+    if action == "skip":
         print(f"creep row already finished, skipped: {out}")
         return
+    if note:
+        print(note)
+    if action == "resume":
+        print(f"creep row unfinished, resumed from its checkpoint: {out}")
     s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
-                            overwrite=(out / "run.json").exists(), progress=print)
+                            overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume")
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {outcome(s)} -> {out}")

@@ -10,7 +10,8 @@ that run's stored parameters (params.json) and run values (seed, load) equal the
 row's; otherwise the row stops with one line naming the folder and the keys that
 differ, or, with ``on_change`` = ``'new_folder'``, runs into ``<folder>_<digest>``
 (:func:`grainfrac_yade.runio.run_digest` of its parameters), skipped in turn once
-finished there.
+finished there.  An unfinished creep row whose folder holds a checkpoint of the same
+parameters and run values goes on from it (:func:`row_plan`); otherwise it starts again.
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from pathlib import Path
 
 from ..errors import GrainfracError
 from ..params import default_files, flatten, nearest_key, read_toml
-from ..runio import SUMMARY, run_digest, stored_run_differences
+from ..runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
 from . import load_yade
 
 #: Table columns that are not model parameters: run controls, with defaults.
@@ -145,6 +146,25 @@ def row_folder(out, params, controls: dict, run_values: dict) -> tuple:
     raise GrainfracError(f"{out}: holds a finished run with other parameters ({'; '.join(diffs)}); fix: give the "
                          "row another out or study, remove the folder, or add a column on_change with 'new_folder' "
                          "to run it into a new folder")
+
+
+def row_plan(out, params, controls: dict, run_values: dict) -> tuple:
+    """(folder, action, note): what a batch row of a resumable run (creep) does with its folder.
+
+    ``action``: "skip" (the folder holds this row's finished run, :func:`row_folder`), "resume" (an
+    unfinished run of this row with a checkpoint: same parameters, apart from those that do not change
+    results, and the same run values), or "run" (start; an unfinished run without a usable checkpoint is
+    replaced).  ``note``: why a checkpoint is not used ("" otherwise).
+    """
+    out, done = row_folder(out, params, controls, run_values)
+    if done:
+        return out, "skip", ""
+    diffs = checkpoint_differences(out, params, run_values)
+    if diffs is None:
+        return out, "run", ""
+    if diffs:
+        return out, "run", f"{out}: its checkpoint is of another run ({'; '.join(diffs)}): started again"
+    return out, "resume", ""
 
 
 @contextmanager

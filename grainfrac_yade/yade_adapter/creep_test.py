@@ -17,6 +17,11 @@ Numerical failure: NaN or infinite forces, stresses or strains (the DEM blew
 up), or ``MAX_STALLED_INTERVALS`` creep intervals of length 0 in a row that
 break no bond, end the run with ``numerical_failure`` set and the reason in
 ``failure_reason``: neither a lifetime nor a survival.
+
+Checkpoints (given a run folder): at the end of the ramp and then every
+``creep.checkpoint_interval`` s of wall time, at a safe point of the clock loops
+(:meth:`CreepRun.safe_point`); :func:`resume_creep` goes on from the last one and
+computes what the uninterrupted run would have (:mod:`.checkpoint`).
 """
 from __future__ import annotations
 
@@ -57,7 +62,7 @@ class CreepRun:
     """State and bookkeeping of one creep test."""
 
     def __init__(self, specimen, params, target_stress, progress=None, vtk_folder=None, vtk_times=(),
-                 history_sink=None):
+                 history_sink=None, checkpoint_folder=None, run_values=None):
         self.params, self.target = params, target_stress
         #: VTK snapshots: folder and the creep times [s] still to write (the first equilibrium state
         #: at or after each time; the final state is always written when a folder is given)
@@ -83,6 +88,16 @@ class CreepRun:
         self.break_time = np.full(self.scene.n_bonds, np.nan)
         #: creep time at which each bond's face was first seen fully separated (macrocrack) [s]
         self.macro_time = np.full(self.scene.n_bonds, np.nan)
+        #: writes checkpoints into ``checkpoint_folder`` (a run folder), None: no checkpoints
+        self.checkpointer = None
+        if checkpoint_folder is not None:
+            from .checkpoint import Checkpointer
+            self.checkpointer = Checkpointer(checkpoint_folder, params.creep.checkpoint_interval, run_values or {},
+                                             self.progress)
+        #: (phase, loop counters) to go on from after :func:`resume_creep`; None: a run from the start
+        self.resumed = None
+        #: the checkpoints this run was resumed from (DEM step, creep time, phase, when written)
+        self.resumes = []
 
     # ------------------------------------------------------------------ measures
     def unbalanced(self, mean_bond_force):
@@ -199,16 +214,28 @@ class CreepRun:
                 "tensile_utilisation": sigma / jt, "shear_utilisation": np.where(limit > 0, tau / limit, np.inf),
                 "inter": self.scene.bond_is_inter[idx]}
 
-    def run_event_clock(self):
-        self.clock = EventClock(self.params.stress_corrosion.max_strength_loss_fraction,
-                                self.params.stress_corrosion.creep_time_limit)
-        self.n_events = event_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion)
+    def run_event_clock(self, resume=None):
+        """Event clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it)."""
+        if resume is None:
+            self.clock = EventClock(self.params.stress_corrosion.max_strength_loss_fraction,
+                                    self.params.stress_corrosion.creep_time_limit)
+        self.n_events = event_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, resume)
 
-    def run_paper_clock(self):
+    def run_paper_clock(self, resume=None):
+        """Paper clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it)."""
         sc = self.params.stress_corrosion
-        self.clock = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
-        paper_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, self.params.creep)
+        if resume is None:
+            self.clock = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
+        paper_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, self.params.creep, resume)
         self.n_events = int(np.sum(self.break_time > 0))
+
+    def safe_point(self, phase, loop):
+        """A point between DEM steps where the driver's state is complete (``phase``: "ramp", "event",
+        "paper"; ``loop``: the clock loop's counters): write a checkpoint if one is due, always at the
+        end of the ramp, then every ``creep.checkpoint_interval`` s of wall time."""
+        ck = self.checkpointer
+        if ck is not None and (phase == "ramp" or ck.due()):
+            ck.write(self, phase, loop)
 
     def check_failure(self):
         """Set ``failed`` if the axial strain passed the cap; return it."""
@@ -244,43 +271,60 @@ class CreepRun:
             return self
 
     def _run(self):
-        self.ramp()
-        self.record(0.0)
-        self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp
-        if self.failed:
-            return self
-        self.hold_servo()
-        if not self.params.stress_corrosion.enabled:
-            # control run: the load is held, nothing corrodes; equilibrium must come and stay
+        phase, loop = self.resumed or (None, None)
+        if phase is None:
+            self.ramp()
+            self.record(0.0)
+            self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp
+            if self.failed:
+                return self
+            self.safe_point("ramp", {})
+        if phase in (None, "ramp"):
+            self.hold_servo()
+            if not self.params.stress_corrosion.enabled:
+                # control run: the load is held, nothing corrodes; equilibrium must come and stay
+                if self.relax(0.0):
+                    self.scene.run(self.params.creep.max_relaxation_steps)
+                    self.check_failure()
+                self.record(0.0, self.servo.stress)
+                return self
+            self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
+            self.scene.extras.append(self.corr)
             if self.relax(0.0):
-                self.scene.run(self.params.creep.max_relaxation_steps)
-                self.check_failure()
-            self.record(0.0, self.servo.stress)
-            return self
-        self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
-        self.scene.extras.append(self.corr)
-        if self.relax(0.0):
-            self.initial_bond_stresses = self.bond_stress_table()
+                self.initial_bond_stresses = self.bond_stress_table()
+            loop = None
+        # else: servo, stress corrosion and clock came back with the checkpoint; the loop goes on from it
         if self.params.stress_corrosion.clock == "event":
-            self.run_event_clock()
+            self.run_event_clock(loop)
         else:
-            self.run_paper_clock()
+            self.run_paper_clock(loop)
         if self.vtk_folder is not None:
             self.write_vtk(self.rows[-1]["creep_time_s"])
         return self
 
 
-def event_clock_loop(holder, corr, clock, sc) -> int:
+def _no_checkpoint(phase, loop):
+    """Stand-in for :meth:`CreepRun.safe_point` for holders without checkpoints."""
+
+
+def event_clock_loop(holder, corr, clock, sc, resume=None) -> int:
     """Event clock (ours): at equilibrium, jump to the next bond failure under frozen stresses; repeat.
 
     ``holder`` relaxes the scene (``relax(creep_time) -> bool``), records rows (``record_now``) and
-    reports progress. Returns the number of events (intervals that ended in a failure).
+    reports progress. Returns the number of events (intervals that ended in a failure).  Each pass
+    starts at a safe point (``holder.safe_point("event", counters)``, a checkpoint if due);
+    ``resume``: the counters of such a point, to go on from it (scene and clock restored).
     """
-    n_events = stalled = 0
-    if not holder.relax(0.0):
-        return n_events
-    holder.record_now(0.0)
+    safe_point = getattr(holder, "safe_point", _no_checkpoint)
+    if resume is None:
+        n_events = stalled = 0
+        if not holder.relax(0.0):
+            return n_events
+        holder.record_now(0.0)
+    else:
+        n_events, stalled = int(resume["n_events"]), int(resume["stalled"])
     while True:
+        safe_point("event", {"n_events": n_events, "stalled": stalled})
         broken_before = int(corr.scene.broken.sum())
         idx = corr.intact()
         sigma, tau = corr.stresses(idx)
@@ -334,9 +378,12 @@ def event_clock_loop(holder, corr, clock, sc) -> int:
 
 
 
-def paper_clock_loop(holder, corr, clock, sc, cp):
+def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     """Paper clock (Eq. 8): every ``engine_period`` DEM steps advance creep time by the doubled or
     reset step and degrade all intact bonds for it (paper Eq. 7).
+
+    Each pass starts at a safe point (``holder.safe_point("paper", counters)``, a checkpoint if
+    due); ``resume``: the counters of such a point, to go on from it (scene and clock restored).
 
     One notion of balance: F_u below the clock's threshold (:meth:`PaperClock.balanced`) both
     doubles the step and resets the count of DEM steps without balance; more than
@@ -347,9 +394,14 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
     the mean bond force.  With ``engine_period`` k > 1 the k steps share the F_u of the last one.
     """
     scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
-    holder.record_now(0.0)
-    applications, not_balanced_steps = 0, 0
+    safe_point = getattr(holder, "safe_point", _no_checkpoint)
+    if resume is None:
+        holder.record_now(0.0)
+        applications, not_balanced_steps = 0, 0
+    else:
+        applications, not_balanced_steps = int(resume["applications"]), int(resume["not_balanced_steps"])
     while True:
+        safe_point("paper", {"applications": applications, "not_balanced_steps": not_balanced_steps})
         corr.scene.run(sc.engine_period)
         # a bond breaks in these DEM steps because the last creep step took it past its failure point
         # (or its neighbours' did): it broke at the creep time that step reached, not at the next one;
@@ -387,6 +439,26 @@ def paper_clock_loop(holder, corr, clock, sc, cp):
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:
     """Ramp, hold and creep ``specimen`` at ``target_stress`` [Pa]; returns the finished run.
 
-    ``outputs``: ``vtk_folder`` and ``vtk_times`` (VTK snapshots), ``history_sink`` (partial history).
+    ``outputs``: ``vtk_folder`` and ``vtk_times`` (VTK snapshots), ``history_sink`` (partial history),
+    ``checkpoint_folder`` (the run folder: checkpoints in its ``checkpoint/``) and ``run_values``
+    (seed, load: stored with the checkpoints).
     """
     return CreepRun(specimen, params, target_stress, progress, **outputs).run()
+
+
+def resume_creep(specimen, params, target_stress, run_folder, progress=None, **outputs) -> CreepRun:
+    """Go on with the creep run whose checkpoint is in ``run_folder`` (same specimen, parameters and
+    load as the run that wrote it) and return the finished run; it writes further checkpoints there.
+
+    The scene is built as for a new run, then replaced by the checkpoint's (``O.load``) and the
+    driver's state is restored (:func:`.checkpoint.restore`).  GrainfracError if the folder holds
+    no usable checkpoint.
+    """
+    from .checkpoint import read, restore
+    where, state, arrays = read(run_folder)
+    outputs.setdefault("run_values", state.get("run_values"))
+    run = CreepRun(specimen, params, target_stress, progress, checkpoint_folder=run_folder, **outputs)
+    run.resumed = restore(run, where, state, arrays)
+    run.progress(f"resumed from the checkpoint at DEM step {state['dem_steps']}, creep time "
+                 f"{state['creep_time_s']:.6g} s ({state['phase']} phase)")
+    return run.run()

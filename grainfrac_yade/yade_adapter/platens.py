@@ -48,6 +48,20 @@ class Platens:
         self.y0_bottom = np.mean([b.state.pos[1] for b in self._bottom_bodies])
         self.x0_gap = self._side_gap()
         self.velocity = 0.0
+        #: (DEM step, axial stress [Pa]) restored from a checkpoint, read until that step has run
+        self._restored_reaction = None
+
+    def rebind(self, reaction: float):
+        """After ``O.load`` of a checkpoint: fetch the platen and side bodies anew (handles of the
+        replaced scene are stale), and read ``reaction`` [Pa], the axial stress saved with the
+        checkpoint, until the next DEM step.  ``O.save`` keeps no forces: after ``O.load`` the force
+        container reads zero until a step has run, and forces added from Python would act in that
+        step, so the reaction of the last step before the checkpoint is restored here instead."""
+        O = self.scene.O
+        self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies = (
+            [O.bodies[b.id] for b in bodies]
+            for bodies in (self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies))
+        self._restored_reaction = (O.iter, float(reaction))
 
     def set_axial_velocity(self, closing_speed: float):
         """Platens approach each other at ``closing_speed`` [m/s] (half each)."""
@@ -85,6 +99,10 @@ class Platens:
 
     def axial_stress(self) -> float:
         """Mean reaction of the two platens over the cross-section (compression positive) [Pa]."""
+        if self._restored_reaction is not None:
+            if self._restored_reaction[0] == self.scene.O.iter:
+                return self._restored_reaction[1]
+            self._restored_reaction = None
         f = self.scene.O.forces.f
         top = sum(f(b.id)[1] for b in self._top_bodies)
         bottom = sum(f(b.id)[1] for b in self._bottom_bodies)
