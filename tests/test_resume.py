@@ -38,10 +38,9 @@ def _creep_args(spec, out, *extra):
 
 
 def _state(folder):
-    try:
-        return json.loads((folder / "checkpoint" / "state.json").read_text())
-    except (OSError, ValueError):
-        return None
+    """The state of the checkpoint a resume would use (also between the renames of a rewrite)."""
+    from grainfrac_yade.runio import read_checkpoint_state
+    return read_checkpoint_state(folder)
 
 
 def _start_and_kill(spec, out, ready, timeout=120):
