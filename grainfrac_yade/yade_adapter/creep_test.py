@@ -143,7 +143,7 @@ class CreepRun:
         idx = np.flatnonzero(sc.broken)
         if not len(idx):
             return 0
-        open_ = np.array([sc.interactions[k].geom.penetrationDepth - sc.interactions[k].phys.initD < 0 for k in idx])
+        open_ = sc.bond_separated(idx)
         face = sc.layout.bond_face
         n_faces = sc.specimen.tessellation.n_faces
         bonds_per_face = np.bincount(face, minlength=n_faces)
