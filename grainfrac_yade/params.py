@@ -182,6 +182,22 @@ class CreepParams:
 
 
 @dataclass(frozen=True, kw_only=True)
+class BrazilianParams:
+    """Strain-controlled Brazilian disc test: diametral compression between two rigid loading jaws
+    (ISRM 1978 suggested method); tensile strength sigma_t = 2 P / (pi D t) at the peak load P."""
+    diameter: float = _spec("m", "positive", "disc diameter D")
+    loading_arc_deg: float = _spec("deg", "angle", "full angle 2 alpha of each jaw's arc about the loaded diameter: "
+                                   "the cells whose rim overlaps it move with the jaw")
+    strain_rate: float = _spec("1/s", "positive", "jaw closing speed / D (DEM time)")
+    stop_load_ratio: float = _spec("1", "unit_interval_open", "stop when the load falls below this x peak "
+                                   "(with bonds broken since the peak)")
+    max_strain: float = _spec("1", "positive", "stop at this diametral strain (jaw closure / D)")
+    record_strain_increment: float = _spec("1", "positive", "diametral strain between history rows")
+    platen_lateral: str = _spec("", "choice", "jaw cells fixed (rough, hold the disc) or free (smooth) "
+                                "across the loaded diameter", ("fixed", "free"))
+
+
+@dataclass(frozen=True, kw_only=True)
 class CalibrationParams:
     """Scale factors that map the paper's UDEC values onto this YADE packing (issue 4).
 
@@ -204,6 +220,7 @@ class Parameters:
     stress_corrosion: StressCorrosionParams
     ucs: UcsParams
     creep: CreepParams
+    brazilian: BrazilianParams
     calibration: CalibrationParams
     sources: tuple = ()
 
@@ -242,6 +259,7 @@ SECTION_CLASSES = {
     "stress_corrosion": StressCorrosionParams,
     "ucs": UcsParams,
     "creep": CreepParams,
+    "brazilian": BrazilianParams,
     "calibration": CalibrationParams,
 }
 
@@ -450,6 +468,21 @@ def _is_new_pair_key(key: str) -> bool:
     return key.startswith("contacts.")
 
 
+#: Sections of one test's protocol that no other command reads, added to the schema after runs were made: a
+#: parameter tree without one (the params.json of an older run, read back by ``creep --resume`` or the
+#: analysis) takes the shipped values, so that it still loads.  A parameter file never lacks them: files are
+#: merged over the shipped ones.
+LATER_PROTOCOL_SECTIONS = ("brazilian",)
+
+
+def _shipped_section(section: str):
+    """The shipped files' table ``section`` (None if they have none)."""
+    merged = {}
+    for path in default_files():
+        _merge(merged, read_toml(path), {}, str(path))
+    return merged.get(section)
+
+
 def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameters:
     """Validate a merged nested dict into :class:`Parameters`."""
     known = set(SECTION_CLASSES) | {"composition", "grains", "contacts"}
@@ -457,7 +490,14 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
         if section not in known:
             raise ParameterError(_section_origin(origins, section), section, "unknown section",
                                  f"remove it or use one of {sorted(known)}")
+    merged = dict(merged)
     for section in known:
+        if section not in merged and section in LATER_PROTOCOL_SECTIONS:
+            shipped = _shipped_section(section)
+            if shipped is not None:
+                merged[section] = shipped
+                origins = {**origins, **{f"{section}.{k}": "shipped defaults" for k in shipped}}
+                continue
         if section not in merged:
             raise ParameterError(" + ".join(sources) or "parameters", section, "missing section",
                                  f"add a [{section}] table (see {PARAMS_DIR})")

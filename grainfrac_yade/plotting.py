@@ -76,15 +76,19 @@ def _specimen_figure_3d(specimen, path, title):
     return path
 
 
-def crack_map(specimen, path, segments, modes, title=None, macro=None):
+def crack_map(specimen, path, segments, modes, title=None, macro=None, guides=None):
     """Crack map: broken-bond faces on the cell picture, tension and shear in two colours.
 
     ``segments`` (c, 2, 2) [m]; ``modes`` (c,) 1 = tension, 2 = shear;
-    ``macro`` optional (c,) bool drawn thicker (fully separated faces).
+    ``macro`` optional (c,) bool drawn thicker (fully separated faces);
+    ``guides`` optional (g, 2, 2) [m] thin dashed lines (e.g. a band the analysis counts cracks in).
     """
     t = specimen.tessellation
     fig, ax = plt.subplots(figsize=(5.5, min(12, 4.5 * t.box[1] / t.box[0])))
     draw_cells(ax, specimen, alpha=0.35)
+    if guides is not None and len(guides):
+        ax.add_collection(LineCollection(np.asarray(guides) * MM, colors="#555555", linewidths=0.7,
+                                         linestyles="dashed"))
     widths = np.full(len(modes), 0.9) if macro is None else np.where(macro, 2.2, 0.9)
     if len(modes):
         ax.add_collection(LineCollection(np.asarray(segments) * MM,

@@ -1,0 +1,213 @@
+"""``brazilian``: Brazilian disc test (diametral compression); summary.json, history.csv, cracks.csv,
+load_strain.png, crack maps at the peak and at the end.
+
+Tensile strength sigma_t = 2 P / (pi D t) (ISRM 1978 suggested method) at the peak load P of a
+disc of diameter D (``brazilian.diameter``) and thickness t (``specimen.thickness``), the disc a
+Voronoi tessellation clipped to the circle with the grain size and composition of the UCS
+specimen (:mod:`grainfrac_yade.disc`), loaded by two rigid jaws
+(:mod:`grainfrac_yade.yade_adapter.brazilian_test`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import GrainfracError
+
+
+def register(sub, common):
+    p = sub.add_parser("brazilian", help="strain-controlled Brazilian disc test (tensile strength 2P/(pi D t))")
+    common(p, geometry=False)
+    p.add_argument("--diameter", type=float, help="disc diameter [m] (brazilian.diameter)")
+    p.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
+    p.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
+    p.add_argument("--seed", type=int, default=1, help="random seed of the specimen")
+    p.add_argument("--tensile-scale", type=float, metavar="F",
+                   help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
+                        "--set contacts.<a>/<b>.tensile_strength=F x its value for each row (recorded so in "
+                        "params.json)")
+    p.set_defaults(func=cmd_brazilian)
+
+
+def cmd_brazilian(args) -> int:
+    from ..cli import load_params_from_args
+    params = load_params_from_args(args)
+    if args.diameter is not None or args.tensile_scale is not None:
+        extra = [] if args.diameter is None else [("brazilian.diameter", args.diameter)]
+        if args.tensile_scale is not None:
+            extra += tensile_scale_overrides(params, args.tensile_scale)
+        params = _reload(args, extra, params, args.tensile_scale)
+    out = args.out or f"results/brazilian_seed{args.seed}"
+    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
+    print(format_result(summary, out))
+    return 0
+
+
+def _reload(args, extra, base, factor):
+    from ..cli import overrides_from_args
+    from ..params import load_parameters
+    params = load_parameters(extra_files=args.params, overrides=overrides_from_args(args) + extra)
+    if factor is not None:
+        check_tensile_scale(base, params, factor)
+    return params
+
+
+def format_result(summary, out) -> str:
+    if summary["numerical_failure"]:
+        return f"Brazilian: no result ({summary['end_reason']}) -> {out}"
+    return (f"Brazilian tensile strength {summary['tensile_strength_pa'] / 1e6:.2f} MPa "
+            f"(P/t {summary['peak_load_per_thickness_n_per_m'] / 1e3:.1f} kN/m, D {summary['diameter_m'] * 1e3:g} mm), "
+            f"UCS/sigma_t {summary['reference_ucs_over_tensile_strength']:.1f}; central band "
+            f"{summary['central_band_fraction']:.2f} of {summary['broken_total']} broken bonds "
+            f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
+
+
+def tensile_scale_overrides(params, factor: float) -> list:
+    """(key, value) overrides that multiply J^T of every contact row the parameter files give by ``factor``.
+
+    The rows are the pure-mineral pairs and any mixed pair a file in ``params.sources`` gives; the
+    other mixed pairs are averages of pure pairs (paper section 3.1), so they scale with them.
+    Effect on every bond: J^T x ``factor`` x ``calibration.strength_scale``; cohesion, friction and
+    stiffness stay.  1.0 changes nothing.
+    """
+    from ..params import pair_key, read_toml
+    if not (isinstance(factor, (int, float)) and math.isfinite(factor) and factor > 0):
+        raise GrainfracError(f"--tensile-scale {factor!r}: not a positive number; fix: give a factor > 0, e.g. 0.5")
+    rows = {pair_key(m, m) for m in params.minerals}
+    for source in params.sources:
+        for name in read_toml(source).get("contacts", {}):
+            rows.add(pair_key(*name.split("/")))
+    return [(f"contacts.{a}/{b}.tensile_strength", params.contact(a, b).tensile_strength * factor)
+            for a, b in sorted(rows)]
+
+
+def check_tensile_scale(base, scaled, factor: float):
+    """GrainfracError unless every pair's J^T in ``scaled`` is ``factor`` x that in ``base`` (1e-12)."""
+    for key, c in base.contacts.items():
+        got = scaled.contacts[key].tensile_strength
+        if abs(got / (c.tensile_strength * factor) - 1) > 1e-12:
+            raise GrainfracError(f"--tensile-scale: contact {'/'.join(key)} ended with J^T {got:g} Pa, not "
+                                 f"{factor:g} x {c.tensile_strength:g} Pa (a mixed pair given by --set only?); fix: "
+                                 "give that pair in a --params file or set its tensile_strength yourself")
+
+
+#: summary.json keys measured from the load curve: null when a numerical failure ended the run.
+MEASURES = ("peak_load_n", "peak_load_per_thickness_n_per_m", "tensile_strength_pa", "peak_diametral_strain")
+
+
+def require_disc_model(params):
+    """GrainfracError unless the cells are rigid (the disc's rim cells are built and tested for rigid cells)."""
+    from ..params import require_plane
+    require_plane(params, "brazilian")
+    if params.resolution.grain_model != "rigid":
+        raise GrainfracError(f"resolution.grain_model = {params.resolution.grain_model!r}: the Brazilian disc is "
+                             "built for rigid cells only (deformable and fem cells mesh straight box walls, not the "
+                             "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
+
+
+def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
+    """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished)."""
+    from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
+                                      crack_location, hondros_centre_factor)
+    from ..disc import build_disc_specimen
+    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
+    from ..yade_adapter.brazilian_test import run_brazilian
+    from .ucs import write_cracks
+    require_disc_model(params)
+    specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
+    out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
+    history, result, scene, (broken_peak, mode_peak) = run_brazilian(specimen, params, progress=progress)
+    t = specimen.tessellation
+    diameter = t.diameter
+    summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else \
+        brazilian_summary(history, diameter, specimen.thickness)
+    ucs = params.calibration.reference_ucs
+    sigma = summary["tensile_strength_pa"]
+    summary["reference_ucs_pa"] = ucs
+    summary["reference_ucs_over_tensile_strength"] = ucs / sigma if sigma else None
+    summary["loading_arc_deg"] = params.brazilian.loading_arc_deg
+    summary["hondros_centre_factor"] = hondros_centre_factor(math.radians(params.brazilian.loading_arc_deg))
+    summary.update(result)
+    summary["hondros_centre_factor_realised"] = hondros_centre_factor(math.radians(np.mean(result["loaded_arc_deg"])))
+    points = scene.layout.bond_point
+    summary.update(crack_location(points, scene.broken, scene.break_step, t.centre, diameter))
+    at_peak = crack_location(points, broken_peak, scene.break_step, t.centre, diameter)
+    summary["broken_at_peak"] = int(broken_peak.sum())
+    summary["central_band_fraction_at_peak"] = at_peak["central_band_fraction"]
+    summary["central_band_area_fraction"] = central_band_area_fraction(CENTRAL_BAND_HALF_WIDTH)
+    summary.update(summary_header(params, seed), n_cells=specimen.n_cells, diameter_m=diameter,
+                   thickness_m=specimen.thickness)
+    write_csv(out / "history.csv", history)
+    write_cracks(out / "cracks.csv", scene)
+    load_figure(history, summary, out / "load_strain.png")
+    draw_crack_maps(scene, summary, broken_peak, mode_peak, out)
+    write_json(out / "summary.json", summary)   # last: marks the run finished
+    return summary
+
+
+def band_guides(tessellation) -> np.ndarray:
+    """(2, 2, 2) the central band's two edges x = x_c +- D/6, clipped to the disc [m]."""
+    from ..brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
+    c, r = tessellation.centre, tessellation.radius
+    dx = CENTRAL_BAND_HALF_WIDTH * 2 * r
+    dy = math.sqrt(r * r - dx * dx)
+    return np.array([[[c[0] + s * dx, c[1] - dy], [c[0] + s * dx, c[1] + dy]] for s in (-1, 1)])
+
+
+def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
+    """crack_map_peak.png (broken bonds at the peak load) and crack_map_end.png (at the end of the test),
+    with the central band's edges dashed."""
+    from ..plotting import crack_map
+    from ..yade_adapter.scene import bond_segments
+    specimen, seed = scene.specimen, summary["seed"]
+    guides = band_guides(specimen.tessellation)
+    sigma = summary["tensile_strength_pa"]
+    at = "the largest load before the numerical failure" if summary["numerical_failure"] else \
+        f"peak (sigma_t {sigma / 1e6:.1f} MPa)"
+    idx = np.flatnonzero(broken_peak)
+    crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
+              title=f"cracks at {at}, seed {seed}", guides=guides)
+    idx = np.flatnonzero(scene.broken)
+    frac = summary["central_band_fraction"]
+    crack_map(specimen, out / "crack_map_end.png", bond_segments(scene, idx), scene.break_mode[idx],
+              title=f"cracks at the end, seed {seed}: {frac if frac is None else round(frac, 2)} in the band "
+                    "|x - x_c| <= D/6", guides=guides)
+
+
+def load_figure(history, summary, path):
+    """Brazilian stress 2P/(pi D t) against diametral and horizontal strain."""
+    from ..plotting import plt
+    s = np.asarray(history["tensile_stress_pa"]) / 1e6
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(np.asarray(history["diametral_strain"]) * 100, s, label="diametral strain (jaw closure / D)")
+    ax.plot(np.asarray(history["horizontal_strain"]) * 100, s, label="horizontal strain (widening negative)")
+    ax.set_xlabel("strain [%] (compression positive)")
+    ax.set_ylabel("2 P / (pi D t) [MPa]")
+    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
+                 f"sigma_t {summary['tensile_strength_pa'] / 1e6:.1f} MPa, D {summary['diameter_m'] * 1e3:g} mm, "
+                 f"seed {summary['seed']}")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def run_brazilian_in_yade():
+    """Entry of ``yade_scripts/brazilian.py``: parameters from the batch row (or defaults); a finished row
+    is skipped or stops as a UCS row does (:mod:`grainfrac_yade.yade_adapter.batch`)."""
+    from ..params import load_parameters
+    from ..yade_adapter.batch import read_table, row_errors, row_folder, run_folder_name
+    with row_errors():
+        overrides, controls = read_table()
+        params = load_parameters(overrides=overrides)
+        require_disc_model(params)
+        out, done = row_folder(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}",
+                               params, controls, {"seed": int(controls["seed"])})
+    if done:
+        print(f"Brazilian row already finished, skipped: {out}")
+        return
+    with row_errors():
+        summary = run_brazilian_to_folder(params, int(controls["seed"]), out,
+                                          overwrite=(out / "run.json").exists())
+    print(format_result(summary, out))

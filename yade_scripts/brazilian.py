@@ -1,0 +1,15 @@
+"""Brazilian disc test, one run per yade-batch row.
+
+    yade -x yade_scripts/brazilian.py
+    yade-batch -j 2 --log 'results/brazilian/%.log' params/brazilian_seeds.table yade_scripts/brazilian.py
+Columns: any parameter path (e.g. brazilian.diameter, specimen.grain_size), plus seed, out, study.
+Each row writes results/<study>/<row name>/ (summary.json, history.csv, cracks.csv, figures).
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))))
+
+from grainfrac_yade.commands.brazilian import run_brazilian_in_yade  # noqa: E402
+
+run_brazilian_in_yade()
