@@ -53,8 +53,9 @@ def cmd_analyze_ucs(args) -> int:
 
 
 def cells_label(grain_model, nodes_per_face) -> str:
-    """The cells column of ucs_stats.md: "rigid" or "deformable, k/face".  A run without grain_model
-    (params.json older than the key) had rigid cells, the only kind there was."""
-    if grain_model == "deformable":
-        return f"deformable, {nodes_per_face:.0f}/face"
+    """The cells column of ucs_stats.md: "rigid", "deformable, k/face" (spring lattice) or
+    "fem, k/face" (finite elements).  A run without grain_model (params.json older than the key) had
+    rigid cells, the only kind there was."""
+    if grain_model in ("deformable", "fem"):
+        return f"{grain_model}, {nodes_per_face:.0f}/face"
     return "rigid"

@@ -1,7 +1,8 @@
 """``bench``: what a creep run costs on this machine, every number from one run.
 
 Scenes: the specimen (10 x 20 mm, seed 1; ``--quick`` a smaller one) with rigid cells at 1 and at 8
-spheres per cell and with deformable cells (``params/presets/deformable.toml``), each ramped as a
+spheres per cell, with deformable cells (``params/presets/deformable.toml``) and with finite-element
+cells (``params/presets/fem.toml``), each ramped as a
 creep run ramps it to 0.7 x its own ``calibration.reference_ucs`` (``--ratio``), then held by the
 servo with the stress-corrosion engine in place and relaxed to equilibrium, as in a creep run; then
 a few events of the event clock are timed, and the scene is measured at the held load after them:
@@ -46,11 +47,14 @@ from pathlib import Path
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
 #: The deformable-cells preset.
 DEFORMABLE_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "deformable.toml"
+#: The finite-element-cells preset.
+FEM_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "fem.toml"
 #: Benchmarked scenes: key, label, extra parameter files, overrides (applied after the user's).
 SCENES = (
     ("rigid_1", "rigid, 1 sphere/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=1")),
     ("rigid_8", "rigid, 8 spheres/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=8")),
-    ("deformable", "deformable cells", (DEFORMABLE_PRESET,), ()),
+    ("deformable", "deformable cells (spring lattice)", (DEFORMABLE_PRESET,), ()),
+    ("fem", "finite-element cells", (FEM_PRESET,), ()),
 )
 #: The scene of the clocks-to-failure comparison.
 FAILURE_SCENE = "rigid_1"

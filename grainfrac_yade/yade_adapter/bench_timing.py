@@ -40,9 +40,9 @@ class TimedCreepRun(CreepRun):
         super().ramp()
         self.ramp_wall_s = time.perf_counter() - t
 
-    def run_event_clock(self):
+    def run_event_clock(self, resume=None):
         self._loop_calls = 0
-        super().run_event_clock()
+        super().run_event_clock(resume)
         if self.at_hold is not None:
             self.measured = self.at_hold(self)
 
