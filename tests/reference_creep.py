@@ -1,0 +1,81 @@
+"""Reference creep runs of the default law (paper Eq. 7, strength degraded, rigid cells), stored in
+tests/data/ and compared bit for bit by tests/test_reference_creep.py.
+
+Made once with ``/usr/bin/python3 tests/reference_creep.py write`` at commit 7e91240 (before the
+degradation laws became the package ``grainfrac_yade.law``); the same command with ``check``
+recomputes them with the code checked out and compares.  One thread (OMP_NUM_THREADS=1), one run
+at a time.
+"""
+import os
+import sys
+from pathlib import Path
+
+os.environ["OMP_NUM_THREADS"] = "1"
+ROOT = Path(__file__).resolve().parent.parent
+DATA = Path(__file__).resolve().parent / "data"
+
+#: name -> (seed, width [m], height [m], driving-stress ratio of 300 MPa, extra overrides)
+RUNS = {
+    "event_s1": (1, 4e-3, 8e-3, 0.5, []),
+    "event_s2": (2, 4e-3, 8e-3, 0.5, []),
+    # the paper clock records every 100 law applications (recording reads the scene, changes nothing)
+    "paper_tiny_s1": (1, 3e-3, 6e-3, 0.8, ["stress_corrosion.clock=paper", "creep.record_period=100"]),
+}
+UCS = 300e6
+#: summary.json keys compared (everything a run computes; not wall time)
+SUMMARY_KEYS = ("lifetime_s", "failed", "failure_reason", "n_events", "broken_ramp", "broken_creep", "broken_total",
+                "macrocracks", "n_bonds", "dem_steps", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
+                "shear_stress_p99_pa", "shear_stress_max_pa", "shear_utilisation_max")
+#: history.csv columns that differ between identical runs
+WALL = ["wall_s"]
+
+
+def run(name, out):
+    """Run reference ``name`` into folder ``out``; (summary dict, history frame, cracks frame)."""
+    import json
+
+    import pandas as pd
+
+    sys.path.insert(0, str(ROOT))
+    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.params import load_parameters
+    seed, width, height, ratio, extra = RUNS[name]
+    p = load_parameters(overrides=[("specimen.width", width), ("specimen.height", height),
+                                   "stress_corrosion.creep_time_limit=1e30", "creep.checkpoint_interval=0", *extra])
+    run_creep_to_folder(p, seed, out, ratio * UCS, ratio, UCS, overwrite=True)
+    out = Path(out)
+    summary = json.loads((out / "summary.json").read_text())
+    history = pd.read_csv(out / "history.csv", float_precision="round_trip").drop(columns=WALL)
+    cracks = pd.read_csv(out / "cracks.csv", float_precision="round_trip")
+    return {k: summary.get(k) for k in SUMMARY_KEYS}, history, cracks
+
+
+def stored(name):
+    import json
+
+    import pandas as pd
+    summary = json.loads((DATA / f"reference_creep_{name}.json").read_text())
+    history = pd.read_csv(DATA / f"reference_creep_{name}_history.csv", float_precision="round_trip")
+    cracks = pd.read_csv(DATA / f"reference_creep_{name}_cracks.csv", float_precision="round_trip")
+    return summary, history, cracks
+
+
+def write(name, tmp):
+    import json
+    summary, history, cracks = run(name, Path(tmp) / name)
+    DATA.mkdir(exist_ok=True)
+    (DATA / f"reference_creep_{name}.json").write_text(json.dumps(summary, indent=1) + "\n")
+    history.to_csv(DATA / f"reference_creep_{name}_history.csv", index=False)
+    cracks.to_csv(DATA / f"reference_creep_{name}_cracks.csv", index=False)
+    print(name, summary["lifetime_s"], summary["n_events"], summary["dem_steps"])
+
+
+if __name__ == "__main__":
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in (sys.argv[2:] or RUNS):
+            if sys.argv[1] == "write":
+                write(n, tmp)
+            else:
+                a, b = run(n, Path(tmp) / n), stored(n)
+                print(n, a[0] == b[0], a[1].equals(b[1]), a[2].equals(b[2]))
