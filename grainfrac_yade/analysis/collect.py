@@ -61,7 +61,7 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
         try:
             failed = _read_json(folder / FAILED) if (folder / FAILED).exists() else None
             run = _read_json(run_json) if run_json.exists() else {k: failed.get(k) for k in ("command", "seed")}
-            row.update({"command": run.get("command"), "seed": run.get("seed")})
+            row.update({"command": run.get("command"), "seed": run.get("seed"), "code_version": run.get("code_version")})
             params_file = folder / "params.json"
             if params_file.exists():
                 params = _read_json(params_file)
@@ -81,6 +81,21 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
         rows.append(row)
     rows += rows_without_runs(root, folders)
     return pd.DataFrame(rows)
+
+
+def code_version_note(frame: pd.DataFrame) -> str | None:
+    """A warning when the finished runs of ``frame`` were made by more than one code version (the
+    ``code_version`` of their run.json: package version, git commit, ``-dirty`` for an edited
+    tree), None otherwise."""
+    if "code_version" not in frame or "status" not in frame:
+        return None
+    versions = frame.loc[frame["status"] == "finished", "code_version"].dropna()
+    counts = versions.value_counts()
+    if len(counts) < 2:
+        return None
+    return ("Warning: the finished runs come from " + str(len(counts)) + " code versions ("
+            + ", ".join(f"{v}: {n} run(s)" for v, n in counts.items())
+            + "); results may differ between them for reasons other than their parameters.")
 
 
 def group_stats(frame: pd.DataFrame, by, values) -> pd.DataFrame:

@@ -16,7 +16,7 @@ import pandas as pd
 from ..errors import GrainfracError
 from ..runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crackmaps, figures, rescale
-from .collect import collect_runs, flatten
+from .collect import code_version_note, collect_runs, flatten
 from .figures import Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
@@ -356,6 +356,10 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         content.notes.append("Keys missing from older params.json files, taken as the shipped defaults when "
                              "comparing runs (variants): " + ", ".join(f"{k} ({n} run(s))" for k, n in filled.items())
                              + ".")
+
+    versions = code_version_note(runs)
+    if versions:
+        content.notes.append(versions)
 
     # lifetimes: model sets, lab set, fits, coefficient table
     sets = lifetime_sets(runs)
