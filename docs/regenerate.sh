@@ -1,0 +1,76 @@
+#!/bin/bash
+# Regenerates the study numbers and figures quoted in README.md and docs/ from the code you have.
+#   bash docs/regenerate.sh list          # the targets, what each feeds and its cost
+#   bash docs/regenerate.sh TARGET ...    # run targets (results/ folders, then their analysis)
+#   bash docs/regenerate.sh all           # everything: about a day on this 2-core machine
+# Costs are wall times measured on this machine (2 cores, yade-batch -j 2 unless said); the README
+# section each target feeds says which of its numbers came from which run. Every run folder records
+# its code version (run.json), and `analyze` warns when a study mixes versions.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=/usr/bin/python3
+export OMP_NUM_THREADS=1
+batch() {  # batch TABLE SCRIPT STUDY
+  mkdir -p "results/$3"
+  yade-batch -j 2 --log "results/$3/%.log" "$1" "yade_scripts/$2"
+}
+
+declare -A WHAT=(
+  [elastic]="README 'Deformable grains' tables, docs/elastic_reference.md (static solves, no YADE): about 5 min on one core"
+  [bench]="README 'Benchmark', docs/bench.json: about 6 min on one core"
+  [calibration]="README 'Calibration', params/calibration.toml (rigid cells, 5 seeds x 2 rounds): about 35 min"
+  [resolution]="README 'Resolution' (params/resolution_small.table): about 20 min"
+  [fem_ucs]="README 'Finite-element grains' UCS table (params/fem_ucs_small.table): about 30 min"
+  [fem_creep]="README 'Finite-element grains' creep table (params/fem_creep_small.table): 2-4 h"
+  [lattice]="README 'spring-lattice option' (params/deformable_*.table): about 3 h"
+  [lifetime_small]="README 'Lifetime studies' 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
+  [lifetime_ldb]="README 'Lifetime studies' paper size, 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
+  [creep_numerics]="README 'creep numerics' (params/creep_numerics_small.table): about 1 h"
+  [brazilian]="README 'Brazilian test' (params/brazilian_ldb.table, docs/brazilian_study.sh)"
+)
+
+run_target() {
+  case "$1" in
+    elastic) bash docs/elastic_study.sh ;;
+    bench) $PY -m grainfrac_yade bench ;;
+    calibration) $PY -m grainfrac_yade calibrate --seeds 1 2 3 4 5 --rounds 2 --jobs 2 ;;
+    resolution) batch params/resolution_small.table ucs.py resolution
+                $PY -m grainfrac_yade analyze-ucs results/resolution ;;
+    fem_ucs) batch params/fem_ucs_small.table ucs.py fem_ucs
+             $PY -m grainfrac_yade analyze-ucs results/fem_ucs ;;
+    fem_creep) batch params/fem_creep_small.table creep.py fem_creep
+               $PY -m grainfrac_yade analyze results/fem_creep ;;
+    lattice) batch params/deformable_ucs_small.table ucs.py deformable_ucs
+             batch params/deformable_creep_small.table creep.py deformable_creep
+             batch params/deformable_scaled_small.table ucs.py deformable_scaled
+             batch params/deformable_scaled_creep.table creep.py deformable_scaled
+             $PY -m grainfrac_yade analyze-ucs results/deformable_ucs
+             $PY -m grainfrac_yade analyze results/deformable_creep ;;
+    lifetime_small) batch params/lifetime_small.table creep.py lifetime_small
+                    batch params/lifetime_small_beta2x3.table creep.py lifetime_small_beta2x3
+                    batch params/lifetime_spread_small.table creep.py lifetime_spread_small
+                    $PY -m grainfrac_yade analyze results/lifetime_small ;;
+    lifetime_ldb) batch params/lifetime_ldb.table creep.py lifetime_ldb
+                  batch params/lifetime_ldb_beta2x3.table creep.py lifetime_ldb_beta2x3
+                  $PY -m grainfrac_yade analyze results/lifetime_ldb
+                  $PY -m grainfrac_yade calibrate-beta1 results/lifetime_ldb ;;
+    creep_numerics) batch params/creep_numerics_small.table creep.py creep_numerics ;;
+    brazilian) if [ -f docs/brazilian_study.sh ]; then bash docs/brazilian_study.sh
+               else batch params/brazilian_ldb.table brazilian.py brazilian_ldb; fi ;;
+    *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
+  esac
+}
+
+if [ $# -eq 0 ] || [ "$1" = list ]; then
+  for t in "${!WHAT[@]}"; do printf '%-16s %s\n' "$t" "${WHAT[$t]}"; done | sort
+  exit 0
+fi
+targets=("$@")
+[ "$1" = all ] && targets=(elastic bench calibration resolution fem_ucs fem_creep lattice lifetime_small
+                           lifetime_ldb creep_numerics brazilian)
+for t in "${targets[@]}"; do
+  echo "== $t: ${WHAT[$t]:-?}"
+  start=$(date +%s)
+  run_target "$t"
+  echo "== $t done in $(( $(date +%s) - start )) s"
+done
