@@ -3,6 +3,12 @@
 Every command accepts ``--params FILE`` (merged over the shipped files in
 ``params/``) and repeated ``--set section.key=value`` overrides, validated like
 the files.  User errors print one line and exit with status 2.
+
+Commands that run a model declare ``with_params=True`` (and optionally
+``param_overrides``, a function of their arguments giving further overrides) in
+``set_defaults``: :func:`main` loads the parameter set once and passes it in,
+``func(args, params)``; the override list used is ``args.resolved_overrides``.
+Command modules never import this module.
 """
 from __future__ import annotations
 
@@ -31,8 +37,11 @@ def _common(parser: argparse.ArgumentParser, geometry: bool = True):
 
 
 def overrides_from_args(args) -> list:
-    """``--set`` strings plus the geometry shortcuts (--width etc.)."""
+    """``--set`` strings plus the geometry shortcuts (--width etc.) and the command's own (``param_overrides``)."""
     out = list(args.overrides)
+    extra = getattr(args, "param_overrides", None)
+    if extra is not None:
+        out += list(extra(args))
     for opt, key in (("width", "specimen.width"), ("height", "specimen.height"),
                      ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell")):
         value = getattr(args, opt, None)
@@ -42,13 +51,14 @@ def overrides_from_args(args) -> list:
 
 
 def load_params_from_args(args):
+    """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
     from .params import load_parameters
-    return load_parameters(extra_files=args.params, overrides=overrides_from_args(args))
+    args.resolved_overrides = overrides_from_args(args)
+    return load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
 
 
-def cmd_specimen(args) -> int:
+def cmd_specimen(args, params) -> int:
     from .commands.specimen import run_specimen
-    params = load_params_from_args(args)
     summary = run_specimen(params, args.seed, args.out or f"results/specimen_seed{args.seed}",
                            draw_bonds=args.bonds, overwrite=args.overwrite)
     print(_format_summary(summary))
@@ -69,7 +79,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("specimen", help="build a Voronoi grain specimen; write specimen.json and specimen.png")
     _common(p)
     p.add_argument("--bonds", action="store_true", help="draw the bond network on the picture")
-    p.set_defaults(func=cmd_specimen)
+    p.set_defaults(func=cmd_specimen, with_params=True)
     from .commands import register_all
     register_all(sub, _common)
     return parser
@@ -79,6 +89,8 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        if getattr(args, "with_params", False):
+            return args.func(args, load_params_from_args(args))
         return args.func(args)
     except GrainfracError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -1,21 +1,18 @@
 """Creep clocks: creep time (the stress-corrosion time axis) kept apart from DEM time.
 
-:class:`PaperClock` is the paper's adaptive creep step (Eq. 8); :class:`EventClock` jumps
-straight to the next bond failure under frozen stresses (closed form of Eq. 7, or the area
-mode of :mod:`grainfrac_yade.corrosion`), capped so no bond loses more than a set fraction of
-its current strength (or area fraction) in one interval. Both are plain validated objects with
-``state_dict()`` / ``from_state()`` for checkpoints; nothing here knows about YADE.
+:class:`PaperClock` is the paper's adaptive creep step (Eq. 8); :class:`EventClock` keeps the creep
+time of the event clock, which jumps straight to the next bond failure under frozen stresses (the
+interval itself is :func:`grainfrac_yade.law.creep_step`: the degradation law decides it).  Both are
+plain validated objects with ``state_dict()`` / ``from_state()`` for checkpoints; nothing here knows
+about YADE or about a degradation law.
 """
 import math
 
 import numpy as np
 
-from grainfrac_yade import corrosion
 from grainfrac_yade.errors import NumericalFailure
 
 STATE_VERSION = 1  # bump when a state_dict layout changes; from_state refuses other versions
-EVENT_REL_TOL = 1e-12  # bonds whose time to failure is within this relative distance of dt fail
-MODES = ("strength", "area")  # degradation modes, see grainfrac_yade.corrosion
 
 
 def _number(name, value, fix, nan_ok=False):
@@ -168,25 +165,18 @@ class PaperClock:
         return clock
 
 
-def _bond_arrays(*arrays):
-    out = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in arrays))
-    if out[0].ndim != 1:
-        raise ValueError("bond arrays must be 1-D (one value per bond) or scalars")
-    return [np.array(a) for a in out]
-
-
 class EventClock:
-    """Event-driven creep clock: jump to the next bond failure under frozen stresses.
+    """Creep time of the event-driven clock: intervals that jump to the next bond failure.
 
-    Each interval dt = min(earliest closed-form time to failure of the intact bonds, earliest
-    time at which a bond loses ``max_strength_loss_fraction`` of its CURRENT strength in either
-    channel (area mode: of its current area fraction), time left to ``time_limit``). If no
-    intact bond can ever fail under the frozen stresses, dt = inf (capped by the time left).
+    The law decides each interval (:func:`grainfrac_yade.law.creep_step`, which reads
+    ``time_limit``, ``creep_time`` and ``max_strength_loss_fraction`` from here); this object adds
+    it to the creep time and counts intervals, events and failed bonds.
 
     Parameters
     ----------
     max_strength_loss_fraction : float
-        Cap on the relative loss per interval [-], in (0, 1).
+        Laws that change stiffness (the area law): the interval ends when a bond has lost this
+        fraction of its intact capacity, so the DEM can redistribute the load [-], in (0, 1).
     time_limit : float
         Creep time at which the run ends [s], > 0, may be inf.
     """
@@ -215,79 +205,6 @@ class EventClock:
         """True once creep_time has reached time_limit."""
         return self._creep_time >= self.time_limit
 
-    @staticmethod
-    def _failure_times(mode, jt, jc, sigma, tau, tphi, beta1, beta2, area):
-        if mode == "strength":
-            return corrosion.time_to_failure(jt, jc, sigma, tau, tphi, beta1, beta2)
-        return corrosion.time_to_failure_area(area, sigma, tau, jt, jc, tphi, beta1, beta2)
-
-    def next_interval(self, tensile_strength, cohesion, normal_stress, shear_stress,
-                      tan_friction, beta1, beta2, mode="strength", area_fraction=None,
-                      intact=None):
-        """Length of the next creep interval and the bonds that fail at its end.
-
-        Parameters
-        ----------
-        tensile_strength, cohesion : array_like
-            strength mode: current J^T, J^C [Pa]; area mode: intrinsic J^T0, J^C0 [Pa].
-        normal_stress, shear_stress : array_like
-            strength mode: sigma (tension positive), tau >= 0 [Pa]; area mode: the forces per
-            intact area p = F_n/A0, q = |F_s|/A0 [Pa].
-        tan_friction : array_like
-            tan(phi) [-].
-        beta1, beta2 : float
-            Law constants [Pa/s], [1/Pa].
-        mode : {'strength', 'area'}
-            Degradation mode (see :mod:`grainfrac_yade.corrosion`).
-        area_fraction : array_like, optional
-            a in (0, 1] [-]; required in area mode.
-        intact : array_like of bool, optional
-            Bonds to consider (default: all).
-
-        Returns
-        -------
-        dt : float
-            [s]; inf if nothing can fail and no time limit is set.
-        failing_index : ndarray of int
-            Indices (into the given arrays) of bonds with t_fail <= dt (1 + EVENT_REL_TOL);
-            empty when the loss cap or the time limit set dt.
-        """
-        mode = _check_mode(mode, area_fraction)
-        arrays = [tensile_strength, cohesion, normal_stress, shear_stress, tan_friction]
-        if mode == "area":
-            arrays.append(area_fraction)
-        jt, jc, sigma, tau, tphi, *rest = _bond_arrays(*arrays)
-        keep = np.ones(jt.shape, bool) if intact is None else np.broadcast_to(
-            np.asarray(intact, bool), jt.shape)
-        idx = np.flatnonzero(keep)
-        time_left = max(self.time_limit - self._creep_time, 0.0)
-        if idx.size == 0:
-            return min(math.inf, time_left), np.empty(0, int)
-        sub = [x[idx] for x in (jt, jc, sigma, tau, tphi, *rest)]
-        area = sub[5] if mode == "area" else None
-        t_fail, _ = self._failure_times(mode, *sub[:5], beta1, beta2, area)
-        t_first = float(np.min(t_fail))
-        if math.isinf(t_first):
-            return time_left, np.empty(0, int)
-        dt = min(t_first, self._loss_cap(mode, *sub[:4], beta1, beta2, area), time_left)
-        failing = idx[t_fail <= dt * (1.0 + EVENT_REL_TOL)]
-        return dt, failing
-
-    def _loss_cap(self, mode, jt, jc, sigma, tau, beta1, beta2, area):
-        """Earliest time any bond loses the set fraction of its current strength or area."""
-        f = self.max_strength_loss_fraction
-        if mode == "area":
-            return float(np.min(corrosion.area_time(area, (1.0 - f) * area, sigma, tau, jt, jc,
-                                                    beta1, beta2)))
-        t_cap = math.inf
-        for strength, stress in ((jt, sigma), (jc, tau)):
-            loss = f * strength
-            if np.any(loss > 0):  # a channel at strength 0 cannot lose more
-                rate = corrosion.degradation_rate(stress[loss > 0], beta1, beta2)
-                with np.errstate(over="ignore"):  # inf: that bond imposes no cap
-                    t_cap = min(t_cap, float(np.min(loss[loss > 0] / rate)))
-        return t_cap
-
     def advance(self, dt, failing_index=()):
         """Add dt [s] to creep_time and count the interval (and its failures); return creep_time."""
         d = _number("dt", dt, "pass the dt returned by next_interval")
@@ -299,45 +216,6 @@ class EventClock:
         self._n_events += n_fail > 0
         self._n_failures += n_fail
         return self._creep_time
-
-    @staticmethod
-    def apply(dt, failing_index, tensile_strength, cohesion, normal_stress, shear_stress,
-              tan_friction, beta1, beta2, mode="strength", area_fraction=None):
-        """Degraded state after dt under frozen stresses; failing bonds set to their failure point.
-
-        Arguments as in :meth:`next_interval`, plus ``dt`` [s] and ``failing_index``.
-
-        Returns
-        -------
-        (new_tensile_strength, new_cohesion) [Pa] in strength mode: a failing bond's strength
-        in its failure channel is set so that :func:`corrosion.failed_now` holds exactly
-        (J^T = sigma, or J^C = tau + sigma tan(phi) to the last bit); new_area_fraction [-] in
-        area mode (failing bonds at exactly their failure area fraction).
-        """
-        mode = _check_mode(mode, area_fraction)
-        fi = np.asarray(failing_index, dtype=int).ravel()
-        if mode == "area":
-            area, sigma, tau, jt, jc, tphi = _bond_arrays(area_fraction, normal_stress,
-                                                          shear_stress, tensile_strength,
-                                                          cohesion, tan_friction)
-            new = corrosion.degrade_area(area, sigma, tau, jt, jc, dt, beta1, beta2)
-            a_fail, _ = corrosion.area_failure_point(sigma, tau, jt, jc, tphi)
-            new[fi] = np.where(area[fi] > a_fail[fi], a_fail[fi], new[fi])  # already failed: keep
-            return new
-        jt, jc, sigma, tau, tphi = _bond_arrays(tensile_strength, cohesion, normal_stress,
-                                                shear_stress, tan_friction)
-        new_t, new_c = corrosion.degrade(jt, jc, sigma, tau, dt, beta1, beta2)
-        _, fmode = corrosion.time_to_failure(jt[fi], jc[fi], sigma[fi], tau[fi], tphi[fi],
-                                             beta1, beta2)
-        ten, sh = fi[fmode == corrosion.MODE_TENSION], fi[fmode == corrosion.MODE_SHEAR]
-        new_t[ten] = np.where(jt[ten] > sigma[ten], sigma[ten], new_t[ten])  # already failed: keep
-        target = np.maximum(tau[sh] + sigma[sh] * tphi[sh], 0.0)
-        for _ in range(4):  # undo rounding of J^C - sigma tan(phi): a few ulps at most
-            short = tau[sh] < corrosion.shear_strength(target, sigma[sh], tphi[sh])
-            target = np.where(short & (target > 0), np.nextafter(target, -np.inf), target)
-        not_yet = tau[sh] < corrosion.shear_strength(jc[sh], sigma[sh], tphi[sh])
-        new_c[sh] = np.where(not_yet, target, new_c[sh])
-        return new_t, new_c
 
     def state_dict(self):
         """JSON-serialisable state (time_limit inf is stored as None)."""
@@ -362,11 +240,3 @@ class EventClock:
         clock._creep_time = t
         clock._n_intervals, clock._n_events, clock._n_failures = counts
         return clock
-
-
-def _check_mode(mode, area_fraction):
-    if mode not in MODES:
-        raise ValueError(f"mode must be one of {MODES} (got {mode!r})")
-    if mode == "area" and area_fraction is None:
-        raise ValueError("area_fraction is required in mode='area'")
-    return mode

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -23,6 +24,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from .errors import GrainfracError, ParameterError
+from .law import LAW_NAMES
 
 PARAMS_DIR = Path(__file__).resolve().parent.parent / "params"
 DEFAULT_FILES = ("ldb_granite.toml", "stress_corrosion.toml", "numerics.toml", "loading.toml",
@@ -117,11 +119,19 @@ class NumericsParams:
 
 @dataclass(frozen=True, kw_only=True)
 class StressCorrosionParams:
-    """Hillig-Charles stress corrosion (paper Eq. 7) and its creep clocks (Eq. 8 and ours)."""
+    """Stress corrosion of bonds (paper Eq. 7 and the laws of :mod:`grainfrac_yade.law`) and its creep
+    clocks (paper Eq. 8 and ours)."""
     enabled: bool = _spec("", "bool", "stress corrosion on (creep tests); off: the load is only held")
+    law: str = _spec("", "choice", "degradation law: hillig_charles = paper Eq. 7 on strength; normalised = "
+                     "exponent on stress/strength (Potyondy 2007); area = corrosion shrinks the bond area",
+                     LAW_NAMES)
     beta1: float = _spec("Pa/s", "positive", "rate constant beta1 (paper Eq. 7)")
-    beta2: float = _spec("1/Pa", "positive", "stress sensitivity beta2 (paper Eq. 7)")
-    mode: str = _spec("", "choice", "what corrosion degrades", ("strength", "area"))
+    beta2: float = _spec("1/Pa", "positive", "stress sensitivity beta2 (paper Eq. 7; laws hillig_charles, area)")
+    beta2_normalised: float = _spec("1", "positive", "stress sensitivity on stress/strength (law normalised)")
+    threshold_ratio: float = _spec("1", "fraction_below_one", "activation threshold: no corrosion while the driving "
+                                   "stress is below this fraction of the bond's strength (Potyondy 2007); 0 = off")
+    threshold_stress: float = _spec("Pa", "nonnegative", "activation threshold: no corrosion while the driving "
+                                    "stress is below this stress (Potyondy 2007's sigma_A); 0 = off")
     clock: str = _spec("", "choice", "creep clock", ("event", "paper"))
     dt_min: float = _spec("s", "positive", "smallest creep step (paper Eq. 8)")
     dt_max: float = _spec("s", "positive", "largest creep step (paper Eq. 8)")
@@ -164,7 +174,7 @@ class UcsParams:
 
 @dataclass(frozen=True, kw_only=True)
 class CreepParams:
-    """Constant-load creep test: ramp, servo hold, equilibrium and failure (issue 5)."""
+    """Constant-load creep test (paper section 4.1): ramp, servo hold, equilibrium and failure."""
     ramp_strain_rate: float = _spec("1/s", "positive", "strain rate of the ramp to the creep load (DEM time)")
     servo_response_steps: int = _spec("1", "positive_int", "DEM steps in which the servo removes a stress error")
     servo_max_strain_rate: float = _spec("1/s", "positive", "largest platen strain rate the servo may use")
@@ -199,7 +209,7 @@ class BrazilianParams:
 
 @dataclass(frozen=True, kw_only=True)
 class CalibrationParams:
-    """Scale factors that map the paper's UDEC values onto this YADE packing (issue 4).
+    """Scale factors that map the paper's UDEC values (Tables 1 and 2) onto this YADE packing.
 
     One factor for all mineral pairs, so the ratios of Table 2 stay as printed.
     """
@@ -310,6 +320,7 @@ def _check_value(value: Any, spec: Mapping, source: str, key: str):
         "positive": (value > 0, f"must be > 0 (got {value:g})", f"give a positive value{unit_txt}"),
         "nonnegative": (value >= 0, f"must be >= 0 (got {value:g})", f"give a value >= 0{unit_txt}"),
         "fraction": (0 <= value <= 1, f"must lie in [0, 1] (got {value:g})", "give a fraction between 0 and 1"),
+        "fraction_below_one": (0 <= value < 1, f"must lie in [0, 1) (got {value:g})", "give a fraction in [0, 1)"),
         "unit_interval": (0 < value <= 1, f"must lie in (0, 1] (got {value:g})", "give a value in (0, 1]"),
         "unit_interval_open": (0 < value < 1, f"must lie in (0, 1) (got {value:g})", "give a value in (0, 1)"),
         "poisson": (-1 < value < 0.5, f"must lie in (-1, 0.5) (got {value:g})", "give a Poisson's ratio below 0.5"),
@@ -336,10 +347,45 @@ def nearest_key(word: str, keys) -> str | None:
     return tails[close[0]] if close else None
 
 
+#: Keys renamed in the schema: old dotted key -> (new dotted key, {old value: new value}).  Parameter
+#: files and --set refuse the old key in one line; params.json of older runs are migrated on reading
+#: (:func:`migrate_tree`).
+RENAMED_KEYS = {"stress_corrosion.mode": ("stress_corrosion.law", {"strength": "hillig_charles", "area": "area"})}
+
+
+def renamed_key_fix(dotted: str) -> str | None:
+    """The fix for a key the schema renamed (None if ``dotted`` was not renamed)."""
+    if dotted not in RENAMED_KEYS:
+        return None
+    new, values = RENAMED_KEYS[dotted]
+    mapping = ", ".join(f'{old!r} -> {v!r}' for old, v in values.items())
+    return f"{dotted} was replaced by {new}; write {new.rsplit('.', 1)[-1]} = ... ({mapping})"
+
+
+def migrate_tree(tree: dict) -> list:
+    """Rewrite renamed keys of a nested parameter tree (a params.json) in place; return what changed."""
+    notes = []
+    for old, (new, values) in RENAMED_KEYS.items():
+        section, key = old.split(".")
+        table = tree.get(section)
+        if not isinstance(table, dict) or key not in table:
+            continue
+        value = table.pop(key)
+        new_key = new.split(".")[1]
+        if new_key not in table:
+            table[new_key] = values.get(value, value)
+        notes.append(f"{old} = {value!r} read as {new} = {table[new_key]!r}")
+    return notes
+
+
 def _build(cls, table: Mapping, origins: Mapping, section: str):
     """Build dataclass ``cls`` from a TOML table, rejecting unknown and missing keys."""
     names = [f.name for f in dataclasses.fields(cls)]
     for key in table:
+        renamed = renamed_key_fix(f"{section}.{key}")
+        if renamed:
+            raise ParameterError(origins.get(f"{section}.{key}", "parameters"), f"{section}.{key}", "renamed key",
+                                 renamed)
         if key not in names:
             close = nearest_key(key, names)
             hint = f"did you mean {close!r}?" if close else f"known keys: {', '.join(names)}"
@@ -399,6 +445,62 @@ def read_toml(path) -> dict:
                              "fix the syntax at that line") from None
 
 
+def field_spec(dotted: str) -> Mapping:
+    """Unit, check, meaning and choices of schema key ``section.key`` (ParameterError if there is none)."""
+    section, _, key = dotted.partition(".")
+    cls = SECTION_CLASSES.get(section)
+    fields = {f.name: f for f in dataclasses.fields(cls)} if cls else {}
+    if key not in fields:
+        raise ParameterError("parameter file", dotted, "no such parameter", "use a key of the schema (params.py)")
+    return fields[key].metadata
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)            # shortest text that reads back to the same double
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, str):
+        return json.dumps(value)      # a TOML basic string
+    raise TypeError(f"no TOML form for {type(value).__name__}")
+
+
+def parameter_file_text(values: Mapping[str, Any], header=(), notes: Mapping[str, str] | None = None) -> str:
+    """A TOML parameter file (to merge with ``--params``) that sets ``values`` ({"section.key": value}).
+
+    Each value is checked as the loader checks it; each line carries its unit and meaning from the
+    schema, and ``notes[key]`` (e.g. where the value came from); ``header`` lines become comments.
+    """
+    notes = notes or {}
+    lines = [f"# {h}" if h else "#" for h in header]
+    by_section = {}
+    for dotted, value in values.items():
+        spec = field_spec(dotted)
+        typed = _check_value(value, spec, "parameter file", dotted)
+        by_section.setdefault(dotted.split(".")[0], []).append((dotted, typed, spec))
+    for section, rows in by_section.items():
+        lines += ["", f"[{section}]"]
+        for dotted, typed, spec in rows:
+            unit = spec["unit"] if spec["unit"] not in ("", "1") else "-"
+            note = f"; {notes[dotted]}" if dotted in notes else ""
+            lines.append(f"{dotted.split('.', 1)[1]} = {_toml_value(typed)}    # {unit}, {spec['doc']}{note}")
+    return "\n".join(lines) + "\n"
+
+
+def write_parameter_file(path, values: Mapping[str, Any], header=(), notes: Mapping[str, str] | None = None):
+    """Write :func:`parameter_file_text` to ``path`` (atomically) and check that it loads; return the path."""
+    from .runio import _write_atomically
+    text = parameter_file_text(values, header, notes)
+    loaded = tomllib.loads(text)
+    for dotted, value in values.items():
+        section, key = dotted.split(".", 1)
+        if loaded[section][key] != value:
+            raise GrainfracError(f"{path}: {dotted} would read back as {loaded[section][key]!r}, not {value!r}")
+    return _write_atomically(path, lambda tmp: Path(tmp).write_text(text))
+
+
 def parse_override(text: str) -> tuple:
     """Split ``section.key=value``; the value is read as TOML, else as a plain string."""
     if "=" not in text or "." not in text.split("=", 1)[0]:
@@ -455,6 +557,8 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
     for text in overrides:
         key, value = parse_override(text) if isinstance(text, str) else text
         flat_known = flatten(merged)
+        if renamed_key_fix(key):
+            raise ParameterError("--set", key, "renamed key", renamed_key_fix(key))
         if key not in flat_known and not _is_new_pair_key(key):
             close = nearest_key(key, flat_known)
             raise ParameterError("--set", key, "no such parameter",
@@ -521,6 +625,7 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
                              f"dt_min = {sc.dt_min:g} s exceeds dt_max = {sc.dt_max:g} s",
                              "make dt_min <= dt_max")
     typed["stress_corrosion"] = _rate_constants(sc, origins)
+    _check_law(sc, origins)
     _check_grain_size(typed["specimen"], origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
 
@@ -549,6 +654,16 @@ def require_plane(params: Parameters, command: str):
         raise GrainfracError(f"specimen.dimension = {params.specimen.dimension}: the {command} command runs plane "
                              "(2D) specimens only; fix: set specimen.dimension = 2 (the specimen command builds "
                              "3D specimens)")
+
+
+def _check_law(sc: StressCorrosionParams, origins: Mapping):
+    """The activation threshold belongs to the strength laws: the area law has none."""
+    if sc.law == "area":
+        for key in ("threshold_ratio", "threshold_stress"):
+            if getattr(sc, key) > 0:
+                raise ParameterError(origins.get(f"stress_corrosion.{key}", "parameters"), f"stress_corrosion.{key}",
+                                     f"{getattr(sc, key):g} with law = \"area\" (the area law has no activation "
+                                     "threshold)", "set it to 0, or choose law hillig_charles or normalised")
 
 
 def _rate_constants(sc: StressCorrosionParams, origins: Mapping) -> StressCorrosionParams:

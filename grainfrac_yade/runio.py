@@ -194,8 +194,9 @@ def comparable_parameters(tree: dict) -> dict:
     """A parameter tree (``Parameters.to_dict()`` or a params.json) as {dotted key: value} as JSON
     stores it, without the provenance entries (:data:`PROVENANCE_KEYS`) and the parameters that do
     not change results (:data:`RESULT_NEUTRAL_KEYS`)."""
-    from .params import flatten
+    from .params import flatten, migrate_tree
     tree = json.loads(json.dumps(_clean({k: v for k, v in tree.items() if k not in PROVENANCE_KEYS})))
+    migrate_tree(tree)   # renamed keys of older params.json (stress_corrosion.mode -> law)
     return {k: v for k, v in flatten(tree).items() if k not in RESULT_NEUTRAL_KEYS}
 
 

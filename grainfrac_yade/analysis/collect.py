@@ -6,13 +6,19 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..params import RENAMED_KEYS, migrate_tree
 from ..params import flatten as flatten_tree
 
-#: Parameter paths copied from each run's params.json into the table.
+#: Parameter paths copied from each run's params.json into the table (older params.json are read through
+#: :func:`~grainfrac_yade.params.migrate_tree`: ``stress_corrosion.mode`` becomes ``stress_corrosion.law``).
 PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resolution.nodes_per_face",
                  "specimen.grain_size", "specimen.width", "specimen.height",
                  "calibration.strength_scale", "calibration.stiffness_scale", "stress_corrosion.clock",
-                 "stress_corrosion.mode", "stress_corrosion.beta1")
+                 "stress_corrosion.law", "stress_corrosion.beta1", "stress_corrosion.beta2",
+                 "stress_corrosion.beta2_normalised", "stress_corrosion.threshold_ratio",
+                 "stress_corrosion.threshold_stress")
+#: summary.json of creep runs made before the degradation laws had names: "mode" -> "law".
+_SUMMARY_LAW = RENAMED_KEYS["stress_corrosion.mode"][1]
 
 
 def _get(tree: dict, dotted: str):
@@ -65,10 +71,13 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
             params_file = folder / "params.json"
             if params_file.exists():
                 params = _read_json(params_file)
+                migrate_tree(params)
                 row.update(flatten(params) if all_params else {k: _get(params, k) for k in PARAM_COLUMNS})
             summary_file = folder / "summary.json"
             if summary_file.exists():
                 summary = _read_json(summary_file)
+                if "mode" in summary and "law" not in summary:
+                    summary["law"] = _SUMMARY_LAW.get(summary.pop("mode"))
                 row.update({k: v for k, v in summary.items() if not isinstance(v, (dict, list))})
                 row["status"] = "finished"
             elif failed is not None:

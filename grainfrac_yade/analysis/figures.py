@@ -1,7 +1,8 @@
-"""Figures of a creep study (paper Fig. 4, 5, 6 and 9); each function writes one PNG and returns its path.
+"""Figures of a creep study (paper Fig. 4, 5, 6 and 9) and of one creep run; each function writes one PNG.
 
 Inputs are plain arrays and DataFrames (history.csv tables, lifetime sets); nothing here reads
-run folders. Strain is compression positive and drawn in %.
+run folders. Strain is compression positive and drawn in %.  Pictures of specimens and the crack
+map itself are :mod:`grainfrac_yade.plotting`; everything built from results is here.
 """
 from __future__ import annotations
 
@@ -22,6 +23,10 @@ FIT_MARGIN = 0.02
 STRAIN_PAD = 0.08
 #: Upward arrows of lower bounds (runs that did not fail) reach this factor times the end time.
 LOWER_BOUND_ARROW = 5.0
+#: Fractions of the lifetime (or of a run's end time) at which crack maps are drawn, for a run and for a
+#: study: early in primary creep, mid-life, tertiary creep and failure, as the points in time of paper
+#: Fig. 7 (taken from its Fig. 6 curve).
+MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
 STAGE_MARKERS = {"primary_end_s": ("o", "end of primary creep"), "tertiary_start_s": ("^", "start of tertiary creep")}
 
 
@@ -277,3 +282,51 @@ def damage_figure(path, curves):
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)
+
+
+# ----------------------------------------------------------------------------- one creep run
+def run_bond_stress_figure(table, stress, path):
+    """One run: histograms of bond normal and shear stress at the start of the creep phase (the tail
+    that paper Eq. 7 turns into lifetimes)."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for ax, key, label in ((axes[0], "normal_stress_pa", "normal stress (tension +) [MPa]"),
+                           (axes[1], "shear_stress_pa", "shear stress [MPa]")):
+        ax.hist(np.asarray(table[key]) / 1e6, bins=60, log=True)
+        ax.set_xlabel(label)
+        ax.set_ylabel("bonds")
+    fig.suptitle(f"bond stresses at the creep load {stress / 1e6:.0f} MPa (after the ramp)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def run_strain_time_figure(hist, summary, path):
+    """One run: axial strain and creep cracks against creep time, creep stages marked (paper Fig. 6)."""
+    t = hist["creep_time_s"]
+    strain = hist["axial_strain"] * 100
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    ax.plot(t, strain, drawstyle="steps-post", label="axial strain")
+    if summary["failed"] and len(strain) > 2:
+        # scale to the creep before the collapse row; the collapse is marked, not drawn to scale
+        lo, hi = strain[:-1].min(), strain[:-1].max()
+        pad = 0.1 * max(hi - lo, 1e-6)
+        ax.set_ylim(lo - pad, hi + 3 * pad)
+        ax.annotate(f"failure (strain {strain[-1]:.2f} %)", xy=(t[-1], hi + 2.5 * pad), ha="right", fontsize=7,
+                    xytext=(t[-1], hi + 2.5 * pad))
+    for key, label in (("primary_end_s", "end of primary"), ("tertiary_start_s", "start of tertiary")):
+        if summary.get(key) is not None:
+            ax.axvline(summary[key], color="grey", ls=":", lw=0.8)
+            ax.text(summary[key], ax.get_ylim()[0], " " + label, rotation=90, va="bottom", fontsize=7)
+    ax2 = ax.twinx()
+    ax2.plot(t, hist["broken_creep"], color="tab:red", lw=0.8, drawstyle="steps-post", label="broken bonds (creep)")
+    if summary["failed"] and len(t) > 2:
+        ax2.set_ylim(0, 1.3 * max(hist["broken_creep"][:-1].max(), 1))
+    ax2.set_ylabel("broken bonds since creep start", color="tab:red")
+    ax.set_xlabel("creep time [s]")
+    ax.set_ylabel("axial strain [%]")
+    state = ("numerical failure: no result" if summary.get("numerical_failure") else
+             f"lifetime {summary['lifetime_s']:.4g} s" if summary["failed"] else "not failed")
+    ax.set_title(f"{summary['stress_pa'] / 1e6:.0f} MPa ({summary['clock']} clock): {state}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)

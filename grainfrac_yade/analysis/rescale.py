@@ -1,6 +1,7 @@
 """Creep times of a study shown at another stress-corrosion rate beta1 (``analyze --beta1``).
 
-In strength mode (paper Eq. 7: dJ/dt = -beta1 exp(beta2 sigma)) with the event clock, every
+With a strength law (paper Eq. 7: dJ/dt = -beta1 exp(beta2 sigma), or its strength-normalised form,
+with or without an activation threshold) and the event clock, every
 interval between bond failures is a strength margin divided by beta1 exp(beta2 sigma) under
 frozen stresses, and the DEM relaxation in between does not know about time. So with beta2
 unchanged the failure sequence is the same and every creep time is proportional to 1/beta1
@@ -12,7 +13,7 @@ Not exact, so refused (GrainfracError naming the run folder, the reason and the 
 - the paper clock (Eq. 8): its steps dt_min, dt_max are absolute seconds and its step control
   depends on the unbalanced force, not on time, so the sequence changes with beta1;
 - ``rate_form = "physical"``: beta1 and beta2 both come from Eq. 6 at a temperature;
-- area mode: exact in principle, but its integration has absolute cut-offs and no test checks it.
+- the area law: exact in principle, but no test checks it.
 """
 from __future__ import annotations
 
@@ -24,6 +25,8 @@ import pandas as pd
 
 from ..errors import GrainfracError
 
+#: Laws whose creep times are all proportional to 1/beta1 (``time_scales_with_beta1`` in grainfrac_yade.law).
+TIME_SCALE_LAWS = ("hillig_charles", "normalised")
 #: Summary and table columns that are creep times [s] (wall_s is wall-clock time: not scaled).
 TIME_COLUMNS = ("lifetime_s", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
                 "stress_corrosion.creep_time_limit")
@@ -66,18 +69,19 @@ def _text(v) -> str | None:
 def not_rescalable(row: dict) -> str | None:
     """Why a run's times cannot be rescaled exactly (None if they can)."""
     clock = _text(row.get("stress_corrosion.clock"))
-    mode = _text(row.get("stress_corrosion.mode"))
+    law = _text(row.get("stress_corrosion.law"))
     form = _text(row.get("stress_corrosion.rate_form"))
     beta1 = pd.to_numeric(pd.Series([row.get("stress_corrosion.beta1")]), errors="coerce").iloc[0]
-    if clock is None or mode is None or not (beta1 > 0):
-        return "params.json lacks stress_corrosion.clock, mode or beta1, so the run's clock and rate are unknown"
+    if clock is None or law is None or not (beta1 > 0):
+        return "params.json lacks stress_corrosion.clock, law or beta1, so the run's clock and rate are unknown"
     if clock != "event":
         return (f"clock = {clock!r}: the paper clock (Eq. 8) steps by absolute dt_min/dt_max seconds controlled "
                 "by the unbalanced force, so its failure sequence changes with beta1")
     if form not in (None, "beta"):
         return f"rate_form = {form!r}: beta1 and beta2 both follow from Eq. 6, so beta2 is not held fixed"
-    if mode != "strength":
-        return f"mode = {mode!r}: only strength mode is checked to scale exactly with 1/beta1"
+    if law not in TIME_SCALE_LAWS:
+        return (f"law = {law!r}: only the strength laws ({', '.join(TIME_SCALE_LAWS)}) are checked to scale exactly "
+                "with 1/beta1")
     return None
 
 

@@ -75,6 +75,8 @@ def load_run_parameters(path, fill_missing: bool = False) -> RunParameters:
         path = path / "params.json"
     tree = _read(path)
     sources = tree.pop("sources", ())
+    from ..params import migrate_tree
+    migrate_tree(tree)   # renamed keys (stress_corrosion.mode -> stress_corrosion.law) read as today's
     filled = []
     if fill_missing:
         for section, table in default_tree().items():

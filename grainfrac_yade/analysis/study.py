@@ -17,15 +17,13 @@ from ..errors import GrainfracError
 from ..runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crackmaps, figures, rescale
 from .collect import code_version_note, collect_runs, flatten
-from .figures import Curve, LifetimeSet
+from .figures import MAP_FRACTIONS, Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
 from .lifetimes import _num, classify_runs, lifetime_stats, representatives
 from .report import ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
 from .runparams import default_tree, rebuild_specimen
 
-#: Fractions of the lifetime (or of the run's end time) at which crack maps are drawn (paper Fig. 7).
-MAP_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
 #: Parameters that do not make a different model (a longer time limit is the same model; how often a run
 #: was checkpointed changes nothing it computes).
 VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
@@ -33,7 +31,7 @@ VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
 CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "unfinished", "run error")
 #: Columns of runs.csv (those present).
 RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
-             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "mode", "n_events",
+             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
              "tertiary_start_s", "dem_steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
              "study", "beta1_run", "time_factor", "code_version", "problem")

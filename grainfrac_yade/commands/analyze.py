@@ -48,7 +48,8 @@ def register(sub, common):
 
 def cmd_analyze(args) -> int:
     from ..analysis.rescale import beta1_from_toml
-    from ..analysis.study import MAP_FRACTIONS, analyze_study
+    from ..analysis.figures import MAP_FRACTIONS
+    from ..analysis.study import analyze_study
     beta1, source = args.beta1, "--beta1"
     if args.beta1_file is not None:
         beta1, source = beta1_from_toml(args.beta1_file), f"--beta1-file {args.beta1_file}"

@@ -35,15 +35,13 @@ def register(sub, common):
     p.add_argument("--target-young", type=float, default=TARGET_YOUNG)
     p.add_argument("--jobs", type=int, default=1, help="seeds run in parallel (one process each)")
     p.add_argument("--write", default=str(CALIBRATION_FILE), help="calibration file to (over)write")
-    p.set_defaults(func=cmd_calibrate)
+    p.set_defaults(func=cmd_calibrate, with_params=True)
 
 
-def cmd_calibrate(args) -> int:
-    from ..cli import overrides_from_args
+def cmd_calibrate(args, params) -> int:
     from ..params import load_parameters, require_plane
     from ..runio import prepare_run_dir, write_csv
-    base = overrides_from_args(args)
-    params = load_parameters(extra_files=args.params, overrides=base)
+    base = list(args.resolved_overrides)   # the overrides of ``params``, for each round's parameter set
     require_plane(params, "calibrate")
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,
                           overwrite=args.overwrite)

@@ -1,12 +1,14 @@
 """``calibrate-beta1``: one factor on beta1 so that the model's lifetime at the paper's reference
-load matches the paper's UDEC lifetime (issue 5d); writes ``params/stress_corrosion_calibrated.toml``.
+load (160 MPa, paper section 4.1) matches the paper's UDEC lifetime (1.62e4 s); writes
+``params/stress_corrosion_calibrated.toml``.
 
-Why one factor is enough: in strength mode with the event clock every time to failure is
-(J - s) / (beta1 exp(beta2 s)) and the degradation of every other bond over that interval is
-beta1 exp(beta2 s) dt, independent of beta1; so the whole failure sequence is unchanged and all
-creep times scale exactly as 1/beta1 (tests/test_creep.py checks this to 1e-9). The factor is
-the geometric mean of the seeds' lifetimes at the paper's load over the paper's lifetime.
-Never tuned per run: the file is used as it is for every load (``--params``).
+Why one factor is enough: with a strength law (paper Eq. 7) and the event clock every time to
+failure is (J - s) / (beta1 exp(beta2 s)) and the degradation of every other bond over that interval
+is beta1 exp(beta2 s) dt, independent of beta1; so the whole failure sequence is unchanged and all
+creep times scale exactly as 1/beta1 (tests/test_creep.py checks this to 1e-9). The factor is the
+geometric mean of the seeds' lifetimes at the paper's load over the paper's lifetime.  Never tuned
+per run: the file is used as it is for every load (``--params``).  To fit beta2 and an activation
+threshold too, against lab lifetimes at several loads: ``calibrate-lifetimes``.
 """
 from __future__ import annotations
 
@@ -37,18 +39,19 @@ def beta1_factor(lifetimes, target_s: float) -> dict:
 
 
 def select_reference_runs(runs, stress_pa: float):
-    """Finished, failed (not on loading) event-clock strength-mode creep runs at ``stress_pa``."""
+    """Finished, failed (not on loading) event-clock creep runs of a strength law at ``stress_pa``."""
+    from ..analysis.rescale import TIME_SCALE_LAWS
     from ..errors import GrainfracError
-    need = ("stress_pa", "lifetime_s", "failed", "clock", "mode")
+    need = ("stress_pa", "lifetime_s", "failed", "clock", "law")
     if runs.empty or any(c not in runs for c in need):
         raise GrainfracError("no finished creep runs in the folder; fix: run params/lifetime_ldb.table first")
     sel = runs[(runs["status"] == "finished") & (runs["failed"] == True)  # noqa: E712 (pandas mask)
                & np.isclose(runs["stress_pa"].astype(float), stress_pa, rtol=STRESS_MATCH_RTOL, atol=0)
-               & (runs["clock"] == "event") & (runs["mode"] == "strength")]
+               & (runs["clock"] == "event") & runs["law"].isin(TIME_SCALE_LAWS)]
     if "failed_on_loading" in sel:
         sel = sel[sel["failed_on_loading"] != True]  # noqa: E712
     if len(sel) < 2:
-        raise GrainfracError(f"{len(sel)} failed event-clock strength-mode run(s) at {stress_pa / 1e6:g} MPa; "
+        raise GrainfracError(f"{len(sel)} failed event-clock strength-law run(s) at {stress_pa / 1e6:g} MPa; "
                              "fix: at least 2 seeds at the paper's load are needed (params/lifetime_ldb.table)")
     betas = sel["stress_corrosion.beta1"].astype(float).unique()
     if len(betas) != 1:
@@ -68,22 +71,22 @@ def cmd_calibrate_beta1(args) -> int:
     runs, beta1_run = select_reference_runs(collect_runs(folder), ref.stress_pa)
     fit = beta1_factor(runs["lifetime_s"].astype(float), ref.lifetime_s)
     beta1 = beta1_run * fit["factor"]
+    from ..params import write_parameter_file
     out = Path(args.out or Path(__file__).resolve().parents[2] / "params" / "stress_corrosion_calibrated.toml")
-    rows = "\n".join(f"#   seed {int(r['seed'])}: lifetime {r['lifetime_s']:.4g} s, {int(r['n_events'])} events ({r['run']})"
-                     for _, r in runs.sort_values("seed").iterrows())
-    out.write_text(f"""# Calibrated stress-corrosion rate (issue 5d): ONE factor on beta1, the same for every load.
-# Use: --params {out.name if out.parent.name == 'params' else out}   (merged over params/stress_corrosion.toml)
-# Written by: python3 -m grainfrac_yade calibrate-beta1 {folder}   ({code_version()})
-# Target: the paper's UDEC lifetime {ref.lifetime_s:.6g} s at {ref.stress_pa / 1e6:g} MPa ({ref.values_file.name}).
-# Model runs at that load (event clock, strength mode, beta1 = {beta1_run:g} Pa/s):
-{rows}
-# Geometric mean {fit['geometric_mean_s']:.4g} s (sd of log10 t: {fit['log10_sd']:.2f}) -> factor {fit['factor']:.4g}.
-# Exact for the event clock in strength mode: every creep time scales as 1/beta1 (tests/test_creep.py).
-# beta2 stays the paper's value: the factor is a time scale, not a change of stress sensitivity.
-
-[stress_corrosion]
-beta1 = {beta1:.6e}                # Pa/s = {beta1_run:g} x {fit['factor']:.6g} (fitted; paper: {beta1_run:g})
-""")
+    header = [
+        "Calibrated stress-corrosion rate: ONE factor on beta1, the same for every load.",
+        f"Use: --params {out.name if out.parent.name == 'params' else out}   (merged over params/stress_corrosion.toml)",
+        f"Written by: python3 -m grainfrac_yade calibrate-beta1 {folder}   ({code_version()})",
+        f"Target: the paper's UDEC lifetime {ref.lifetime_s:.6g} s at {ref.stress_pa / 1e6:g} MPa ({ref.values_file.name}).",
+        f"Model runs at that load (event clock, strength law, beta1 = {beta1_run:g} Pa/s):",
+        *(f"  seed {int(r['seed'])}: lifetime {r['lifetime_s']:.4g} s, {int(r['n_events'])} events ({r['run']})"
+          for _, r in runs.sort_values("seed").iterrows()),
+        f"Geometric mean {fit['geometric_mean_s']:.4g} s (sd of log10 t: {fit['log10_sd']:.2f}) -> factor {fit['factor']:.4g}.",
+        "Exact for the event clock with a strength law: every creep time scales as 1/beta1 (tests/test_creep.py).",
+        "beta2 stays the paper's value: the factor is a time scale, not a change of stress sensitivity.",
+    ]
+    write_parameter_file(out, {"stress_corrosion.beta1": beta1}, header,
+                         {"stress_corrosion.beta1": f"= {beta1_run:g} x {fit['factor']:.6g} (fitted; paper: {beta1_run:g})"})
     print(f"beta1 factor {fit['factor']:.4g} (geometric mean {fit['geometric_mean_s']:.4g} s over {len(runs)} seeds "
           f"vs paper {ref.lifetime_s:.4g} s) -> beta1 = {beta1:.4g} Pa/s written to {out}")
     return 0

@@ -1,4 +1,4 @@
-"""``creep``: constant-load creep test to failure; history, cracks, summary, figures."""
+"""``creep``: constant-load creep test to failure (paper section 4.1); history, cracks, summary, figures."""
 from __future__ import annotations
 
 import math
@@ -7,9 +7,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GrainfracError
-
-#: Fractions of the lifetime (or of the last creep time) at which crack maps are drawn (paper Fig. 7).
-MAP_FRACTIONS = (0.0, 0.5, 0.9, 1.0)
 
 
 def register(sub, common):
@@ -28,7 +25,11 @@ def register(sub, common):
                    help="go on with the interrupted creep run in DIR from its last checkpoint (DIR/checkpoint/, "
                         "written at the end of the ramp and every creep.checkpoint_interval s); load, seed and "
                         "parameters come from DIR")
-    p.set_defaults(func=cmd_creep)
+    p.set_defaults(func=cmd_creep, with_params=True, param_overrides=_clock_override)
+
+
+def _clock_override(args) -> list:
+    return [f"stress_corrosion.clock={args.clock}"] if args.clock else []
 
 
 def outcome(summary: dict) -> str:
@@ -79,8 +80,7 @@ RESUME_CONFLICTS = (("stress", "--stress"), ("ratio", "--ratio"), ("ucs", "--ucs
                     ("vtk_times", "--vtk-times"), ("out", "--out"), ("overwrite", "--overwrite"))
 
 
-def cmd_creep(args) -> int:
-    from ..cli import load_params_from_args
+def cmd_creep(args, params) -> int:
     from ..params import require_plane
     if args.resume:
         given = [flag for attr, flag in RESUME_CONFLICTS if getattr(args, attr, None) not in (None, [], False)]
@@ -95,9 +95,6 @@ def cmd_creep(args) -> int:
               f"resumed: {outcome(s)}, {s['n_events']} events, {s['broken_creep']} creep cracks, {s['dem_steps']} "
               f"DEM steps -> {args.resume}")
         return 0
-    if args.clock:
-        args.overrides.append(f"stress_corrosion.clock={args.clock}")
-    params = load_params_from_args(args)
     require_plane(params, "creep")
     stress, ratio, ref = resolve_stress(params, args.stress, args.ratio, args.ucs)
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
@@ -153,9 +150,10 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     """
     import time
 
+    from ..analysis.figures import MAP_FRACTIONS, run_bond_stress_figure, run_strain_time_figure
     from ..creep_analysis import creep_stages, damage_index
-    from ..plotting import crack_map
     from ..params import require_plane
+    from ..plotting import crack_map
     from ..runio import (prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
     from ..specimen import build_specimen
@@ -196,7 +194,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
-        "clock": params.stress_corrosion.clock, "mode": params.stress_corrosion.mode,
+        "clock": params.stress_corrosion.clock, "law": params.stress_corrosion.law,
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
@@ -208,11 +206,11 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         summary["resumed_from"] = run.resumes   # checkpoints this run went on from (only in resumed runs)
     if run.initial_bond_stresses is not None:
         write_csv(out / "bond_stresses_start.csv", run.initial_bond_stresses)
-        bond_stress_figure(run.initial_bond_stresses, stress, out / "bond_stresses_start.png")
+        run_bond_stress_figure(run.initial_bond_stresses, stress, out / "bond_stresses_start.png")
         t = run.initial_bond_stresses["shear_stress_pa"]
         summary.update(shear_stress_p99_pa=float(np.percentile(t, 99)), shear_stress_max_pa=float(t.max()),
                        shear_utilisation_max=float(np.max(run.initial_bond_stresses["shear_utilisation"])))
-    strain_time_figure(hist, summary, out / "strain_time.png")
+    run_strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
     for frac in MAP_FRACTIONS:
         t = frac * t_ref
@@ -236,7 +234,8 @@ def end_reason(run, params, t_end) -> str:
     if t_end >= sc.creep_time_limit:
         return (f"creep time reached stress_corrosion.creep_time_limit = {sc.creep_time_limit:g} s: not failed, "
                 "the lifetime is a lower bound")
-    return "no intact bond can fail under the held stresses (Eq. 7 gives an infinite time): not failed"
+    return ("no intact bond can fail under the held stresses (the degradation law gives an infinite time, e.g. "
+            "every bond below its activation threshold): not failed")
 
 
 def _row_before_history(run, counts) -> dict:
@@ -268,53 +267,6 @@ def write_crack_list(path, run):
         "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
         "x0_m": seg[:, 0, 0], "y0_m": seg[:, 0, 1], "x1_m": seg[:, 1, 0], "y1_m": seg[:, 1, 1],
         "macro_time_s": run.macro_time[idx]})
-
-
-def bond_stress_figure(table, stress, path):
-    """Histograms of bond normal and shear stress at the start of the creep phase (issue 5c)."""
-    from ..plotting import plt
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    for ax, key, label in ((axes[0], "normal_stress_pa", "normal stress (tension +) [MPa]"),
-                           (axes[1], "shear_stress_pa", "shear stress [MPa]")):
-        ax.hist(np.asarray(table[key]) / 1e6, bins=60, log=True)
-        ax.set_xlabel(label)
-        ax.set_ylabel("bonds")
-    fig.suptitle(f"bond stresses at the creep load {stress / 1e6:.0f} MPa (after the ramp)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-
-
-def strain_time_figure(hist, summary, path):
-    from ..plotting import plt
-    t = hist["creep_time_s"]
-    strain = hist["axial_strain"] * 100
-    fig, ax = plt.subplots(figsize=(6, 4.2))
-    ax.plot(t, strain, drawstyle="steps-post", label="axial strain")
-    if summary["failed"] and len(strain) > 2:
-        # scale to the creep before the collapse row; the collapse is marked, not drawn to scale
-        lo, hi = strain[:-1].min(), strain[:-1].max()
-        pad = 0.1 * max(hi - lo, 1e-6)
-        ax.set_ylim(lo - pad, hi + 3 * pad)
-        ax.annotate(f"failure (strain {strain[-1]:.2f} %)", xy=(t[-1], hi + 2.5 * pad), ha="right", fontsize=7,
-                    xytext=(t[-1], hi + 2.5 * pad))
-    for key, label in (("primary_end_s", "end of primary"), ("tertiary_start_s", "start of tertiary")):
-        if summary.get(key) is not None:
-            ax.axvline(summary[key], color="grey", ls=":", lw=0.8)
-            ax.text(summary[key], ax.get_ylim()[0], " " + label, rotation=90, va="bottom", fontsize=7)
-    ax2 = ax.twinx()
-    ax2.plot(t, hist["broken_creep"], color="tab:red", lw=0.8, drawstyle="steps-post", label="broken bonds (creep)")
-    if summary["failed"] and len(t) > 2:
-        ax2.set_ylim(0, 1.3 * max(hist["broken_creep"][:-1].max(), 1))
-    ax2.set_ylabel("broken bonds since creep start", color="tab:red")
-    ax.set_xlabel("creep time [s]")
-    ax.set_ylabel("axial strain [%]")
-    state = ("numerical failure: no result" if summary.get("numerical_failure") else
-             f"lifetime {summary['lifetime_s']:.4g} s" if summary["failed"] else "not failed")
-    ax.set_title(f"{summary['stress_pa'] / 1e6:.0f} MPa ({summary['clock']} clock): {state}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
 
 
 #: yade-batch columns of a creep row that are not model parameters [Pa or 1; 0 = not given].

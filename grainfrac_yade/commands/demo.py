@@ -38,16 +38,15 @@ def register(sub, common):
     p.add_argument("--width", type=float, default=DEMO_WIDTH_M, help="specimen width [m]")
     p.add_argument("--height", type=float, default=DEMO_HEIGHT_M, help="specimen height [m]")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: cores)")
-    p.set_defaults(func=cmd_demo)
+    p.set_defaults(func=cmd_demo, with_params=True)
 
 
 def _say(t0, msg):
     print(f"[demo {time.time() - t0:6.0f} s] {msg}", flush=True)
 
 
-def cmd_demo(args) -> int:
+def cmd_demo(args, params) -> int:
     from ..batchrun import run_batch, write_table
-    from ..cli import load_params_from_args
     from ..errors import GrainfracError
     from ..params import require_plane
     from .specimen import run_specimen
@@ -56,11 +55,8 @@ def cmd_demo(args) -> int:
     out = Path(args.out or time.strftime("results/demo_%Y%m%d-%H%M%S")).resolve()  # a new folder each run
     if out.exists() and any(out.iterdir()) and not args.overwrite:
         raise GrainfracError(f"{out} already holds results; fix: choose another --out or add --overwrite")
-    geometry = [("specimen.width", args.width), ("specimen.height", args.height)]
-    args.overrides = list(args.overrides) + [f"{k}={v}" for k, v in geometry]
-    params = load_params_from_args(args)   # validates --params/--set before anything runs
-    require_plane(params, "demo")
-    extra = _flat_overrides(args.params, args.overrides)
+    require_plane(params, "demo")   # params: loaded (--params/--set validated) before anything runs
+    extra = _flat_overrides(args.params, args.resolved_overrides)   # --set and --width/--height
     _say(t0, f"specimen {args.width * 1e3:.0f} x {args.height * 1e3:.0f} mm, seeds {args.seeds}, "
              f"ratios {args.ratios}, {args.jobs} jobs -> {out}")
     rec = run_specimen(params, args.seeds[0], out / "specimen", overwrite=args.overwrite)

@@ -27,17 +27,18 @@ def register(sub, common):
     p.add_argument("--platens", choices=("cells", "wall"), default="cells",
                    help="cells: the end cells move with the platens, as in the YADE tests; wall: only nodes "
                         "on the walls (triangle meshes only)")
-    p.set_defaults(func=cmd_elastic)
+    p.set_defaults(func=cmd_elastic, with_params=True, param_overrides=_model_overrides)
 
 
-def cmd_elastic(args) -> int:
-    from ..cli import load_params_from_args
-    from ..params import require_plane
-    if args.nodes_per_face is not None:
-        args.overrides.append(f"resolution.nodes_per_face={args.nodes_per_face}")
+def _model_overrides(args) -> list:
+    out = [f"resolution.nodes_per_face={args.nodes_per_face}"] if args.nodes_per_face is not None else []
     if args.grains in CLUSTER_MODELS:
-        args.overrides.append(f"resolution.grain_model={CLUSTER_MODELS[args.grains]}")
-    params = load_params_from_args(args)
+        out.append(f"resolution.grain_model={CLUSTER_MODELS[args.grains]}")
+    return out
+
+
+def cmd_elastic(args, params) -> int:
+    from ..params import require_plane
     require_plane(params, "elastic")
     out = args.out or f"results/elastic_seed{args.seed}"
     summary = run_elastic_to_folder(params, args.seed, out, args.grains, params.resolution.nodes_per_face, args.contacts,

@@ -1,4 +1,4 @@
-"""``ucs``: uniaxial compression test; summary.json, history.csv, stress_strain.png, crack map at peak."""
+"""``ucs``: uniaxial compression test (paper section 3.1); summary.json, history.csv, stress_strain.png, crack map at peak."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -9,13 +9,11 @@ import numpy as np
 def register(sub, common):
     p = sub.add_parser("ucs", help="strain-controlled uniaxial compression test")
     common(p)
-    p.set_defaults(func=cmd_ucs)
+    p.set_defaults(func=cmd_ucs, with_params=True)
 
 
-def cmd_ucs(args) -> int:
-    from ..cli import load_params_from_args
+def cmd_ucs(args, params) -> int:
     from ..params import require_plane
-    params = load_params_from_args(args)
     require_plane(params, "ucs")
     out = args.out or f"results/ucs_seed{args.seed}"
     summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import statistics
 import time
 
-from .. import corrosion
 from .creep_test import CreepRun
 
 #: DEM steps of the probe that sizes the timing windows.
@@ -161,12 +160,11 @@ def time_bond_io(corr, repeats: int) -> dict:
     read, write, law = [], [], []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        sigma, tau = corr.stresses(idx)
+        stresses = corr.stresses(idx)
         t1 = time.perf_counter()
         corr.write(idx)   # the current strengths: writing them changes nothing
         t2 = time.perf_counter()
-        jt, jc = corr.law_arrays(idx)
-        corrosion.time_to_failure(jt, jc, sigma, tau, corr.tan_phi[idx], corr.p.beta1, corr.p.beta2)
+        corr.law.time_to_failure(corr.state.subset(idx), stresses)
         law.append(time.perf_counter() - t2)
         read.append(t1 - t0)
         write.append(t2 - t1)

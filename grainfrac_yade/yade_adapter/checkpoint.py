@@ -3,9 +3,9 @@
 A checkpoint is the folder ``DIR/checkpoint/`` (:data:`grainfrac_yade.runio.CHECKPOINT`):
 
 * ``scene.yade.gz``: the YADE scene (``O.save``, YADE's binary archive, gzip'd: exact doubles);
-* ``arrays.npz``: the driver's per-bond arrays (bookkeeping of breaks, degraded strengths J^T, J^C
-  of paper Eq. 7 or area fractions, break and macrocrack times, the bond stresses at the start of
-  creep);
+* ``arrays.npz``: the driver's per-bond arrays (bookkeeping of breaks, the degradation law's state:
+  strengths J^T, J^C of paper Eq. 7 or area fractions, break and macrocrack times, the bond
+  stresses at the start of creep);
 * ``state.json``: everything else (phase, clock state, servo and platen state, history rows so
   far, run values), written last.
 
@@ -159,7 +159,7 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
                           "stress": float(servo.stress)}
     if run.corr is not None:
         corr = run.corr.state_dict()
-        state["corrosion"] = {"creep_time": corr["creep_time"], "mode": corr["mode"]}
+        state["corrosion"] = {"creep_time": corr["creep_time"], "law": corr["law"], "restored": corr["restored"]}
         arrays.update(tensile_strength_pa=np.asarray(corr["tensile_strength_pa"]),
                       cohesion_pa=np.asarray(corr["cohesion_pa"]), area_fraction=np.asarray(corr["area_fraction"]))
     clock = getattr(run, "clock", None)
@@ -224,6 +224,7 @@ def restore(run, where, state: dict, arrays: dict):
     """
     from ..clocks import EventClock, PaperClock
     from .corrosion_engine import StressCorrosion
+    from .creep_test import add_stiffness_restorer
     from .platens import StressServo
     sc, pl = run.scene, run.platens
     O = sc.O
@@ -261,10 +262,12 @@ def restore(run, where, state: dict, arrays: dict):
     if state["corrosion"] is not None:
         corr = StressCorrosion(sc, run.params.stress_corrosion)
         corr.load_state({"creep_time": state["corrosion"]["creep_time"],
+                         "restored": state["corrosion"].get("restored", []),
                          **{k: arrays[k] for k in ("tensile_strength_pa", "cohesion_pa", "area_fraction")}},
                         write=False)
         run.corr = corr
         sc.extras.append(corr)
+        add_stiffness_restorer(sc, corr)
     if state["clock"] is not None:
         kind = state["clock"].get("kind")
         run.clock = (EventClock if kind == EventClock.KIND else PaperClock).from_state(state["clock"])

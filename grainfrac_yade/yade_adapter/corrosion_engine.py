@@ -1,28 +1,28 @@
-"""Hillig-Charles stress corrosion of the scene's cohesive bonds (paper Eq. 7), driven by a creep clock.
+"""Stress corrosion of the scene's cohesive bonds: the YADE side of a degradation law.
 
-The bond state lives in numpy arrays (strengths, area fractions); YADE is touched
-only to read bond forces and to write ``FnMax``/``FsMax`` (and ``kn``/``ks`` in
-the area mode).  Two degradation modes (``stress_corrosion.mode``):
+The law (:mod:`grainfrac_yade.law`, built once from ``[stress_corrosion]``) and its per-bond state
+(:class:`~grainfrac_yade.law.BondState`) are pure numpy.  This adapter only reads bond forces
+(:meth:`StressCorrosion.stresses`) and writes what the law says a bond can carry: ``FnMax`` and
+``FsMax``, and ``kn``/``ks`` for a law that changes stiffness (the area law).
 
-* ``strength`` (paper): J^T and J^C fall at beta1*exp(beta2*stress); stiffness stays.
-* ``area`` (Potyondy 2007 idea): the bond's effective area fraction a falls, so
-  stiffness k = a k0 and capacity J a A0 fall together and the stress on what
-  remains rises (see :mod:`grainfrac_yade.corrosion`).
+A bond the law says has failed is handed to YADE's JCFpm law with its strength a hair
+(``BREAK_MARGIN``) below its current load, so the law breaks it on the next step, in its true mode,
+and records it (a strength of exactly 0 would never break in tension: shared/yade_notes.md).
 
-A bond the law says has failed is handed to YADE's JCFpm law with its strength a
-hair (``BREAK_MARGIN``) below its current load, so the law breaks it on the next
-step, in its true mode, and records it (a strength of exactly 0 would never break
-in tension: shared/yade_notes.md).
+Broken bonds of a law that changes stiffness get their contact stiffness back
+(:class:`ContactStiffnessRestorer`): a broken bond stays a frictional contact that carries
+compression (``neverErase``), and a corroded bond's stiffness (down to 1e-9 of k_n0) would let the
+grains pass through each other.  The stiffness returns to k_n0, k_s0 with the contact's reference gap
+moved so that the normal force is continuous; further closing is resisted with k_n0.
 
-NaN or infinite bond forces (a DEM that blew up) are refused where they are read
-(:meth:`StressCorrosion.stresses`), and nothing non-finite is ever written to YADE:
-both raise :class:`~grainfrac_yade.errors.NumericalFailure`.
+NaN or infinite bond forces (a DEM that blew up) are refused where they are read, and nothing
+non-finite is ever written to YADE: both raise :class:`~grainfrac_yade.errors.NumericalFailure`.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .. import corrosion
+from ..law import MODE_CORRODED, MODE_TENSION, Stresses, build_law, check_finite, degrade_step
 from .scene import SHEAR
 
 #: Relative margin below the current load given to a bond that has reached its strength,
@@ -31,70 +31,74 @@ BREAK_MARGIN = 1e-6
 #: Smallest strength written to YADE, relative to the bond's initial strength: JCFpm never
 #: breaks a bond with FnMax = 0 in tension.
 MIN_STRENGTH_FRACTION = 1e-9
+#: Names of the law's state arrays in checkpoints (state_dict), with the value of an intact bond.
+STATE_KEYS = {"tensile_strength": "tensile_strength_pa", "cohesion": "cohesion_pa", "area_fraction": "area_fraction"}
 
 
 class StressCorrosion:
-    """Bond degradation state of a scene plus the operations both creep clocks need."""
+    """A degradation law's state on a scene's bonds, and the reads and writes the creep clocks need."""
 
     name = "StressCorrosion"
 
     def __init__(self, scene, sc_params):
         self.scene, self.p = scene, sc_params
+        self.law = build_law(sc_params)
         props = scene.props
         self.area0 = scene.layout.bond_area.copy()
         self.tensile0 = props.tensile_strength.copy()
         self.cohesion0 = props.cohesion.copy()
-        self.tensile = self.tensile0.copy()          # J^T [Pa] (strength mode)
-        self.cohesion = self.cohesion0.copy()        # J^C [Pa] (strength mode)
-        self.area_fraction = np.ones(scene.n_bonds)  # a [1] (area mode)
         self.kn0 = props.normal_stiffness.copy()
         self.ks0 = props.shear_stiffness.copy()
         self.tan_phi = np.tan(props.friction_angle)
+        self.state = self.law.initial_state(self.tensile0, self.cohesion0, self.tan_phi)
         self.creep_time = 0.0
+        #: broken bonds whose contact stiffness was given back (laws that change stiffness)
+        self.restored = np.zeros(scene.n_bonds, bool)
 
     # ------------------------------------------------------------------ reading
-    def stresses(self, idx):
-        """sigma (tension positive) and tau [Pa] of bonds ``idx``; per intact area A0 in area mode.
+    def stresses(self, idx) -> Stresses:
+        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``.
 
         NumericalFailure if a force is NaN or infinite."""
+        idx = np.asarray(idx, dtype=np.int64)
         fn, fs = self.scene.bond_forces(idx)
-        corrosion.check_finite("bond normal force", fn, idx)
-        corrosion.check_finite("bond shear force", fs, idx)
-        return fn / self.area0[idx], fs / self.area0[idx]
+        check_finite("bond normal force", fn, idx)
+        check_finite("bond shear force", fs, idx)
+        return Stresses(idx, fn / self.area0[idx], fs / self.area0[idx])
 
     def intact(self) -> np.ndarray:
         return np.flatnonzero(~self.scene.broken)
 
-    def law_arrays(self, idx):
-        """(J^T, J^C) in strength mode, (J^T0, J^C0) in area mode, for bonds ``idx``."""
-        if self.p.mode == "area":
-            return self.tensile0[idx], self.cohesion0[idx]
-        return self.tensile[idx], self.cohesion[idx]
+    def strengths(self, idx=None):
+        """What bonds ``idx`` can carry now, per intact area: (J^T, J^C) [Pa] (all bonds by default)."""
+        state = self.state if idx is None else self.state.subset(idx)
+        jt, jc, _ = self.law.strengths(state)
+        return jt, jc
 
     # ------------------------------------------------------------------ writing
     def write(self, idx):
-        """Push the numpy state of bonds ``idx`` into YADE (strengths; stiffness in area mode)."""
+        """Push the state of bonds ``idx`` into YADE: strengths, and stiffness for a law that changes it."""
+        idx = np.asarray(idx, dtype=np.int64)
         inter = self.scene.interactions
-        if self.p.mode == "area":
-            a = self.area_fraction[idx]
-            cap_t = np.maximum(self.tensile0[idx] * a, MIN_STRENGTH_FRACTION * self.tensile0[idx]) * self.area0[idx]
-            cap_c = np.maximum(self.cohesion0[idx] * a, MIN_STRENGTH_FRACTION * self.cohesion0[idx]) * self.area0[idx]
-            kn, ks = self.kn0[idx] * np.maximum(a, MIN_STRENGTH_FRACTION), self.ks0[idx] * np.maximum(a, MIN_STRENGTH_FRACTION)
-            _check_written(idx, cap_t, cap_c, kn)
+        jt, jc, stiffness = self.law.strengths(self.state.subset(idx))
+        ft = np.maximum(jt, MIN_STRENGTH_FRACTION * self.tensile0[idx]) * self.area0[idx]
+        fc = np.maximum(jc, MIN_STRENGTH_FRACTION * self.cohesion0[idx]) * self.area0[idx]
+        if stiffness is None:
+            _check_written(idx, ft, fc)
             for n, k in enumerate(idx):
                 ph = inter[k].phys
                 if ph.isCohesive:
-                    ratio = float(kn[n]) / ph.kn
-                    ph.kn, ph.ks = float(kn[n]), float(ks[n])
-                    ph.shearForce = ph.shearForce * ratio   # the law's shear force is incremental
-                    ph.FnMax, ph.FsMax = float(cap_t[n]), float(cap_c[n])
+                    ph.FnMax, ph.FsMax = float(ft[n]), float(fc[n])
             return
-        ft = np.maximum(self.tensile[idx], MIN_STRENGTH_FRACTION * self.tensile0[idx]) * self.area0[idx]
-        fc = np.maximum(self.cohesion[idx], MIN_STRENGTH_FRACTION * self.cohesion0[idx]) * self.area0[idx]
-        _check_written(idx, ft, fc)
+        kn = self.kn0[idx] * np.maximum(stiffness, MIN_STRENGTH_FRACTION)
+        ks = self.ks0[idx] * np.maximum(stiffness, MIN_STRENGTH_FRACTION)
+        _check_written(idx, ft, fc, kn)
         for n, k in enumerate(idx):
             ph = inter[k].phys
             if ph.isCohesive:
+                ratio = float(kn[n]) / ph.kn
+                ph.kn, ph.ks = float(kn[n]), float(ks[n])
+                ph.shearForce = ph.shearForce * ratio   # the law's shear force is incremental
                 ph.FnMax, ph.FsMax = float(ft[n]), float(fc[n])
 
     def hand_over_failures(self, idx, sigma, tau, modes):
@@ -103,11 +107,12 @@ class StressCorrosion:
         _check_written(idx, sigma, tau)   # Python's max(nan, 0) is nan: refuse before any max() below
         for k, s, t, m in zip(idx, sigma, tau, modes):
             ph = inter[k].phys
-            if m == corrosion.MODE_CORRODED:  # nothing left; friction alone carries it: break it ourselves
+            if m == MODE_CORRODED:  # nothing left; friction alone carries it: break it ourselves
                 self.scene.break_bonds([k], SHEAR)
-            elif m == corrosion.MODE_TENSION:
+                self.restore_contact_stiffness([k])
+            elif m == MODE_TENSION:
                 ph.FnMax = max(float(s * self.area0[k]) * (1 - BREAK_MARGIN), MIN_STRENGTH_FRACTION * ph.FnMax)
-            else:  # shear (or corroded away): Mohr-Coulomb limit just below the shear force
+            else:  # shear: Mohr-Coulomb limit just below the shear force
                 fn = -s * self.area0[k]  # compression positive
                 ph.FsMax = max(float(t * self.area0[k] - fn * ph.tanFrictionAngle) * (1 - BREAK_MARGIN)
                                - BREAK_MARGIN * abs(t * self.area0[k]), 0.0)
@@ -115,38 +120,75 @@ class StressCorrosion:
                     ph.FsMax = MIN_STRENGTH_FRACTION * self.cohesion0[k] * self.area0[k]
                     ph.FnMax = MIN_STRENGTH_FRACTION * self.tensile0[k] * self.area0[k]
 
+    def restore_contact_stiffness(self, idx):
+        """Broken bonds ``idx`` become contacts of stiffness k_n0, k_s0 with the normal force they carry now
+        (the reference gap moves by the extra closure a softened bond allowed); once per bond."""
+        inter, bodies = self.scene.interactions, self.scene.O.bodies
+        for k in np.atleast_1d(idx):
+            k = int(k)
+            if self.restored[k]:
+                continue
+            i = inter[k]
+            ph = i.phys
+            fn = float(ph.normalForce.dot(ph.jointNormal if ph.isOnJoint else i.geom.normal))  # compression +
+            if fn > 0:   # in compression: the same force with the full stiffness
+                if ph.isOnJoint:
+                    gap = abs((bodies[i.id2].state.pos - bodies[i.id1].state.pos).dot(ph.jointNormal))
+                    ph.initD = gap + fn / float(self.kn0[k])        # D = initD - gap
+                else:
+                    ph.initD = i.geom.penetrationDepth - fn / float(self.kn0[k])   # D = pen - initD
+            ph.kn, ph.ks = float(self.kn0[k]), float(self.ks0[k])
+            self.restored[k] = True
+
     # ------------------------------------------------------------------ law steps
-    def degrade_for(self, dt, idx, sigma, tau):
-        """Apply Eq. 7 (or the area law) for creep time ``dt`` under frozen stresses; write to YADE."""
-        if self.p.mode == "area":
-            self.area_fraction[idx] = corrosion.degrade_area(self.area_fraction[idx], sigma, tau,
-                                                             self.tensile0[idx], self.cohesion0[idx], dt,
-                                                             self.p.beta1, self.p.beta2)
-        else:
-            self.tensile[idx], self.cohesion[idx] = corrosion.degrade(self.tensile[idx], self.cohesion[idx],
-                                                                      sigma, tau, dt, self.p.beta1, self.p.beta2)
+    def degrade(self, dt, stresses: Stresses):
+        """Apply the law for creep time ``dt`` under frozen ``stresses`` (the paper clock's step); write to YADE."""
+        self.state = degrade_step(self.law, self.state, stresses, dt)
         self.creep_time += dt
-        self.write(idx)
+        self.write(stresses.index)
 
     def state_dict(self) -> dict:
-        """Whole engine state (for checkpoints): arrays as lists, creep time."""
-        return {"creep_time": self.creep_time, "tensile_strength_pa": self.tensile.tolist(),
-                "cohesion_pa": self.cohesion.tolist(), "area_fraction": self.area_fraction.tolist(),
-                "mode": self.p.mode}
+        """Whole engine state (for checkpoints): the law's arrays as lists, creep time."""
+        out = {"creep_time": self.creep_time, "law": self.law.name, "restored": np.flatnonzero(self.restored).tolist()}
+        intact = {"tensile_strength": self.tensile0, "cohesion": self.cohesion0, "area_fraction": np.ones(len(self.restored))}
+        for name, key in STATE_KEYS.items():
+            values = self.state.arrays.get(name, intact[name])
+            out[key] = values.tolist()
+        return out
 
     def load_state(self, state: dict, write: bool = True):
         """Restore :meth:`state_dict` output; ``write``: push the strengths into YADE's bonds (False when
         the bonds come back with the scene, as after ``O.load`` of a checkpoint: a bond handed over
         at its failure point holds a strength the arrays do not, and must keep it)."""
         self.creep_time = float(state["creep_time"])
-        self.tensile = np.array(state["tensile_strength_pa"], float)
-        self.cohesion = np.array(state["cohesion_pa"], float)
-        self.area_fraction = np.array(state["area_fraction"], float)
+        arrays = {name: np.array(state[STATE_KEYS[name]], float) for name in self.law.state_names}
+        self.state = self.law.initial_state(self.tensile0, self.cohesion0, self.tan_phi).replaced(
+            np.arange(len(self.tensile0)), arrays)
+        self.restored = np.zeros(len(self.tensile0), bool)
+        self.restored[np.asarray(state.get("restored", []), dtype=np.int64)] = True
         if write:
             self.write(self.intact())
+
+
+class ContactStiffnessRestorer:
+    """Scene driver (before every DEM step): broken bonds of a law that changes stiffness get their
+    contact stiffness back as soon as the contact law has broken them (a cheap check of the crack count)."""
+
+    name = "ContactStiffnessRestorer"
+
+    def __init__(self, corr: StressCorrosion):
+        self.corr = corr
+        self._seen = -1
+
+    def before_step(self, scene):
+        if scene._cracks_seen != self._seen:
+            new = np.flatnonzero(scene.broken & ~self.corr.restored)
+            if new.size:
+                self.corr.restore_contact_stiffness(new)
+            self._seen = scene._cracks_seen
 
 
 def _check_written(idx, *values):
     """NumericalFailure unless every value meant for YADE's bonds ``idx`` is finite."""
     for v in values:
-        corrosion.check_finite("value written to a YADE bond", v, idx)
+        check_finite("value written to a YADE bond", v, idx)

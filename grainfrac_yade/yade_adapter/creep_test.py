@@ -1,12 +1,14 @@
-"""Constant-load creep test to failure with stress corrosion (issue 5).
+"""Constant-load creep test to failure with stress corrosion (paper section 4.1).
 
 1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
    stress reaches the target; bonds broken during the ramp are counted apart.
 2. Hold: a servo keeps the axial stress at the target (:class:`StressServo`).
-3. Creep: the stress-corrosion driver degrades bonds as creep time passes, with
-   the ``event`` clock (exact jump to the next failure at equilibrium, ours) or
-   the ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is
-   below the threshold, applied every ``engine_period`` DEM steps).
+3. Creep: the degradation law (:mod:`grainfrac_yade.law`) acts as creep time
+   passes, with the ``event`` clock (at equilibrium, one pure
+   :func:`~grainfrac_yade.law.creep_step` to the next failure, ours) or the
+   ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is below
+   the threshold, applied every ``engine_period`` DEM steps).  This module reads
+   forces and writes strengths (:mod:`.corrosion_engine`); the law is not here.
 
 Failure: the platens cannot hold the load at equilibrium -- no equilibrium at the
 held stress within ``creep.max_relaxation_steps`` DEM steps (the strain runs
@@ -30,11 +32,11 @@ import time
 
 import numpy as np
 
-from .. import corrosion
-from ..clocks import EVENT_REL_TOL, EventClock, PaperClock
+from ..clocks import EventClock, PaperClock
 from ..errors import NumericalFailure
+from ..law import check_finite, creep_step, shear_strength
 from ..params import unbalanced_threshold
-from .corrosion_engine import StressCorrosion
+from .corrosion_engine import ContactStiffnessRestorer, StressCorrosion
 from .platens import Platens, StressServo
 from .scene import broken_counts, build_scene, check_value
 
@@ -105,7 +107,7 @@ class CreepRun:
         spheres of deformable cells)."""
         f = self.scene.O.forces.f
         res = np.array([f(b).norm() for b in self._free_ids])
-        corrosion.check_finite("resultant force", res, self._free_ids, item="body")
+        check_finite("resultant force", res, self._free_ids, item="body")
         rel = res.mean() / mean_bond_force if mean_bond_force > 0 else math.inf
         return res.max(), rel
 
@@ -113,7 +115,7 @@ class CreepRun:
         idx = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
         sample = idx[:: max(1, len(idx) // 500)]
         fn, fs = self.scene.bond_forces(sample)
-        corrosion.check_finite("bond force", np.hypot(fn, fs), sample)
+        check_finite("bond force", np.hypot(fn, fs), sample)
         return float(np.mean(np.hypot(fn, fs))) if len(sample) else 0.0
 
     def at_equilibrium(self, servo):
@@ -207,9 +209,10 @@ class CreepRun:
         """Normal (tension positive) and shear stress of every intact bond, with its utilisation."""
         corr = self.corr
         idx = corr.intact()
-        sigma, tau = corr.stresses(idx)
-        jt, jc = corr.law_arrays(idx)
-        limit = corrosion.shear_strength(jc, sigma, corr.tan_phi[idx])
+        st = corr.stresses(idx)
+        sigma, tau = st.normal, st.shear
+        jt, jc = corr.strengths(idx)
+        limit = shear_strength(jc, sigma, corr.tan_phi[idx])
         return {"bond": idx, "normal_stress_pa": sigma, "shear_stress_pa": tau,
                 "tensile_utilisation": sigma / jt, "shear_utilisation": np.where(limit > 0, tau / limit, np.inf),
                 "inter": self.scene.bond_is_inter[idx]}
@@ -219,7 +222,7 @@ class CreepRun:
         if resume is None:
             self.clock = EventClock(self.params.stress_corrosion.max_strength_loss_fraction,
                                     self.params.stress_corrosion.creep_time_limit)
-        self.n_events = event_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, resume)
+        self.n_events = event_clock_loop(self, self.corr, self.clock, resume)
 
     def run_paper_clock(self, resume=None):
         """Paper clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it)."""
@@ -290,6 +293,7 @@ class CreepRun:
                 return self
             self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
             self.scene.extras.append(self.corr)
+            add_stiffness_restorer(self.scene, self.corr)
             if self.relax(0.0):
                 self.initial_bond_stresses = self.bond_stress_table()
             loop = None
@@ -307,8 +311,15 @@ def _no_checkpoint(phase, loop):
     """Stand-in for :meth:`CreepRun.safe_point` for holders without checkpoints."""
 
 
-def event_clock_loop(holder, corr, clock, sc, resume=None) -> int:
-    """Event clock (ours): at equilibrium, jump to the next bond failure under frozen stresses; repeat.
+def add_stiffness_restorer(scene, corr):
+    """For a law that changes stiffness: broken bonds get their contact stiffness back before the next step."""
+    if not corr.law.exact_jump:
+        scene.drivers.append(ContactStiffnessRestorer(corr))
+
+
+def event_clock_loop(holder, corr, clock, resume=None) -> int:
+    """Event clock (ours): at equilibrium, one :func:`~grainfrac_yade.law.creep_step` under the frozen
+    stresses (to the next bond failure, or the law's loss cap); write, hand over, relax; repeat.
 
     ``holder`` relaxes the scene (``relax(creep_time) -> bool``), records rows (``record_now``) and
     reports progress. Returns the number of events (intervals that ended in a failure).  Each pass
@@ -327,49 +338,26 @@ def event_clock_loop(holder, corr, clock, sc, resume=None) -> int:
         safe_point("event", {"n_events": n_events, "stalled": stalled})
         broken_before = int(corr.scene.broken.sum())
         idx = corr.intact()
-        sigma, tau = corr.stresses(idx)
-        jt, jc = corr.law_arrays(idx)
-        area = corr.area_fraction[idx] if sc.mode == "area" else None
-        if sc.mode == "strength":
-            # Eq. 7 lowers strength, not stiffness: stresses stay frozen until a bond fails, so the
-            # jump to the next failure is exact and needs no loss cap (a cap on bonds whose strength
-            # heads to 0 without failing would cut the interval geometrically, never reaching it).
-            t_fail, _ = corrosion.time_to_failure(jt, jc, sigma, tau, corr.tan_phi[idx], sc.beta1, sc.beta2)
-            t_first = float(t_fail.min()) if len(t_fail) else math.inf
-            dt = min(t_first, max(clock.time_limit - clock.creep_time, 0.0))
-            failing = np.flatnonzero(t_fail <= dt * (1 + EVENT_REL_TOL)) if math.isfinite(dt) else []
-        else:
-            dt, failing = clock.next_interval(jt, jc, sigma, tau, corr.tan_phi[idx], sc.beta1, sc.beta2,
-                                              mode=sc.mode, area_fraction=area)
-        if math.isfinite(dt) and dt >= 0:
-            new = clock.apply(dt, failing, jt, jc, sigma, tau, corr.tan_phi[idx], sc.beta1, sc.beta2,
-                              mode=sc.mode, area_fraction=area)
-        if not math.isfinite(dt) or (dt <= 0 and not len(failing)):
+        stresses = corr.stresses(idx)
+        step = creep_step(corr.law, clock, corr.state, stresses)
+        if step.stalled:
             break
-        if sc.mode == "area":
-            corr.area_fraction[idx] = new
-        else:
-            corr.tensile[idx], corr.cohesion[idx] = new
+        corr.state = step.state
         corr.write(idx)
-        if len(failing):
-            if sc.mode == "area":
-                _, modes = corrosion.area_failure_point(sigma[failing], tau[failing], jt[failing], jc[failing],
-                                                        corr.tan_phi[idx][failing])
-            else:
-                _, modes = corrosion.time_to_failure(jt[failing], jc[failing], sigma[failing], tau[failing],
-                                                     corr.tan_phi[idx][failing], sc.beta1, sc.beta2)
-            corr.hand_over_failures(idx[failing], sigma[failing], tau[failing], modes)
+        if len(step.failing):
+            corr.hand_over_failures(step.failing, stresses.normal[step.positions], stresses.shear[step.positions],
+                                    step.modes)
             n_events += 1
-        clock.advance(dt, failing)
+        clock.advance(step.dt, step.failing)
         corr.creep_time = clock.creep_time
         ok = holder.relax(clock.creep_time)
         holder.record_now(clock.creep_time)
-        if n_events % PROGRESS_EVERY == 0 and len(failing):
+        if n_events % PROGRESS_EVERY == 0 and len(step.failing):
             holder.progress(f"t {clock.creep_time:.4g} s  events {n_events}  broken "
                             f"{int(corr.scene.broken.sum())}  relaxation {holder.last_relaxation_steps} steps")
         if not ok or clock.finished:
             break
-        stalled = stalled + 1 if dt == 0 and int(corr.scene.broken.sum()) == broken_before else 0
+        stalled = stalled + 1 if step.dt == 0 and int(corr.scene.broken.sum()) == broken_before else 0
         if stalled >= MAX_STALLED_INTERVALS:
             raise NumericalFailure(f"{stalled} creep intervals of length 0 in a row broke no bond (creep time "
                                    f"{clock.creep_time:.6g} s): a bond at its failure point that the contact law "
@@ -380,7 +368,7 @@ def event_clock_loop(holder, corr, clock, sc, resume=None) -> int:
 
 def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     """Paper clock (Eq. 8): every ``engine_period`` DEM steps advance creep time by the doubled or
-    reset step and degrade all intact bonds for it (paper Eq. 7).
+    reset step and degrade all intact bonds for it (the law's degrade, paper Eq. 7 by default).
 
     Each pass starts at a safe point (``holder.safe_point("paper", counters)``, a checkpoint if
     due); ``resume``: the counters of such a point, to go on from it (scene and clock restored).
@@ -414,12 +402,12 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
             break
         if clock.creep_time >= sc.creep_time_limit:
             break
-        sigma, tau = corr.stresses(idx)
-        mean_force = float(np.mean(np.hypot(sigma, tau) * corr.area0[idx]))
+        stresses = corr.stresses(idx)
+        mean_force = float(np.mean(np.hypot(stresses.normal, stresses.shear) * corr.area0[idx]))
         f_max, rel = holder.unbalanced(mean_force)
         f_u = f_max / scale if sc.unbalanced_force_reference == "absolute" else rel
         dt_b = clock.advance_many([f_u] * sc.engine_period)
-        corr.degrade_for(dt_b, idx, sigma, tau)
+        corr.degrade(dt_b, stresses)
         applications += 1
         not_balanced_steps = 0 if clock.balanced(f_u) else not_balanced_steps + sc.engine_period
         if applications % cp.record_period == 0:

@@ -56,7 +56,8 @@ class BondUnderForce:
         self.relax(0.0)
         #: the bond's own stresses at equilibrium [Pa] (the face normal of the geometry has turned a
         #: little with the displacement, so they differ slightly from the applied ones)
-        (self.sigma0,), (self.tau0,) = self.corr.stresses([0])
+        st = self.corr.stresses([0])
+        self.sigma0, self.tau0 = float(st.normal[0]), float(st.shear[0])
         self.failed, self.failure_reason = False, ""
         self.scene.extras.append(self.corr)
 

@@ -67,10 +67,7 @@ def write_snapshot(scene, corr, folder, index: int, creep_time: float) -> list:
     cells = write_polygons(folder / f"cells_{index:04d}.vtk", polygons,
                            {"mineral": spec.mineral, "clump": spec.clump_label}, title=title)
     segments = bond_segments(scene, np.arange(scene.n_bonds)) + bond_shift(scene, pos)[:, None, :]
-    if corr.p.mode == "area":
-        tensile, cohesion = corr.tensile0 * corr.area_fraction, corr.cohesion0 * corr.area_fraction
-    else:
-        tensile, cohesion = corr.tensile.copy(), corr.cohesion.copy()
+    tensile, cohesion = (np.array(x, float) for x in corr.strengths())
     tensile[scene.broken] = 0.0
     cohesion[scene.broken] = 0.0
     fn, fs = scene.bond_forces()
