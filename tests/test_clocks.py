@@ -1,12 +1,16 @@
-"""Creep clocks: paper Eq. 8 step rule, event clock, checkpoint round trips, validation."""
+"""Creep clocks: paper Eq. 8 step rule, the event clock with creep_step (pure), checkpoint round trips,
+validation."""
 import json
 import math
 
 import numpy as np
 import pytest
 
-from grainfrac_yade import corrosion as c
 from grainfrac_yade.clocks import EventClock, PaperClock
+from grainfrac_yade.law import MODE_SHEAR, MODE_TENSION, Stresses, area, creep_step, failed_now, hillig_charles
+from grainfrac_yade.law._common import RATE_CAP
+from grainfrac_yade.law.area import AreaLaw
+from grainfrac_yade.law.hillig_charles import HilligCharles
 
 B1, B2 = 1e-3, 1e-7  # paper section 4.1: beta1 [Pa/s], beta2 [1/Pa]
 TAN55 = math.tan(math.radians(55.0))  # K-feldspar/K-feldspar friction angle, Table 2
@@ -71,14 +75,14 @@ def test_stepping_degrade_with_paper_clock_fails_at_the_closed_form_time(dt_max)
     """Frozen stresses: failure is detected at the end of the step containing the closed-form
     time, so the overshoot is in [0, last dt_b] and dt_b <= dt_max."""
     jt, jc, sigma, tau = 23e6, 52e6, -100e6, 150e6  # compressed bond sheared near its limit
-    t_exact, mode = c.time_to_failure(jt, jc, sigma, tau, TAN55, B1, B2)
-    assert mode == c.MODE_SHEAR
+    t_exact, mode = hillig_charles.time_to_failure(jt, jc, sigma, tau, TAN55, B1, B2)
+    assert mode == MODE_SHEAR
     clock = PaperClock(dt_min=1e-5, dt_max=dt_max)
     rng = np.random.default_rng(3)
     while True:
         dt = clock.next_step(rng.choice([0.0, 2 * F_U], p=[0.9, 0.1]))
-        jt, jc = c.degrade(jt, jc, sigma, tau, dt, B1, B2)
-        if any(c.failed_now(jt, jc, sigma, tau, TAN55)):
+        jt, jc = hillig_charles.degrade(jt, jc, sigma, tau, dt, B1, B2)
+        if any(failed_now(jt, jc, sigma, tau, TAN55)):
             break
         assert clock.creep_time < t_exact * (1 + 1e-12)
     overshoot = clock.creep_time - t_exact
@@ -143,93 +147,115 @@ def test_state_of_another_kind_or_version_is_refused():
         EventClock.from_state({**EventClock().state_dict(), "version": -1})
 
 
-# ------------------------------------------------------------------ EventClock
-def _run_to_first_failure(clock, jt, jc, sigma, tau, tphi, beta2=B2, **kw):
+# ------------------------------------------------------------------ EventClock with creep_step
+def _bonds(law, jt, jc, sigma, tau, tphi, area_fraction=None):
+    """(state, stresses) of bonds given as lists (tan(phi) may be a scalar)."""
+    jt, jc, sigma, tau = (np.atleast_1d(np.asarray(x, float)) for x in (jt, jc, sigma, tau))
+    tphi = np.broadcast_to(np.asarray(tphi, float), jt.shape).copy()
+    state = law.initial_state(jt, jc, tphi)
+    if area_fraction is not None:
+        state = state.replaced(np.arange(len(jt)), {"area_fraction": np.asarray(area_fraction, float)})
+    return state, Stresses.of(np.arange(len(jt)), sigma, tau)
+
+
+def _run_to_first_failure(clock, law, state, stresses):
     while True:
-        dt, failing = clock.next_interval(jt, jc, sigma, tau, tphi, B1, beta2, **kw)
-        state = clock.apply(dt, failing, jt, jc, sigma, tau, tphi, B1, beta2, **kw)
-        clock.advance(dt, failing)
-        if kw.get("mode") == "area":
-            kw["area_fraction"] = state
-        else:
-            jt, jc = state
-        if len(failing):
-            return failing, state
+        step = creep_step(law, clock, state, stresses)
+        clock.advance(step.dt, step.failing)
+        state = step.state
+        if len(step.failing):
+            return step, state
 
 
-def test_event_clock_single_bond_interval_count_and_failure_time():
-    """Under frozen sigma the loss rate R is constant, so a capped interval removes exactly
-    f J_n: J_n = (1-f)^n J0. Interval n is capped while f J_n < J_n - s, i.e. (1-f)^(n+1) J0 > s;
-    the failure interval is the first with (1-f)^(n+1) J0 <= s. Intervals = ceil(ln(s/J0)/ln(1-f)).
-    J^C is chosen so that its own cap f J^C / beta1 exceeds the whole lifetime."""
-    f, j0, s = 0.1, 20e6, 5e6
-    t_exact = (j0 - s) / (B1 * math.exp(B2 * s))
-    jc = 10 * t_exact * B1 / f
-    clock = EventClock(max_strength_loss_fraction=f)
-    failing, (jt, _) = _run_to_first_failure(clock, [j0], [jc], [s], [0.0], [0.0])
-    assert list(failing) == [0]
-    assert clock.n_intervals == math.ceil(math.log(s / j0) / math.log(1 - f))
-    assert clock.n_events == 1 and clock.n_failures == 1
-    assert clock.creep_time == pytest.approx(t_exact, rel=1e-12)
-    assert jt[0] == s and c.failed_now(jt, jc, s, 0.0, 0.0)[0][0]
+def test_strength_law_jumps_in_one_interval_exactly_to_the_closed_form_failure():
+    """Eq. 7 does not change stiffness: under frozen sigma the event clock needs no loss cap and lands on
+    the closed-form time t = (J0 - s) / (beta1 exp(beta2 s)) in one interval, with J^T = s exactly."""
+    j0, s = 20e6, 5e6
+    law = HilligCharles(B1, B2)
+    state, stresses = _bonds(law, [j0], [1e12], [s], [0.0], 0.0)
+    clock = EventClock(max_strength_loss_fraction=0.1)
+    step, state = _run_to_first_failure(clock, law, state, stresses)
+    assert list(step.failing) == [0] and list(step.modes) == [MODE_TENSION]
+    assert clock.n_intervals == 1 and clock.n_events == 1 and clock.n_failures == 1
+    assert clock.creep_time == pytest.approx((j0 - s) / (B1 * math.exp(B2 * s)), rel=1e-12)
+    assert state["tensile_strength"][0] == s and failed_now(state["tensile_strength"], state["cohesion"], s, 0.0, 0.0)[0][0]
 
 
 def test_event_clock_shear_failure_lands_exactly_on_the_criterion():
-    jt, jc, sigma, tau = [23e6], [52e6], [-100e6], [150e6]
-    t_exact, _ = c.time_to_failure(jt, jc, sigma, tau, TAN55, B1, B2)
+    law = HilligCharles(B1, B2)
+    state, stresses = _bonds(law, [23e6], [52e6], [-100e6], [150e6], TAN55)
+    t_exact, _ = hillig_charles.time_to_failure(23e6, 52e6, -100e6, 150e6, TAN55, B1, B2)
     clock = EventClock()
-    failing, (new_t, new_c) = _run_to_first_failure(clock, jt, jc, sigma, tau, [TAN55])
-    assert clock.creep_time == pytest.approx(t_exact[0], rel=1e-12)
-    assert c.failed_now(new_t, new_c, sigma, tau, TAN55)[1][0]
-    assert new_c[0] == pytest.approx(tau[0] - (-sigma[0]) * TAN55, rel=1e-12)
+    step, state = _run_to_first_failure(clock, law, state, stresses)
+    assert clock.creep_time == pytest.approx(float(t_exact), rel=1e-12) and list(step.modes) == [MODE_SHEAR]
+    assert failed_now(state["tensile_strength"], state["cohesion"], -100e6, 150e6, TAN55)[1][0]
+    assert state["cohesion"][0] == pytest.approx(150e6 - 100e6 * TAN55, rel=1e-12)
 
 
-def test_event_clock_picks_the_earliest_bonds():
+def test_event_clock_picks_the_earliest_bonds_among_those_given():
     sigma = np.array([12e6, 18e6, 15e6, 18e6, -5e6])  # bonds 1 and 3 identical and earliest
-    jt, jc, tau = np.full(5, 20e6), np.full(5, 1e12), np.zeros(5)
-    clock = EventClock(max_strength_loss_fraction=0.99)
-    dt, failing = clock.next_interval(jt, jc, sigma, tau, 0.0, B1, B2)
-    t, _ = c.time_to_failure(jt, jc, sigma, tau, 0.0, B1, B2)
-    assert dt == np.min(t) and list(failing) == [1, 3]
-    dt, failing = clock.next_interval(jt, jc, sigma, tau, 0.0, B1, B2,
-                                      intact=[True, False, True, False, True])
-    assert dt == t[2] and list(failing) == [2]
+    law = HilligCharles(B1, B2)
+    state, stresses = _bonds(law, np.full(5, 20e6), np.full(5, 1e12), sigma, np.zeros(5), 0.0)
+    t, _ = hillig_charles.time_to_failure(np.full(5, 20e6), 1e12, sigma, 0.0, 0.0, B1, B2)
+    step = creep_step(law, EventClock(), state, stresses)
+    assert step.dt == np.min(t) and list(step.failing) == [1, 3]
+    intact = stresses.take([0, 2, 4])            # only the intact bonds are given
+    step = creep_step(law, EventClock(), state, intact)
+    assert step.dt == t[2] and list(step.failing) == [2] and list(step.positions) == [1]
+    assert step.state["tensile_strength"][1] == 20e6 and step.state["tensile_strength"][3] == 20e6   # not given: kept
 
 
-def test_event_clock_cap_gives_empty_failing_index():
-    clock = EventClock(max_strength_loss_fraction=0.1)
-    dt, failing = clock.next_interval(20e6, 1e12, 5e6, 0.0, 0.0, B1, B2)
-    assert dt == pytest.approx(0.1 * 20e6 / (B1 * math.exp(B2 * 5e6)), rel=1e-14)
-    assert failing.size == 0
+def test_area_law_cap_gives_an_interval_without_failures():
+    """The area law changes stiffness: the clock stops when a bond has lost the set fraction of its intact area."""
+    law = AreaLaw(B1, B2)
+    state, stresses = _bonds(law, [23e6], [52e6], [-50e6], [100e6], TAN55)
+    step = creep_step(law, EventClock(max_strength_loss_fraction=0.1), state, stresses)
+    assert step.failing.size == 0
+    assert step.dt == pytest.approx(float(area.area_time(1.0, 0.9, -50e6, 100e6, 23e6, 52e6, B1, B2)), rel=1e-12)
+    assert step.state["area_fraction"][0] == pytest.approx(0.9, rel=1e-12)
 
 
 def test_event_clock_nothing_can_fail():
-    clock = EventClock()
-    dt, failing = clock.next_interval(20e6, 50e6, -30e6, 10e6, TAN55, B1, B2)
-    assert dt == math.inf and failing.size == 0
-    dt, failing = clock.next_interval(20e6, 50e6, 5e6, 0.0, TAN55, B1, B2, intact=[False])
-    assert dt == math.inf and failing.size == 0
+    law = HilligCharles(B1, B2)
+    state, stresses = _bonds(law, [20e6], [50e6], [-30e6], [10e6], TAN55)
+    step = creep_step(law, EventClock(), state, stresses)
+    assert step.dt == math.inf and step.failing.size == 0 and step.stalled and step.state is state
+    step = creep_step(law, EventClock(), state, stresses.take([]))    # no intact bond
+    assert step.dt == math.inf and step.failing.size == 0
     limited = EventClock(time_limit=1e4)
     limited.advance(3e3)
-    dt, failing = limited.next_interval(20e6, 50e6, -30e6, 10e6, TAN55, B1, B2)
-    assert dt == 1e4 - 3e3 and failing.size == 0
-    limited.advance(dt)
+    step = creep_step(law, limited, state, stresses)
+    assert step.dt == 1e4 - 3e3 and step.failing.size == 0 and not step.stalled
+    limited.advance(step.dt)
     assert limited.finished
 
 
-def test_event_clock_area_mode_reaches_failure_in_the_expected_intervals():
-    """Same argument as the strength mode with a in place of J: each capped interval removes
-    f a_n, so intervals = ceil(ln(a_fail/a0)/ln(1-f)) (a_fail/a0 is not a power of 1-f)."""
+def test_area_law_reaches_failure_in_the_expected_intervals():
+    """Each capped interval removes f of the INTACT area (no geometric shrinking towards a = 0), so
+    intervals = ceil((a0 - a_fail) / f); the creep time is the whole time to failure."""
     f, a0, p, q, jt0, jc0 = 0.1, 1.0, -50e6, 100e6, 23e6, 52e6
-    a_fail, mode = c.area_failure_point(p, q, jt0, jc0, TAN55)
-    t_exact, _ = c.time_to_failure_area(a0, p, q, jt0, jc0, TAN55, B1, B2)
+    a_fail, mode = area.area_failure_point(p, q, jt0, jc0, TAN55)
+    t_exact, _ = area.time_to_failure_area(a0, p, q, jt0, jc0, TAN55, B1, B2)
+    law = AreaLaw(B1, B2)
+    state, stresses = _bonds(law, [jt0], [jc0], [p], [q], TAN55)
     clock = EventClock(max_strength_loss_fraction=f)
-    failing, a = _run_to_first_failure(clock, [jt0], [jc0], [p], [q], [TAN55], mode="area",
-                                       area_fraction=[a0])
-    assert list(failing) == [0] and a[0] == a_fail
-    assert clock.n_intervals == math.ceil(math.log(a_fail / a0) / math.log(1 - f))
-    assert clock.creep_time == pytest.approx(t_exact, rel=1e-9)
-    assert any(x[0] for x in c.failed_now_area(a, p, q, jt0, jc0, TAN55))
+    step, state = _run_to_first_failure(clock, law, state, stresses)
+    assert list(step.failing) == [0] and state["area_fraction"][0] == a_fail and list(step.modes) == [mode]
+    assert clock.n_intervals == math.ceil((a0 - a_fail) / f)
+    assert clock.creep_time == pytest.approx(float(t_exact), rel=1e-9)
+    assert any(x[0] for x in area.failed_now_area(state["area_fraction"], p, q, jt0, jc0, TAN55))
+
+
+def test_a_bond_corroding_away_takes_at_most_one_interval_per_capped_loss():
+    """Friction carries the shear: no criterion is met, the bond corrodes to a = 0 (MODE_CORRODED).  With the
+    cap on the current area this took endless geometrically shorter intervals; now 1/f of them."""
+    law = AreaLaw(B1, B2)
+    state, stresses = _bonds(law, [23e6], [52e6], [-50e6], [10e6], TAN55)
+    clock = EventClock(max_strength_loss_fraction=0.1)
+    step, state = _run_to_first_failure(clock, law, state, stresses)
+    assert list(step.modes) == [area.MODE_CORRODED] and clock.n_intervals == 10
+    t_away, _ = area.time_to_failure_area(1.0, -50e6, 10e6, 23e6, 52e6, TAN55, B1, B2)
+    assert clock.creep_time == pytest.approx(float(t_away), rel=1e-9)
 
 
 def test_event_clock_state_round_trip_and_validation():
@@ -242,44 +268,35 @@ def test_event_clock_state_round_trip_and_validation():
     assert restored.advance(1.0) == clock.advance(1.0)
     inf_limit = EventClock.from_state(json.loads(json.dumps(EventClock().state_dict())))
     assert inf_limit.time_limit == math.inf
-    with pytest.raises(ValueError, match="mode"):
-        clock.next_interval(1.0, 1.0, 0.0, 0.0, 0.0, B1, B2, mode="bogus")
-    with pytest.raises(ValueError, match="area_fraction"):
-        clock.next_interval(1.0, 1.0, 0.0, 0.0, 0.0, B1, B2, mode="area")
     with pytest.raises(ValueError, match="dt"):
         clock.advance(math.inf)
 
 
 @pytest.mark.parametrize("bad", [math.nan, math.inf])
-def test_event_clock_refuses_non_finite_stresses(bad):
+@pytest.mark.parametrize("law", [HilligCharles(B1, B2), AreaLaw(B1, B2)], ids=["hillig_charles", "area"])
+def test_creep_step_refuses_non_finite_stresses(bad, law):
     """A NaN stress used to give a finite time to failure (the quotient helper replaced the NaN gap by 1)."""
     from grainfrac_yade.errors import NumericalFailure
+    state, stresses = _bonds(law, [20e6, 20e6], [52e6, 52e6], [1e6, bad], [0.0, 0.0], TAN55)
     clock = EventClock(0.1)
-    for mode, extra in (("strength", {}), ("area", {"area_fraction": [1.0, 1.0]})):
-        with pytest.raises(NumericalFailure, match="NaN or infinite at 1 of 2 bond"):
-            clock.next_interval([20e6, 20e6], [52e6, 52e6], [1e6, bad], [0.0, 0.0], TAN55, B1, B2, mode=mode,
-                                **extra)
-        with pytest.raises(NumericalFailure, match="NaN or infinite at 1 of 2 bond"):
-            clock.apply(1.0, [1], [20e6, 20e6], [52e6, 52e6], [1e6, bad], [0.0, 0.0], TAN55, B1, B2, mode=mode,
-                        **extra)
+    with pytest.raises(NumericalFailure, match="NaN or infinite at 1 of 2 bond"):
+        creep_step(law, clock, state, stresses)
+    with pytest.raises(NumericalFailure, match="NaN or infinite at 1 of 2 bond"):
+        law.degrade(state, stresses, 1.0)
     assert clock.creep_time == 0.0 and clock.n_intervals == 0
 
 
-@pytest.mark.parametrize("mode", ["strength", "area"])
-def test_event_clock_at_beta2_times_stress_of_1e4_has_no_overflow(mode):
-    """beta2 sigma = 1e4 (float warnings are errors here): finite intervals; in strength mode the
-    capped rate RATE_CAP gives the first interval 0.1 J^T / RATE_CAP (loss cap) and the failure at
-    (J^T - sigma) / RATE_CAP of creep time."""
-    beta2 = 1e-3
-    jt, jc, sigma, tau = [2e7, 2e7], [52e6, 52e6], [1e7, 1e3], [0.0, 1e7]   # beta2 sigma = 1e4, beta2 tau = 1e4
-    extra = {"area_fraction": [1.0, 1.0]} if mode == "area" else {}
-    clock = EventClock(0.1)
-    dt, failing = clock.next_interval(jt, jc, sigma, tau, TAN55, B1, beta2, mode=mode, **extra)
-    assert math.isfinite(dt) and dt > 0
+@pytest.mark.parametrize("law", [HilligCharles(B1, 1e-3), AreaLaw(B1, 1e-3)], ids=["hillig_charles", "area"])
+def test_event_clock_at_beta2_times_stress_of_1e4_has_no_overflow(law):
+    """beta2 sigma = 1e4 (float warnings are errors here): finite intervals; with Eq. 7 the capped rate
+    RATE_CAP gives the failure at (J^T - sigma) / RATE_CAP of creep time in one interval."""
+    state, stresses = _bonds(law, [2e7, 2e7], [52e6, 52e6], [1e7, 1e3], [0.0, 1e7], TAN55)
+    step = creep_step(law, EventClock(0.1), state, stresses)
+    assert math.isfinite(step.dt) and step.dt >= 0
     later = EventClock(0.1)
-    failing, state = _run_to_first_failure(later, jt, jc, sigma, tau, TAN55, mode=mode, beta2=beta2, **extra)
-    assert all(np.all(np.isfinite(x)) for x in np.atleast_2d(state))
-    if mode == "strength":
-        assert dt == pytest.approx(0.1 * 2e7 / c.RATE_CAP, rel=1e-12)
-        assert list(failing) == [0] and c.failed_now(state[0][0], state[1][0], sigma[0], tau[0], TAN55)[0]
-        assert later.creep_time == pytest.approx((2e7 - 1e7) / c.RATE_CAP, rel=1e-9)
+    step, state = _run_to_first_failure(later, law, state, stresses)
+    assert all(np.all(np.isfinite(v)) for v in state.arrays.values())
+    if law.name == "hillig_charles":
+        assert list(step.failing) == [0]
+        assert failed_now(state["tensile_strength"][0], state["cohesion"][0], 1e7, 0.0, TAN55)[0]
+        assert later.creep_time == pytest.approx((2e7 - 1e7) / RATE_CAP, rel=1e-9)

@@ -1,13 +1,18 @@
-"""Hillig-Charles stress corrosion (paper Eq. 5-7) and its area mode: closed forms, limits."""
+"""Degradation laws: Hillig-Charles on strength (paper Eq. 5-7) and the area law, closed forms and limits
+(the laws' module functions; the law objects, the threshold and the normalised exponent: tests/test_law.py)."""
 import itertools
 import math
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from grainfrac_yade import corrosion as c
+from grainfrac_yade.law import _common, area, hillig_charles
+
+# the laws' functions under one name, as the tests below call them
+c = SimpleNamespace(**{k: getattr(m, k) for m in (_common, hillig_charles, area) for k in dir(m) if not k.startswith("_")})
 
 B1, B2 = 1e-3, 1e-7  # paper section 4.1: beta1 [Pa/s], beta2 [1/Pa]
 TAN55 = math.tan(math.radians(55.0))  # K-feldspar/K-feldspar friction angle, Table 2

@@ -35,7 +35,7 @@ def _run(clock, sigma, tau, extra=()):
     sc = p.stress_corrosion
     if clock == "event":
         c = EventClock(sc.max_strength_loss_fraction, sc.creep_time_limit)
-        event_clock_loop(holder, holder.corr, c, sc)
+        event_clock_loop(holder, holder.corr, c)
     else:
         c = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
         paper_clock_loop(holder, holder.corr, c, sc, p.creep)
@@ -80,13 +80,13 @@ def test_paper_clock_tension_within_one_creep_step():
 
 
 def test_engine_state_round_trip():
-    """The corrosion engine's whole state (strengths, area fractions, creep time) saves and restores."""
+    """The corrosion engine's whole state (the law's strengths, creep time) saves and restores."""
     import json
     from grainfrac_yade.clocks import EventClock
     from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
     p = _params("event")
     a = BondUnderForce(p, 5e6, 0.0)
-    a.corr.degrade_for(1e6, [0], np.array([a.sigma0]), np.array([a.tau0]))
+    a.corr.degrade(1e6, a.corr.stresses([0]))
     clock = EventClock(0.1)
     clock.advance(1e6)
     saved = json.loads(json.dumps({"engine": a.corr.state_dict(), "clock": clock.state_dict()}))
@@ -94,6 +94,6 @@ def test_engine_state_round_trip():
     b.corr.load_state(saved["engine"])
     restored = EventClock.from_state(saved["clock"])
     assert b.corr.creep_time == a.corr.creep_time == restored.creep_time == 1e6
-    np.testing.assert_array_equal(b.corr.tensile, a.corr.tensile)
+    np.testing.assert_array_equal(b.corr.state["tensile_strength"], a.corr.state["tensile_strength"])
     assert b.scene.interactions[0].phys.FnMax == a.scene.interactions[0].phys.FnMax
-    assert a.corr.tensile[0] < a.corr.tensile0[0]
+    assert a.corr.state["tensile_strength"][0] < a.corr.tensile0[0]

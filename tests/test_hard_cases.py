@@ -21,7 +21,7 @@ import pytest
 
 from conftest import ROOT, needs_yade
 from test_reliability import StandInBonds, StandInHolder
-from grainfrac_yade import corrosion
+from grainfrac_yade.law import degrade_step, failed_now, hillig_charles
 from grainfrac_yade.clocks import EventClock, PaperClock
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
@@ -65,7 +65,7 @@ def no_negative_strength(scene, corr=None):
         values = np.array([getattr(i.phys, name) for i in scene.interactions])
         assert np.isfinite(values).all() and (values >= 0).all(), name
     if corr is not None:
-        for values in (corr.tensile, corr.cohesion, corr.area_fraction):
+        for values in corr.state.arrays.values():
             assert np.isfinite(values).all() and (values >= 0).all()
 
 
@@ -419,14 +419,13 @@ class FrozenBonds(StandInBonds):
 
     def _dem_steps(self, n):
         idx = self.intact()
-        tension, shear = corrosion.failed_now(self.tensile[idx], self.cohesion[idx], self.sigma[idx], self.tau[idx],
-                                              self.tan_phi[idx])
+        tension, shear = failed_now(self.tensile[idx], self.cohesion[idx], self.sigma[idx], self.tau[idx],
+                                    self.tan_phi[idx])
         self.scene.broken[idx[tension | shear]] = True
 
-    def degrade_for(self, dt, idx, sigma, tau):
-        self.tensile[idx], self.cohesion[idx] = corrosion.degrade(self.tensile[idx], self.cohesion[idx], sigma, tau,
-                                                                  dt, B1, B2)
-        super().degrade_for(dt, idx, sigma, tau)
+    def degrade(self, dt, stresses):
+        self.state = degrade_step(self.law, self.state, stresses, dt)
+        super().degrade(dt, stresses)
 
 
 class BreakRecorder(StandInHolder):
@@ -476,7 +475,7 @@ def _clocked_breaks(clock_name, dt_max=1e8, limit=1e12):
     else:
         clock = EventClock(0.1, limit)
         holder = BreakRecorder(bonds, clock)
-        event_clock_loop(holder, bonds, clock, SimpleNamespace(mode="strength", beta1=B1, beta2=B2))
+        event_clock_loop(holder, bonds, clock)
     return holder, clock
 
 
@@ -487,7 +486,7 @@ def test_h_the_paper_clock_with_a_1e8_s_step_breaks_each_bond_in_the_step_that_p
     marked one creep step late while other bonds stayed intact (the clock advanced before the breaks were
     read): 1e8 s late at dt_max."""
     sigma, tau, jt, jc = frozen_bonds()
-    t_fail, _ = corrosion.time_to_failure(np.full(60, jt), np.full(60, jc), sigma, tau, np.full(60, TAN_PHI), B1, B2)
+    t_fail, _ = hillig_charles.time_to_failure(np.full(60, jt), np.full(60, jc), sigma, tau, np.full(60, TAN_PHI), B1, B2)
     assert 1e7 < t_fail.min() and t_fail.max() < 1e11
     holder, clock = _clocked_breaks("paper")
     assert holder.failed and holder.failure_reason == "every bond broken"
@@ -504,7 +503,7 @@ def test_h_paper_clock_lifetimes_lie_within_one_doubling_of_the_event_clock():
     tolerance: Eq. 8's resolution, up to a factor 2 with dt_max = 1e8 s (measured here: t_paper / t_event
     1.0004 to 1.55; beyond 1.8e8 s the step is capped at 1e8 s)."""
     sigma, tau, jt, jc = frozen_bonds()
-    t_fail, _ = corrosion.time_to_failure(np.full(60, jt), np.full(60, jc), sigma, tau, np.full(60, TAN_PHI), B1, B2)
+    t_fail, _ = hillig_charles.time_to_failure(np.full(60, jt), np.full(60, jc), sigma, tau, np.full(60, TAN_PHI), B1, B2)
     event, _ = _clocked_breaks("event")
     paper, _ = _clocked_breaks("paper")
     t_event, t_paper = event.break_time, paper.break_time

@@ -37,27 +37,30 @@ class StandInScene:
 
 
 class StandInBonds:
-    """The corrosion engine's interface on fixed stresses; ``breaks``: hand-overs break the bond."""
+    """The corrosion engine's interface (paper Eq. 7 as its law) on fixed stresses; ``breaks``: hand-overs
+    break the bond; its degrade only counts creep time."""
 
     def __init__(self, sigma, tau, tensile, cohesion, breaks=False):
+        from grainfrac_yade.law.hillig_charles import HilligCharles
         self.sigma, self.tau = np.asarray(sigma, float), np.asarray(tau, float)
         n = len(self.sigma)
         self.scene = StandInScene(n)
-        self.tensile, self.cohesion = np.full(n, float(tensile)), np.full(n, float(cohesion))
-        self.area0, self.tan_phi, self.area_fraction = np.full(n, 1e-6), np.full(n, math.tan(math.radians(55))), \
-            np.ones(n)
+        self.law = HilligCharles(B1, B2)
+        self.area0, self.tan_phi = np.full(n, 1e-6), np.full(n, math.tan(math.radians(55)))
+        self.state = self.law.initial_state(np.full(n, float(tensile)), np.full(n, float(cohesion)), self.tan_phi)
         self.breaks, self.handed, self.creep_time = breaks, [], 0.0
+
+    tensile = property(lambda self: self.state["tensile_strength"])
+    cohesion = property(lambda self: self.state["cohesion"])
 
     def intact(self):
         return np.flatnonzero(~self.scene.broken)
 
     def stresses(self, idx):
-        return self.sigma[idx], self.tau[idx]
+        from grainfrac_yade.law import Stresses
+        return Stresses.of(idx, self.sigma[idx], self.tau[idx])
 
-    def law_arrays(self, idx):
-        return self.tensile[idx], self.cohesion[idx]
-
-    def degrade_for(self, dt, idx, sigma, tau):
+    def degrade(self, dt, stresses):
         self.creep_time += dt
 
     def write(self, idx):
@@ -151,7 +154,7 @@ def _event_loop(bonds, holder=None):
     from grainfrac_yade.yade_adapter.creep_test import event_clock_loop
     holder = holder or StandInHolder()
     clock = EventClock(0.1)
-    n = event_clock_loop(holder, bonds, clock, SimpleNamespace(mode="strength", beta1=B1, beta2=B2))
+    n = event_clock_loop(holder, bonds, clock)
     return n, holder, clock
 
 
@@ -490,16 +493,16 @@ def test_yade_nan_ends_the_run_as_a_numerical_failure(tmp_path, monkeypatch, pha
 def test_yade_bond_never_gets_a_nan_strength():
     """write() and hand_over_failures() refuse non-finite values before touching YADE (Python's
     max(nan, 0) is nan, which hand_over_failures would have written as FsMax)."""
-    from grainfrac_yade import corrosion
+    from grainfrac_yade.law import MODE_SHEAR
     from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
     holder = BondUnderForce(load_parameters(), 1e6, 0.0)
     phys = holder.scene.interactions[0].phys
     before = (phys.FnMax, phys.FsMax)
-    holder.corr.tensile[0] = math.nan
+    holder.corr.state["tensile_strength"][0] = math.nan
     with pytest.raises(NumericalFailure, match="^value written to a YADE bond is NaN or infinite at 1 of 1 bond"):
         holder.corr.write([0])
     with pytest.raises(NumericalFailure, match="^value written to a YADE bond is NaN or infinite at 1 of 1 bond"):
-        holder.corr.hand_over_failures([0], [math.nan], [0.0], [corrosion.MODE_SHEAR])
+        holder.corr.hand_over_failures([0], [math.nan], [0.0], [MODE_SHEAR])
     assert (phys.FnMax, phys.FsMax) == before and all(map(math.isfinite, before))
 
 

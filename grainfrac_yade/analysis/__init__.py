@@ -4,7 +4,7 @@ Modules: :mod:`.collect` (run folders -> DataFrame), :mod:`.lifetimes` (run outc
 ratio), :mod:`.fits` (static-fatigue laws), :mod:`.labdata` (lab CSV, paper reference values),
 :mod:`.figures` and :mod:`.crackmaps` (PNG), :mod:`.report` (markdown), :mod:`.runparams`
 (params.json -> Parameters, the run's specimen rebuilt and verified), :mod:`.rescale` (creep times
-at another beta1, exact for event-clock strength-mode runs), :mod:`.study` (``analyze_study``:
+at another beta1, exact for event-clock runs of a strength law), :mod:`.study` (``analyze_study``:
 study folder(s) -> report.md; imports matplotlib).
 """
 from .collect import collect_runs, group_stats  # noqa: F401

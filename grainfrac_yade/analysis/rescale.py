@@ -101,7 +101,7 @@ def time_factors(runs: pd.DataFrame, beta1: float, creep_outcomes) -> pd.Series:
         folder, why = bad[0]
         more = f" (and {len(bad) - 1} more run(s))" if len(bad) > 1 else ""
         raise GrainfracError(f"{folder}: cannot rescale times to beta1 = {beta1:g} Pa/s{more}: {why}; fix: run "
-                             "without --beta1, or analyze only event-clock strength-mode runs (rerun this one "
+                             "without --beta1, or analyze only event-clock runs of a strength law (rerun this one "
                              f"with --set stress_corrosion.beta1={beta1:g})")
     return factors
 

@@ -44,8 +44,7 @@ def creep_step(law: DegradationLaw, clock, state: BondState, stresses: Stresses)
     dt, positions, modes = law.interval(sub, stresses, time_left, clock.max_strength_loss_fraction)
     if not math.isfinite(dt) or dt < 0:
         return CreepStep(dt, state, np.empty(0, np.int64), np.empty(0, int), np.empty(0, np.int64))
-    new = law.degrade(sub, stresses, dt)
-    new = law.at_failure(new, sub, stresses, positions, modes)
+    new = law.step(sub, stresses, dt, positions, modes)
     return CreepStep(dt, state.replaced(index, new), index[positions], np.asarray(modes), np.asarray(positions))
 
 

@@ -117,6 +117,12 @@ class DegradationLaw:
         """``new`` (from :meth:`degrade`) with the bonds at ``positions`` set exactly on their failure point."""
         raise NotImplementedError
 
+    def step(self, state: BondState, stresses: Stresses, dt, positions, modes) -> dict:
+        """The law arrays at the end of an event-clock interval of length ``dt``: every bond degraded,
+        the failing ones (``positions``, ``modes``) exactly on their failure point."""
+        new = self.degrade(state, stresses, dt)
+        return self.at_failure(new, state, stresses, positions, modes)
+
     def failed_now(self, state: BondState, stresses: Stresses):
         """(tensile_failed, shear_failed) of the bonds now."""
         raise NotImplementedError

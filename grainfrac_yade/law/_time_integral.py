@@ -18,7 +18,23 @@ All results are logs of times, so nothing overflows; every exponent is clipped t
 """
 import numpy as np
 
-from ._common import LOG_LIMIT, logaddexp
+from ._common import LOG_LIMIT
+
+
+def logaddexp(x, y):
+    """ln(e^x + e^y) (numpy's; callers run under :func:`_quiet`)."""
+    return np.logaddexp(x, y)
+
+
+def _quiet(function):
+    """Run ``function`` with float warnings off: inf, 0 and -inf are meant (log space, clipped exponents)."""
+    import functools
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        with np.errstate(all="ignore"):
+            return function(*args, **kwargs)
+    return wrapper
 
 GL_NODES = 10       # Gauss-Legendre nodes per panel
 V_PANEL = 4.0       # largest variation of ln psi across a panel: 10-node GL error ~ 4^20 6e-31 < 1e-18
@@ -28,6 +44,9 @@ TAIL_RATIO = 1e16   # u0 * TAIL_RATIO stands for u = inf (y = 0): the tail beyon
 DOMINANCE = 40.0    # a channel below e^-40 of the other does not shape psi (relative 4e-18)
 MAX_SPLIT = 16      # pieces a panel is split into per round
 MAX_ROUNDS = 400    # panel rounds (each at least halves every undecided panel's log-variation)
+STOP_BOUND_PIECES = 8  # geometric panels of the upper bound that settles 'past the stop' for large changes
+BRACKET_GROWTH = 16.0  # factor by which a bracket that is too short grows
+BRACKET_GROWTHS = 200  # growths of the bracket (16^200 covers any float range)
 NEWTON_STEPS = 200  # Newton-bisection iterations of advance() (bisection alone needs < 120)
 U_RELATIVE_TOL = 4 * np.finfo(float).eps
 
@@ -47,8 +66,7 @@ class Channels:
             l2, k2 = -np.inf, 0.0
         self.l1, self.k1, self.l2, self.k2 = (np.array(x, dtype=float) for x in np.broadcast_arrays(
             np.atleast_1d(l1), np.atleast_1d(k1), np.atleast_1d(l2), np.atleast_1d(k2)))
-        with np.errstate(invalid="ignore"):
-            kmax = np.maximum(np.abs(self.k1), np.where(np.isneginf(self.l2), 0.0, np.abs(self.k2)))
+        kmax = np.maximum(np.abs(self.k1), np.where(np.isneginf(self.l2), 0.0, np.abs(self.k2)))
         self.kmax = np.where(np.isfinite(kmax), kmax, np.finfo(float).max)
 
     def take(self, rows):
@@ -58,48 +76,59 @@ class Channels:
 
 
 def _exponent(l, k, u):
-    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        e = l + k * u
-    return np.where(np.isneginf(l), -np.inf, np.clip(np.nan_to_num(e, nan=-np.inf), -LOG_LIMIT, LOG_LIMIT))
+    """l + k u clipped to +-LOG_LIMIT; -inf for an absent channel (l = -inf; the only way to get NaN)."""
+    e = np.minimum(np.maximum(l + k * u, -LOG_LIMIT), LOG_LIMIT)
+    return np.where(l == -np.inf, -np.inf, e)
 
 
-def channel_exponents(ch, rows, u):
-    """ln of each channel's rate at u (rows: which bonds)."""
+def _channel_exponents(ch, rows, u):
     return _exponent(ch.l1[rows], ch.k1[rows], u), _exponent(ch.l2[rows], ch.k2[rows], u)
 
 
+def _log_rate(ch, rows, u):
+    return logaddexp(*_channel_exponents(ch, rows, u))
+
+
+def _log_psi(ch, rows, u):
+    return -_log_rate(ch, rows, u) - 2.0 * np.log(u)
+
+
+@_quiet
+def channel_exponents(ch, rows, u):
+    """ln of each channel's rate at u (rows: which bonds)."""
+    return _channel_exponents(ch, rows, u)
+
+
+@_quiet
 def log_rate(ch, rows, u):
     """ln R(u)."""
-    e1, e2 = channel_exponents(ch, rows, u)
-    return logaddexp(e1, e2)
+    return _log_rate(ch, rows, u)
 
 
+@_quiet
 def log_psi(ch, rows, u):
     """ln psi(u) = -ln R(u) - 2 ln u."""
-    return -log_rate(ch, rows, u) - 2.0 * np.log(u)
+    return _log_psi(ch, rows, u)
 
 
 def _gl(ch, rows, a, b):
     """ln of the 10-node Gauss-Legendre value of int_a^b psi (one panel per row)."""
     half = 0.5 * (b - a)
     u = (0.5 * (a + b))[:, None] + half[:, None] * _XI
-    lp = log_psi(ch, rows[:, None], u) + _LOG_W + np.log(np.where(half > 0, half, 1.0))[:, None]
+    lp = _log_psi(ch, rows[:, None], u) + _LOG_W + np.log(np.where(half > 0, half, 1.0))[:, None]
     m = np.max(lp, axis=1)
     m = np.where(np.isfinite(m), m, 0.0)
-    with np.errstate(under="ignore"):
-        s = np.sum(np.exp(lp - m[:, None]), axis=1)
-    with np.errstate(divide="ignore"):
-        return np.where(half > 0, np.log(s) + m, -np.inf)
+    s = np.sum(np.exp(lp - m[:, None]), axis=1)
+    return np.where(half > 0, np.log(s) + m, -np.inf)
 
 
 def _panel_bounds(ch, rows, a, b):
     """(ln lower, ln upper) bounds of int_a^b psi: each channel is monotone in u."""
-    ea1, ea2 = channel_exponents(ch, rows, a)
-    eb1, eb2 = channel_exponents(ch, rows, b)
+    ea1, ea2 = _channel_exponents(ch, rows, a)
+    eb1, eb2 = _channel_exponents(ch, rows, b)
     log_r_min = logaddexp(np.minimum(ea1, eb1), np.minimum(ea2, eb2))
     log_r_max = logaddexp(np.maximum(ea1, eb1), np.maximum(ea2, eb2))
-    with np.errstate(divide="ignore"):
-        log_w = np.log(b - a)
+    log_w = np.log(b - a)
     return log_w - log_r_max - 2.0 * np.log(b), log_w - log_r_min - 2.0 * np.log(a)
 
 
@@ -112,24 +141,41 @@ def _slope_bound(ch, rows, a, b):
     """Bound on |d ln R/du| over [a, b]: d ln R/du is a weighted mean of k1 and k2; where one channel
     exceeds the other by more than DOMINANCE at both ends (their gap is linear in u, so everywhere
     between), the other's weight is below e^-DOMINANCE and the slope is the dominant channel's k."""
-    ea1, ea2 = channel_exponents(ch, rows, a)
-    eb1, eb2 = channel_exponents(ch, rows, b)
-    with np.errstate(invalid="ignore"):
-        gap_lo = np.minimum(ea1 - ea2, eb1 - eb2)
-        gap_hi = np.maximum(ea1 - ea2, eb1 - eb2)
+    ea1, ea2 = _channel_exponents(ch, rows, a)
+    eb1, eb2 = _channel_exponents(ch, rows, b)
+    gap_lo = np.minimum(ea1 - ea2, eb1 - eb2)
+    gap_hi = np.maximum(ea1 - ea2, eb1 - eb2)
     k1 = np.where(_clipped(ea1, eb1), 0.0, np.abs(ch.k1[rows]))   # clipped across the panel: flat
     k2 = np.where(_clipped(ea2, eb2), 0.0, np.abs(ch.k2[rows]))
     both = np.minimum(np.maximum(k1, k2), np.finfo(float).max)
-    return np.where(np.nan_to_num(gap_lo, nan=np.inf) > DOMINANCE, k1,
-                    np.where(np.nan_to_num(gap_hi, nan=-np.inf) < -DOMINANCE, k2, both))
+    return np.where(gap_lo > DOMINANCE, k1, np.where(gap_hi < -DOMINANCE, k2, both))
+
+
+def _log_tail_upper_bound(ch, rows, u0):
+    """ln of an upper bound on t(u0 -> inf).  R(u) >= e^(l_c + k_c u) for a channel c with k_c > 0, so
+    t <= int_{u0}^inf e^-(l_c + k_c u) / u0^2 du = e^-(l_c + k_c u0) / (u0^2 k_c); where the exponent is
+    clipped at +LOG_LIMIT, R >= e^LOG_LIMIT and t <= e^-LOG_LIMIT / u0.  inf without such a channel."""
+    out = np.full(len(u0), np.inf)
+    for e, k in zip(_channel_exponents(ch, rows, u0), (ch.k1[rows], ch.k2[rows])):
+        growing = (k > 0) & (e > -LOG_LIMIT)
+        bound = np.where(e >= LOG_LIMIT, -LOG_LIMIT - np.log(u0),
+                         -e - np.log(np.where(growing, k, 1.0)) - 2.0 * np.log(u0))
+        out = np.minimum(out, np.where(growing, bound, np.inf))
+    return out
 
 
 def _finite_end(u0, u1):
     return np.where(np.isfinite(u1), u1, u0 * TAIL_RATIO)
 
 
+@_quiet
 def log_time_bounds(ch, u0, u1, pieces=1):
     """(ln lower, ln upper) bounds of t(u0 -> u1) from ``pieces`` geometric panels (cheap)."""
+    return _log_time_bounds(ch, u0, u1, pieces)
+
+
+def _log_time_bounds(ch, u0, u1, pieces=1):
+    """:func:`log_time_bounds` without its float-warning guard."""
     u0, u1 = np.asarray(u0, float), _finite_end(np.asarray(u0, float), np.asarray(u1, float))
     rows = np.arange(len(u0))
     lo = np.full(len(u0), -np.inf)
@@ -144,11 +190,17 @@ def log_time_bounds(ch, u0, u1, pieces=1):
     return lo, hi
 
 
+@_quiet
 def log_time(ch, u0, u1, rows=None):
     """ln t(u0 -> u1) = ln int_{u0}^{u1} psi du for each bond (u1 >= u0; inf: up to u0 TAIL_RATIO).
 
     ``rows``: the bonds of ``ch`` these u0, u1 belong to (default: all, in order). -inf for u1 == u0.
     """
+    return _log_time(ch, u0, u1, rows)
+
+
+def _log_time(ch, u0, u1, rows=None):
+    """:func:`log_time` without its float-warning guard (callers hold it)."""
     u0 = np.asarray(u0, float)
     n = len(u0)
     rows_all = np.arange(n) if rows is None else np.asarray(rows)
@@ -177,14 +229,14 @@ def log_time(ch, u0, u1, rows=None):
         owner, lo, hi, variation = owner[keep], lo[keep], hi[keep], variation[keep]
         geometric = hi > 2.0 * lo
         m = np.where(geometric, np.minimum(np.ceil(np.log2(hi / lo)), MAX_SPLIT),
-                     np.minimum(np.ceil(variation / V_PANEL), MAX_SPLIT)).astype(int)
+                     np.minimum(np.ceil(variation / V_PANEL), MAX_SPLIT))
+        m = np.nan_to_num(m, nan=2.0).astype(int)
         m = np.maximum(m, 2)
         reps = np.repeat(np.arange(len(owner)), m)
         j = np.arange(reps.size) - np.repeat(np.cumsum(m) - m, m)
         mm = m[reps].astype(float)
         a, b = lo[reps], hi[reps]
-        with np.errstate(over="ignore", invalid="ignore"):
-            geo_a, geo_b = a * (b / a) ** (j / mm), a * (b / a) ** ((j + 1) / mm)
+        geo_a, geo_b = a * (b / a) ** (j / mm), a * (b / a) ** ((j + 1) / mm)
         lin_a, lin_b = a + (b - a) * (j / mm), a + (b - a) * ((j + 1) / mm)
         g = geometric[reps]
         new_lo, new_hi = np.where(g, geo_a, lin_a), np.where(g, geo_b, lin_b)
@@ -195,6 +247,7 @@ def log_time(ch, u0, u1, rows=None):
     return out
 
 
+@_quiet
 def advance(ch, u0, u_stop, log_dt, rows=None):
     """(u1, reached): u1 with t(u0 -> u1) = dt, or u_stop and True if dt takes the bond past u_stop.
 
@@ -208,13 +261,42 @@ def advance(ch, u0, u_stop, log_dt, rows=None):
     u_stop = np.asarray(u_stop, float)
     log_dt = np.broadcast_to(np.asarray(log_dt, float), (n,)).copy()
     stop_end = _finite_end(u0, u_stop)
-    # past the stop? decide with bounds, integrate exactly only where they do not settle it
-    lb, ub = log_time_bounds(ch.take(rows), u0, stop_end, pieces=2)
-    reached = ub <= log_dt
-    unsure = ~reached & (lb < log_dt)
-    if unsure.any():
-        total = log_time(ch, u0[unsure], stop_end[unsure], rows[unsure])
-        reached[unsure] = total <= log_dt[unsure]
+    # bracket the root: [u0, u_try] with t(u0 -> u_try) >= dt by a cheap lower bound, u_try growing from
+    # twice the Euler step; only where u_try reaches the stop is the whole integral needed (past it or not)
+    euler = np.exp(np.clip(log_dt - _log_psi(ch, rows, u0), -LOG_LIMIT, LOG_LIMIT))
+    u_try = np.minimum(np.maximum(u0 + 2.0 * euler, u0 * (1.0 + 1e-15)), stop_end)
+    reached = np.zeros(n, bool)
+    open_ = np.isfinite(log_dt)
+    # past the stop already?  t(u0 -> inf) <= 1/(u0^2 R_c(u0) k_c) for each channel c with k_c > 0 (R >= R_c);
+    # for large changes also the panel bounds up to the stop
+    past = open_ & (_log_tail_upper_bound(ch, rows, u0) <= log_dt)
+    big = np.flatnonzero(open_ & ~past & (euler > u0))
+    if big.size:
+        _, ub = _log_time_bounds(ch.take(rows[big]), u0[big], stop_end[big], pieces=STOP_BOUND_PIECES)
+        past[big[ub <= log_dt[big]]] = True
+    reached[past], open_[past] = True, False
+    for _ in range(BRACKET_GROWTHS):
+        k = np.flatnonzero(open_)
+        if not k.size:
+            break
+        lb, ub = _log_time_bounds(ch.take(rows[k]), u0[k], u_try[k])
+        ok = lb >= log_dt[k]
+        loose = np.flatnonzero(~ok & (ub >= log_dt[k]))   # the bounds do not settle it: integrate exactly
+        if loose.size:
+            j = k[loose]
+            ok[loose] = _log_time(ch, u0[j], u_try[j], rows[j]) >= log_dt[j]
+        at_stop = ~ok & (u_try[k] >= stop_end[k])
+        past = at_stop & (ub <= log_dt[k])
+        unsure = at_stop & ~past
+        if unsure.any():
+            j = k[unsure]
+            total = _log_time(ch, u0[j], stop_end[j], rows[j])
+            past[unsure] = total <= log_dt[j]
+        reached[k[past]] = True
+        open_[k[ok | at_stop]] = False
+        grow = k[~ok & ~at_stop]
+        u_try[grow] = np.minimum(u0[grow] + BRACKET_GROWTH * (u_try[grow] - u0[grow]), stop_end[grow])
+    stop_end = np.where(reached, stop_end, u_try)
     u = u0.copy()
     u[reached] = u_stop[reached]
     todo = np.flatnonzero(~reached & np.isfinite(log_dt))
@@ -227,18 +309,22 @@ def advance(ch, u0, u_stop, log_dt, rows=None):
         k = np.flatnonzero(active)
         if not k.size:
             break
-        with np.errstate(over="ignore", under="ignore"):
-            slope = np.exp(np.clip(log_psi(ch, bond[k], cur[k]) - ldt[k], -LOG_LIMIT, LOG_LIMIT))
-            step = -g[k] / slope
+        slope = np.exp(np.clip(_log_psi(ch, bond[k], cur[k]) - ldt[k], -LOG_LIMIT, LOG_LIMIT))
+        step = -g[k] / slope
         new = cur[k] + step
-        outside = ~((new > lo_b[k]) & (new < hi_b[k]))
+        settled = np.abs(step) <= U_RELATIVE_TOL * cur[k]     # Newton's correction below resolution: done
+        active[k[settled]] = False
+        keep = ~settled
+        k, new = k[keep], new[keep]
+        if not k.size:
+            break
+        outside = ~((new >= lo_b[k]) & (new <= hi_b[k]))
         wide = hi_b[k] > 2.0 * lo_b[k]
-        bisect = np.where(wide, np.sqrt(lo_b[k] * hi_b[k]), 0.5 * (lo_b[k] + hi_b[k]))
+        bisect = np.where(wide, np.sqrt(lo_b[k]) * np.sqrt(hi_b[k]), 0.5 * (lo_b[k] + hi_b[k]))
         new = np.where(outside, bisect, new)
         a, b = np.minimum(cur[k], new), np.maximum(cur[k], new)
-        inc = log_time(ch, a, b, bond[k])
-        with np.errstate(over="ignore", under="ignore"):
-            ratio = np.exp(np.clip(inc - ldt[k], -LOG_LIMIT, LOG_LIMIT))
+        inc = _log_time(ch, a, b, bond[k])
+        ratio = np.exp(np.clip(inc - ldt[k], -LOG_LIMIT, LOG_LIMIT))
         g_new = g[k] + np.where(new >= cur[k], ratio, -ratio)
         done = (np.abs(new - cur[k]) <= U_RELATIVE_TOL * new) | (g_new == 0)
         lo_b[k] = np.where(g_new < 0, new, lo_b[k])

@@ -38,6 +38,7 @@ NAME = "area"
 AREA_MIN = 1e-250   # a below this counts as 0: keeps u = 1/a finite
 ASYMPTOTIC_X = 50.0  # x above which 1 - x e^x E1(x) uses its asymptotic series (e^x E1 overflows)
 ASYMPTOTIC_TERMS = 40  # series terms: 40!/50^40 ~ 1e-20, far below float64 resolution
+STOP_MARGIN = 1e-6  # a capped stop within 1e-6 of the cap above the failure point is the failure itself
 BOUND_PIECES = 4    # geometric panels of the cheap bounds that pick the bonds integrated exactly
 
 
@@ -262,9 +263,19 @@ class AreaLaw(DegradationLaw):
                                     self.beta2)
 
     def degrade(self, state, stresses, dt):
-        return {"area_fraction": degrade_area(state["area_fraction"], stresses.normal, stresses.shear,
-                                              state.tensile_strength0, state.cohesion0, dt, self.beta1,
-                                              self.beta2)}
+        a = state["area_fraction"]
+        out = a.copy()
+        left = np.flatnonzero(a > 0)          # a bond corroded to 0 (paper clock) has nothing left to lose
+        out[left] = degrade_area(a[left], stresses.normal[left], stresses.shear[left], state.tensile_strength0[left],
+                                 state.cohesion0[left], np.broadcast_to(dt, a.shape)[left], self.beta1, self.beta2)
+        return {"area_fraction": out}
+
+    def step(self, state, stresses, dt, positions, modes):
+        """Degrade the bonds that do not fail (the failing ones go straight to their failure point)."""
+        rest = np.setdiff1d(np.arange(len(state)), positions)
+        new = {"area_fraction": state["area_fraction"].copy()}
+        new["area_fraction"][rest] = self.degrade(state.subset(rest), stresses.take(rest), dt)["area_fraction"]
+        return self.at_failure(new, state, stresses, positions, modes)
 
     def at_failure(self, new, state, stresses, positions, modes):
         a = state["area_fraction"]
@@ -276,15 +287,18 @@ class AreaLaw(DegradationLaw):
     def interval(self, state, stresses, time_left, cap_fraction):
         """Next stop: the earliest failure, or the earliest bond to lose ``cap_fraction`` of its intact
         area, or ``time_left``.  Bounds pick the candidates; only they are integrated exactly."""
-        a, p, q, b1, b2 = _area_args(state["area_fraction"], stresses.normal, stresses.shear,
-                                     state.tensile_strength0, state.cohesion0, self.beta1, self.beta2)
-        n = len(a)
+        a_now = np.asarray(state["area_fraction"], float)
+        n = len(a_now)
         if n == 0:
             return time_left, np.empty(0, np.int64), np.empty(0, int)
+        a, p, q, b1, b2 = _area_args(np.where(a_now > 0, a_now, 1.0), stresses.normal, stresses.shear,
+                                     state.tensile_strength0, state.cohesion0, self.beta1, self.beta2)
+        a = np.where(a_now > 0, a, AREA_MIN)
         a_fail, modes = self.failure_point(state, stresses)
-        a_stop = np.maximum(a - cap_fraction, a_fail)
+        # the next stop: a - fraction, unless the failure point comes first or within a hair of it
+        a_stop = np.where(a - cap_fraction > a_fail + STOP_MARGIN * cap_fraction, a - cap_fraction, a_fail)
         fails = a_stop == a_fail
-        now = a <= a_fail
+        now = a_now <= a_fail
         ch = self._channels(state, stresses)
         u0 = 1.0 / a
         with np.errstate(divide="ignore"):

@@ -13,6 +13,7 @@ from ..layout import build_layout
 from ..specimen import specimen_from_tessellation
 from ..tessellation import tessellate_seeds
 from .corrosion_engine import StressCorrosion
+from .creep_test import add_stiffness_restorer
 from .scene import build_scene
 
 #: Relative unbalanced force on the loaded cell at which the pair counts as relaxed.
@@ -60,6 +61,7 @@ class BondUnderForce:
         self.sigma0, self.tau0 = float(st.normal[0]), float(st.shear[0])
         self.failed, self.failure_reason = False, ""
         self.scene.extras.append(self.corr)
+        add_stiffness_restorer(self.scene, self.corr)   # a law that changes stiffness: broken bond, full contact
 
     def progress(self, msg):
         pass
