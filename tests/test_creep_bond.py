@@ -97,3 +97,26 @@ def test_engine_state_round_trip():
     np.testing.assert_array_equal(b.corr.state["tensile_strength"], a.corr.state["tensile_strength"])
     assert b.scene.interactions[0].phys.FnMax == a.scene.interactions[0].phys.FnMax
     assert a.corr.state["tensile_strength"][0] < a.corr.tensile0[0]
+
+
+def test_event_clock_normalised_law_tension_matches_its_closed_form():
+    """The strength-normalised exponent in YADE: dJ/dt = -beta1 exp(beta2 sigma/J) reaches sigma at
+    (F(J0) - F(sigma))/beta1, F(y) = y e^(-k/y) G(k/y) (grainfrac_yade.law.normalised)."""
+    from grainfrac_yade.law.normalised import closed_form_time
+    p = load_parameters()
+    j0 = p.contact("quartz", "quartz").tensile_strength * p.calibration.strength_scale
+    holder, clock, p = _run("event", 0.8 * j0, 0.0, ["stress_corrosion.law=normalised"])
+    assert holder.failed and holder.scene.break_mode[0] == 1
+    expected = float(closed_form_time(j0, holder.sigma0, holder.sigma0, BETA1, p.stress_corrosion.beta2_normalised))
+    assert holder.lifetime == pytest.approx(expected, rel=0.01)
+
+
+def test_below_the_activation_threshold_a_bond_never_fails():
+    """Tension at 0.3 J^T with threshold_ratio 0.4: no corrosion; the run reaches its creep-time limit with
+    the bond whole and its strength untouched."""
+    p = load_parameters()
+    j0 = p.contact("quartz", "quartz").tensile_strength * p.calibration.strength_scale
+    holder, clock, p = _run("event", 0.3 * j0, 0.0, ["stress_corrosion.threshold_ratio=0.4",
+                                                     "stress_corrosion.creep_time_limit=1e12"])
+    assert not holder.failed and clock.creep_time == 1e12 and not holder.scene.broken[0]
+    assert holder.corr.state["tensile_strength"][0] == holder.corr.tensile0[0]
