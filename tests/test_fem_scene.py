@@ -171,3 +171,32 @@ def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
     # plain deformable scenes carry no element engine
     q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=deformable"])
     assert "FEInternalForceEngine" not in build_scene(build_specimen(q, 1), q).engine_names()
+
+
+@needs_yade
+@pytest.mark.yade
+@pytest.mark.parametrize("command", [["ucs"], pytest.param(["creep", "--ratio", "0.8", "--set",
+                                                              "stress_corrosion.creep_time_limit=1e13"],
+                                                             marks=pytest.mark.slow)])
+def test_fem_cells_run_the_commands_end_to_end(tmp_path, command):
+    """The preset runs a UCS and a creep test on a tiny specimen: a clean end, the grain model in
+    the summary, cracks recorded, no numerical failure."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path / command[0]
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", *command, "--params", "params/presets/fem.toml",
+                          "--width", "4e-3", "--height", "8e-3", "--seed", "1", "--out", str(out)],
+                         capture_output=True, text=True, cwd=root)
+    assert res.returncode == 0, res.stderr[-2000:]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["numerical_failure"] is False and summary["end_reason"]
+    assert json.loads((out / "params.json").read_text())["resolution"]["grain_model"] == "fem"
+    assert (out / "cracks.csv").exists() and (out / "history.csv").exists()
+    if command[0] == "creep":
+        assert summary["failed"] is True or summary["lifetime_s"] is None
+        assert summary["broken_total"] > 0
+    else:
+        assert 0 < summary["ucs_pa"] < 1e9 and 50e9 < summary["young_pa"] < 100e9
