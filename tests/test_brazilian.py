@@ -234,3 +234,28 @@ def test_params_json_written_before_the_brazilian_section_still_loads(tmp_path):
     (tmp_path / "params.json").write_text(json.dumps(tree))
     with pytest.raises(GrainfracError, match="ucs: missing section"):
         load_run_parameters(tmp_path)
+
+
+@needs_yade
+@pytest.mark.yade
+def test_levers_off_change_nothing_and_slits_are_not_cracks():
+    """Levers() leaves a run bit-identical; slits start broken (mode PRE_EXISTING), are left out of the crack
+    counts, and lower the strength; blocked rotation blocks every cell's Z rotation (8 mm disc, seed 1)."""
+    from grainfrac_yade.yade_adapter.brazilian_test import run_brazilian
+    from grainfrac_yade.yade_adapter.levers import PRE_EXISTING, Levers, apply_levers
+    from grainfrac_yade.yade_adapter.scene import build_scene
+    p = load_parameters(overrides=TINY)
+    sp = build_disc_specimen(p, 1)
+    plain, r_plain, _, _ = run_brazilian(sp, p)
+    off, r_off, _, _ = run_brazilian(sp, p, levers=Levers())
+    assert plain == off and r_off["levers"] == Levers().to_dict()
+    slit, r_slit, scene, (at_peak, _) = run_brazilian(sp, p, levers=Levers(slit_fraction=0.3))
+    pre = scene.break_mode == PRE_EXISTING
+    assert pre.sum() == r_slit["n_slits"] == round(0.3 * scene.n_bonds)
+    assert r_slit["broken_total"] == int((scene.broken & ~pre).sum()) and not (at_peak & pre).any()
+    assert max(slit["load_n"]) < max(plain["load_n"])
+    scene = build_scene(sp, p)
+    apply_levers(scene, Levers(block_rotation=True), 1)
+    assert all("Z" in scene.O.bodies[int(b)].state.blockedDOFs for b in scene.cell_body)
+    with pytest.raises(GrainfracError, match="slit-fraction"):
+        Levers(slit_fraction=1.0)

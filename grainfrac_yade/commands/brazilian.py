@@ -27,6 +27,13 @@ def register(sub, common):
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
                         "--set contacts.<a>/<b>.tensile_strength=F x its value for each row (recorded so in "
                         "params.json)")
+    lv = p.add_argument_group("levers on the bonds and cells (grainfrac_yade.yade_adapter.levers; recorded in "
+                              "summary.json under 'levers', not parameters: ucs and creep do not know them)")
+    lv.add_argument("--slit-fraction", type=float, default=0.0, metavar="F",
+                    help="share of faces unbonded before loading (slits: compression and friction, no tension)")
+    lv.add_argument("--strength-cv", type=float, default=0.0, metavar="C",
+                    help="coefficient of variation of a lognormal factor (mean 1) on each bond's J^T and J^C")
+    lv.add_argument("--block-rotation", action="store_true", help="cells do not rotate (rigid cells)")
     p.set_defaults(func=cmd_brazilian)
 
 
@@ -38,8 +45,10 @@ def cmd_brazilian(args) -> int:
         if args.tensile_scale is not None:
             extra += tensile_scale_overrides(params, args.tensile_scale)
         params = _reload(args, extra, params, args.tensile_scale)
+    from ..yade_adapter.levers import Levers
+    levers = Levers(slit_fraction=args.slit_fraction, strength_cv=args.strength_cv, block_rotation=args.block_rotation)
     out = args.out or f"results/brazilian_seed{args.seed}"
-    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
+    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers)
     print(format_result(summary, out))
     return 0
 
@@ -106,18 +115,21 @@ def require_disc_model(params):
                              "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
 
 
-def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
-    """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished)."""
+def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None) -> dict:
+    """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished).
+
+    ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none)."""
     from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..disc import build_disc_specimen
     from ..runio import prepare_run_dir, summary_header, write_csv, write_json
     from ..yade_adapter.brazilian_test import run_brazilian
-    from .ucs import write_cracks
+    from ..yade_adapter.levers import new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
     out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
-    history, result, scene, (broken_peak, mode_peak) = run_brazilian(specimen, params, progress=progress)
+    history, result, scene, (broken_peak, mode_peak) = run_brazilian(specimen, params, progress=progress,
+                                                                     levers=levers)
     t = specimen.tessellation
     diameter = t.diameter
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else \
@@ -131,7 +143,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None) -
     summary.update(result)
     summary["hondros_centre_factor_realised"] = hondros_centre_factor(math.radians(np.mean(result["loaded_arc_deg"])))
     points = scene.layout.bond_point
-    summary.update(crack_location(points, scene.broken, scene.break_step, t.centre, diameter))
+    summary.update(crack_location(points, new_breaks(scene), scene.break_step, t.centre, diameter))
     at_peak = crack_location(points, broken_peak, scene.break_step, t.centre, diameter)
     summary["broken_at_peak"] = int(broken_peak.sum())
     summary["central_band_fraction_at_peak"] = at_peak["central_band_fraction"]
@@ -139,11 +151,32 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None) -
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells, diameter_m=diameter,
                    thickness_m=specimen.thickness)
     write_csv(out / "history.csv", history)
-    write_cracks(out / "cracks.csv", scene)
+    write_disc_cracks(out / "cracks.csv", scene)
     load_figure(history, summary, out / "load_strain.png")
     draw_crack_maps(scene, summary, broken_peak, mode_peak, out)
     write_json(out / "summary.json", summary)   # last: marks the run finished
     return summary
+
+
+def write_disc_cracks(path, scene):
+    """cracks.csv: one row per bond broken during the test (DEM step, mode, kind, position, orientation, and
+    whether it lies in the central band); slits (:mod:`~grainfrac_yade.yade_adapter.levers`) are left out."""
+    from ..brazilian_analysis import in_central_band
+    from ..runio import write_csv
+    from ..yade_adapter.levers import new_breaks
+    from ..yade_adapter.scene import SHEAR
+    idx = np.flatnonzero(new_breaks(scene))
+    t = scene.specimen.tessellation
+    normal = t.face_normal[scene.layout.bond_face[idx]]
+    points = scene.layout.bond_point[idx]
+    write_csv(path, {
+        "bond": idx, "dem_step": scene.break_step[idx],
+        "mode": np.where(scene.break_mode[idx] == SHEAR, "shear", "tensile"),
+        "kind": np.where(scene.bond_is_inter[idx], "inter", "intra"),
+        "x_m": points[:, 0], "y_m": points[:, 1],
+        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
+        "central_band": in_central_band(points, t.centre, t.diameter),
+    })
 
 
 def band_guides(tessellation) -> np.ndarray:
@@ -168,7 +201,8 @@ def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     idx = np.flatnonzero(broken_peak)
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}", guides=guides)
-    idx = np.flatnonzero(scene.broken)
+    from ..yade_adapter.levers import new_breaks
+    idx = np.flatnonzero(new_breaks(scene))
     frac = summary["central_band_fraction"]
     crack_map(specimen, out / "crack_map_end.png", bond_segments(scene, idx), scene.break_mode[idx],
               title=f"cracks at the end, seed {seed}: {frac if frac is None else round(frac, 2)} in the band "

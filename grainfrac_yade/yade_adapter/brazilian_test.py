@@ -34,7 +34,8 @@ import numpy as np
 
 from ..disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
-from .scene import broken_counts, build_scene, check_value
+from .levers import Levers, apply_levers, new_breaks
+from .scene import SHEAR, TENSION, build_scene, check_value
 
 #: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
 JAW_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -112,11 +113,26 @@ class DiscJaws:
         return 0.5 * (top - bottom)
 
 
-def run_brazilian(specimen, params, progress=None, scene=None):
-    """Run the test; return (history columns, result dict, scene, broken-at-peak snapshot)."""
+def crack_counts(scene) -> dict:
+    """Bonds broken during the test by mode and kind (:func:`.scene.broken_counts` without the slits of
+    :mod:`.levers`, which are broken before loading)."""
+    b, inter = new_breaks(scene), scene.bond_is_inter
+    return {"broken_total": int(b.sum()),
+            "broken_tensile": int((b & (scene.break_mode == TENSION)).sum()),
+            "broken_shear": int((b & (scene.break_mode == SHEAR)).sum()),
+            "broken_inter": int((b & inter).sum()), "broken_intra": int((b & ~inter).sum())}
+
+
+def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
+    """Run the test; return (history columns, result dict, scene, broken-at-peak snapshot).
+
+    ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).  Broken
+    counts and the snapshot (bonds broken at the peak load, their modes) leave out slits.
+    """
     from ..brazilian_analysis import tensile_stress
     t0 = time.time()
     scene = scene or build_scene(specimen, params)
+    applied = apply_levers(scene, levers or Levers(), specimen.seed)
     bz = params.brazilian
     jaws = DiscJaws(scene, math.radians(bz.loading_arc_deg), bz.platen_lateral)
     scene.extras.append(jaws)
@@ -127,7 +143,7 @@ def run_brazilian(specimen, params, progress=None, scene=None):
     cols = {k: [] for k in ("dem_step", "dem_time_s", "diametral_strain", "horizontal_strain", "load_n",
                             "tensile_stress_pa", "broken_total", "broken_tensile", "broken_shear", "broken_inter",
                             "broken_intra")}
-    peak, broken_at_peak, peak_snapshot = 0.0, 0, (scene.broken.copy(), scene.break_mode.copy())
+    peak, broken_at_peak, peak_snapshot = 0.0, 0, (new_breaks(scene), scene.break_mode.copy())
     numerical, peak_reached = False, False
     try:
         while True:
@@ -136,14 +152,14 @@ def run_brazilian(specimen, params, progress=None, scene=None):
             strain = jaws.diametral_strain()
             row = dict(dem_step=scene.O.iter, dem_time_s=scene.O.time, diametral_strain=strain,
                        horizontal_strain=jaws.horizontal_strain(), load_n=load,
-                       tensile_stress_pa=float(tensile_stress(load, jaws.diameter, thickness)), **broken_counts(scene))
+                       tensile_stress_pa=float(tensile_stress(load, jaws.diameter, thickness)), **crack_counts(scene))
             for k, v in row.items():
                 check_value(k, v, scene.O.iter)
             for k, v in row.items():
                 cols[k].append(v)
             if load > peak:
                 peak, broken_at_peak = load, row["broken_total"]
-                peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
+                peak_snapshot = (new_breaks(scene), scene.break_mode.copy())
             if progress and len(cols["dem_step"]) % 50 == 0:
                 progress(f"strain {strain:.6f}  sigma {row['tensile_stress_pa'] / 1e6:6.2f} MPa  "
                          f"broken {row['broken_total']}")
@@ -161,7 +177,7 @@ def run_brazilian(specimen, params, progress=None, scene=None):
         if progress:
             progress(end)
     result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "dem_timestep_s": dt,
-              "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
+              "n_bonds": scene.n_bonds, **crack_counts(scene), "numerical_failure": numerical,
               "peak_reached": peak_reached, "end_reason": end,
-              "jaw_cells": [len(jaws.top), len(jaws.bottom)], "loaded_arc_deg": jaws.loaded_arc_deg}
+              "jaw_cells": [len(jaws.top), len(jaws.bottom)], "loaded_arc_deg": jaws.loaded_arc_deg, **applied}
     return cols, result, scene, peak_snapshot

@@ -1,0 +1,95 @@
+"""Levers of a grain-based model on its tensile strength, applied to a built scene (study options).
+
+Each lever changes the bonds or the cells of a scene built by :func:`.scene.build_scene` before
+the first DEM step; with every lever off (:class:`Levers` defaults) nothing is touched, so results
+are bit-identical to a scene without levers.  They are options of the ``brazilian`` command and of
+the lever study (``docs/brazilian_levers.py``, which applies them to UCS tests too), recorded in
+each summary.json under ``levers``; they are not model parameters (``params/``) yet, so the other
+commands (ucs, creep) do not know them.  The tensile strength of the contacts alone is a parameter
+already: ``brazilian --tensile-scale`` (contact rows' J^T).
+
+* ``slit_fraction`` f: a random share f of the bonds (faces, with one sphere per cell) start broken
+  ("slits", as the flat-joint model's unbonded faces, Potyondy 2012, or a granite's pre-existing
+  grain-boundary cracks): no tension and no cohesion, friction phi_r, in contact, so they carry
+  compression and friction but no tension.  Recorded with break mode :data:`PRE_EXISTING` and left
+  out of the crack counts of the test (``new_breaks``).
+* ``strength_cv`` c: each bond's J^T and J^C multiplied by one factor drawn from a lognormal of mean 1
+  and coefficient of variation c (weak and strong grain boundaries; the mean strength stays).
+* ``block_rotation``: no cell rotates (rigid cells; an upper bound of the rotational resistance that
+  grain interlocking, or several bonds per face as ``resolution.spheres_per_cell = 8`` give, adds to
+  the one centre-to-centre bond per face that leaves rotation free).
+
+Random draws use their own stream, seeded by the specimen's seed: the specimen is unchanged.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..errors import GrainfracError
+
+#: Break mode of a bond broken before loading (a slit); 1 = tension and 2 = shear are JCFpm's, 3 the
+#: corrosion law's "corroded".
+PRE_EXISTING = 4
+#: Second word of the random stream of the levers (the first is the specimen's seed).
+LEVER_STREAM = 20261127
+
+
+@dataclass(frozen=True)
+class Levers:
+    slit_fraction: float = 0.0      # 1, share of bonds broken before loading
+    strength_cv: float = 0.0        # 1, coefficient of variation of a per-bond strength factor (lognormal, mean 1)
+    block_rotation: bool = False    # cells do not rotate
+
+    def __post_init__(self):
+        if not (math.isfinite(self.slit_fraction) and 0 <= self.slit_fraction < 1):
+            raise GrainfracError(f"--slit-fraction {self.slit_fraction!r}: must lie in [0, 1); fix: give the share of "
+                                 "faces unbonded before loading, e.g. 0.3")
+        if not (math.isfinite(self.strength_cv) and self.strength_cv >= 0):
+            raise GrainfracError(f"--strength-cv {self.strength_cv!r}: must be >= 0; fix: give a coefficient of "
+                                 "variation, e.g. 0.5")
+
+    @property
+    def active(self) -> bool:
+        return self.slit_fraction > 0 or self.strength_cv > 0 or self.block_rotation
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def apply_levers(scene, levers: Levers, seed: int) -> dict:
+    """Apply ``levers`` to ``scene`` (before its first step); return what was done (counts)."""
+    done = {"levers": levers.to_dict()}
+    if not levers.active:
+        return done
+    if scene.O.iter != 0:
+        raise GrainfracError("levers: the scene has already run; fix: apply levers right after build_scene")
+    if not scene.layout.rigid_cells:
+        raise GrainfracError("levers: built for rigid cells; fix: use resolution.grain_model = \"rigid\"")
+    rng = np.random.default_rng([int(seed), LEVER_STREAM])
+    n = scene.n_bonds
+    if levers.strength_cv > 0:
+        s2 = math.log1p(levers.strength_cv ** 2)
+        factor = rng.lognormal(-0.5 * s2, math.sqrt(s2), n)
+        for k, inter in enumerate(scene.interactions):
+            ph = inter.phys
+            ph.FnMax = float(ph.FnMax * factor[k])
+            ph.FsMax = float(ph.FsMax * factor[k])
+        done["strength_factor_mean"] = float(factor.mean())
+    if levers.slit_fraction > 0:
+        slits = np.sort(rng.choice(n, int(round(levers.slit_fraction * n)), replace=False))
+        scene.break_bonds(slits, PRE_EXISTING)
+        done["n_slits"] = int(len(slits))
+    if levers.block_rotation:
+        for body in scene.cell_body:
+            st = scene.O.bodies[int(body)].state
+            if "Z" not in st.blockedDOFs:
+                st.blockedDOFs = st.blockedDOFs + "Z"
+    return done
+
+
+def new_breaks(scene) -> np.ndarray:
+    """(n_bonds,) True for bonds broken during the test (tension or shear), not slits."""
+    return scene.broken & (scene.break_mode != PRE_EXISTING)
