@@ -97,7 +97,9 @@ def crack_map(specimen, path, segments, modes, title=None, macro=None, guides=No
     n_t, n_s = int(np.sum(np.asarray(modes) == 1)), int(np.sum(np.asarray(modes) == 2))
     ax.legend(handles=[Patch(color=CRACK_COLOURS[1], label=f"tensile ({n_t})"),
                        Patch(color=CRACK_COLOURS[2], label=f"shear ({n_s})")],
-              loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=8)
+              loc="upper center", ncol=2, fontsize=8,
+              # below the x label: -0.08 of a tall specimen's axes, proportionally lower for squat ones (discs)
+              bbox_to_anchor=(0.5, -0.08 * max(1.0, 2.0 * t.box[0] / t.box[1])))
     ax.set_title(title or "crack map")
     fig.tight_layout()
     fig.savefig(path, dpi=150)
