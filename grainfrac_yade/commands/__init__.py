@@ -4,7 +4,8 @@
 def register_all(subparsers, common):
     """Add later commands (ucs, creep, analyze, demo) to the CLI as they exist."""
     import importlib
-    for name in ("ucs", "calibrate", "calibrate_beta1", "analyze_ucs", "creep", "analyze", "demo", "elastic", "bench",
+    for name in ("ucs", "calibrate", "calibrate_beta1", "calibrate_lifetimes", "analyze_ucs", "creep", "analyze", "demo",
+                 "elastic", "bench",
                  "submit", "status", "brazilian"):
         try:
             module = importlib.import_module(f"{__name__}.{name}")
