@@ -1,4 +1,4 @@
-"""Study analysis (issue 6 item 2): lifetime fits, run outcomes, figures and report, the analyze CLI.
+"""Study analysis (lifetime studies, paper Fig. 4-9): lifetime fits, run outcomes, figures and report, the analyze CLI.
 
 All on synthetic run folders written here (no YADE): lifetimes follow ln t = a - b r exactly
 (or with seeded noise), so the fits must return the generating coefficients.

@@ -2,9 +2,13 @@
 commit 7e91240): the same times and areas, no endless halving of the interval, and at least 10 times faster.
 
 Timing: CPU time (time.process_time, robust to the other jobs on the shared cores), best of several repeats,
-old and new in the same process on the same bonds.  Measured when written (2 shared cores): one event-clock
-interval of 96 bonds 115-130 ms -> 7.7 ms (15 x), of 7489 bonds 3.6-4.4 s -> 80-100 ms (45 x); a paper-clock
-step (degrade, dt = 1e-3 s) 76-121 ms -> 1-2 ms (60-80 x) and 1.7-2.3 s -> 18-37 ms (60-95 x).
+old and new in the same process on the same bonds.  Measured when written (2 shared cores, two sessions), old ->
+new: one event-clock interval of 96 bonds 45-60 ms -> 2-5 ms (13-24 x), of 2000 bonds 325-367 ms -> 6-8 ms
+(45-51 x), of 7489 bonds 1.3-1.7 s -> 16-35 ms (38-93 x); a paper-clock step (degrade, dt = 1e-3 s) of 96
+bonds 30-49 ms -> 2-3 ms (14-15 x), of 7489 bonds 0.59-0.67 s -> 23-24 ms (24-29 x).  In YADE, the 4 x 8 mm
+creep run at 0.5 x 300 MPa (seed 1, event clock): 151.5 s -> 19.1 s of wall time (its lifetime changed
+with the intact-area cap and the restored contact stiffness: 6.99e7 -> 1.40e8 s; 1.17e8 and 1.20e8 s at caps 0.03
+and 0.01).
 """
 import time
 

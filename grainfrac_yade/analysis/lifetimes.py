@@ -22,7 +22,7 @@ import pandas as pd
 
 from .fits import RATIO_DECIMALS
 
-#: Minimum number of failed runs at one ratio for a scatter statistic (issue 6: three seeds).
+#: Minimum number of failed runs at one ratio for a scatter statistic (three seeds per ratio, as the lifetime studies run).
 MIN_SEEDS_FOR_STATS = 3
 
 

@@ -1,4 +1,4 @@
-"""``calibrate``: fit the strength and stiffness scale factors to the UCS and E targets (issue 4).
+"""``calibrate``: fit the strength and stiffness scale factors to the UCS and E targets (paper section 3.1, Tables 1-2).
 
 A YADE packing of rigid cells is not UDEC's deformable blocks: with Table 1 and 2
 as printed it is weaker and softer than the paper's model.  Two factors, the same
@@ -99,7 +99,7 @@ def write_calibration_file(path: Path, rows, args, overrides):
     first = [r for r in rows if r["round"] == 0]
     last_round = max(r["round"] for r in rows)
     last = [r for r in rows if r["round"] == last_round]
-    lines = ["# Calibration of the YADE packing to the paper's granite (issue 4), written by",
+    lines = ["# Calibration of the YADE packing to the paper's granite (UCS and E of paper section 3.1), written by",
              "#   python3 -m grainfrac_yade calibrate --seeds " + " ".join(map(str, args.seeds))
              + f" --rounds {args.rounds} " + " ".join(f"--set {k}={v}" for k, v in overrides).strip(),
              f"# seeds {args.seeds}; targets: UCS {args.target_ucs / 1e6:.1f} MPa (paper, simulated),",

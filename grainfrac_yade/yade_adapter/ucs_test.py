@@ -1,4 +1,4 @@
-"""Strain-controlled uniaxial compression between rigid platens (issue 4).
+"""Strain-controlled uniaxial compression between rigid platens (the UCS of paper section 3.1).
 
 The test ends once the axial stress falls below ``ucs.stop_stress_ratio`` of its peak with bonds
 broken since the peak (post-peak; a drop without a break is elastic ringing, e.g. of a one-cell-wide
