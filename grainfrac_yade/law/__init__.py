@@ -13,6 +13,17 @@ to failure; failure point and mode) and is built once from the parameters by :fu
 :func:`creep_step` is one event of the event clock.  Adding a law: a new module here with a
 ``NAME`` and a ``build(stress_corrosion_params)``, and its name among the choices of
 ``stress_corrosion.law`` (:data:`LAW_NAMES`).
+
+The path of beta1 from ``params/stress_corrosion.toml`` to a bond's strength in YADE (6 calls):
+
+1. :func:`grainfrac_yade.params.load_parameters` reads and checks it: ``params.stress_corrosion.beta1``;
+2. :func:`build_law` (called once by the adapter's ``StressCorrosion``) gives it to the law:
+   ``HilligCharles(beta1, beta2, ...)`` keeps it as ``law.beta1``;
+3. :func:`creep_step` (event clock; the paper clock calls :func:`degrade_step`) asks the law for the
+   interval and the new state;
+4. ``law.step`` / ``law.degrade`` calls
+5. :func:`.hillig_charles.degrade` with ``law.beta1``: J <- J - beta1 exp(beta2 s) dt (paper Eq. 7);
+6. ``StressCorrosion.write`` puts J A0 into the bond's ``FnMax`` / ``FsMax``.
 """
 from __future__ import annotations
 
