@@ -3,7 +3,6 @@ carries its compression, instead of keeping the corroded stiffness (down to 1e-9
 grains would pass.  One bond between two cells under a constant force (grainfrac_yade.yade_adapter.single_bond);
 about 1 s per case.  (A bond the area law breaks in shear cannot be checked this way: under a constant shear
 force that beat full friction, residual friction cannot hold it and the cell slides away.)"""
-import numpy as np
 import pytest
 
 from conftest import needs_yade

@@ -178,7 +178,8 @@ def test_strength_law_jumps_in_one_interval_exactly_to_the_closed_form_failure()
     assert list(step.failing) == [0] and list(step.modes) == [MODE_TENSION]
     assert clock.n_intervals == 1 and clock.n_events == 1 and clock.n_failures == 1
     assert clock.creep_time == pytest.approx((j0 - s) / (B1 * math.exp(B2 * s)), rel=1e-12)
-    assert state["tensile_strength"][0] == s and failed_now(state["tensile_strength"], state["cohesion"], s, 0.0, 0.0)[0][0]
+    assert state["tensile_strength"][0] == s
+    assert failed_now(state["tensile_strength"], state["cohesion"], s, 0.0, 0.0)[0][0]
 
 
 def test_event_clock_shear_failure_lands_exactly_on_the_criterion():

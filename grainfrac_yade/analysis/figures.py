@@ -284,7 +284,7 @@ def damage_figure(path, curves):
     return _save(fig, path)
 
 
-# ----------------------------------------------------------------------------- one creep run
+# ----------------------------------------------------------------------------- one run (creep, UCS, elastic solve)
 def run_bond_stress_figure(table, stress, path):
     """One run: histograms of bond normal and shear stress at the start of the creep phase (the tail
     that paper Eq. 7 turns into lifetimes)."""
@@ -327,6 +327,55 @@ def run_strain_time_figure(hist, summary, path):
     state = ("numerical failure: no result" if summary.get("numerical_failure") else
              f"lifetime {summary['lifetime_s']:.4g} s" if summary["failed"] else "not failed")
     ax.set_title(f"{summary['stress_pa'] / 1e6:.0f} MPa ({summary['clock']} clock): {state}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def run_stress_strain_figure(history, summary, path):
+    """One UCS run: axial, lateral and volumetric strain against axial stress, CI and CD marked."""
+    ea = np.asarray(history["axial_strain"]) * 100
+    el = np.asarray(history["lateral_strain"]) * 100
+    s = np.asarray(history["axial_stress_pa"]) / 1e6
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(ea, s, label="axial strain")
+    ax.plot(el, s, label="lateral strain")
+    ax.plot(ea + el, s, "--", lw=0.8, label="volumetric strain (plane)")
+    for key, label in (("crack_initiation_pa", "CI"), ("crack_damage_pa", "CD")):
+        if summary.get(key) is not None and np.isfinite(summary[key]):
+            ax.axhline(summary[key] / 1e6, color="grey", lw=0.6, ls=":")
+            ax.text(ax.get_xlim()[0], summary[key] / 1e6, f" {label}", va="bottom", fontsize=7)
+    ax.set_xlabel("strain [%] (compression positive)")
+    ax.set_ylabel("axial stress [MPa]")
+    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
+                 f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {_measure(summary['young_pa'], 1e9)} GPa, "
+                 f"nu {_measure(summary['poisson'], 1, 2)}")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def _measure(value, unit=1e6, digits=1) -> str:
+    """``value / unit`` with ``digits`` decimals; "-" if not measured (None or NaN)."""
+    return "-" if value is None or not np.isfinite(value) else f"{value / unit:.{digits}f}"
+
+
+def contact_stress_histograms(ratios: dict, path, title: str = ""):
+    """One elastic solve: histograms of contact shear and tension over the applied stress, one line per model."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.8))
+    for ax, k, label in ((axes[0], 0, "contact shear stress / applied stress"),
+                         (axes[1], 1, "contact tension / applied stress")):
+        top = max(float(np.percentile(r[k], 99.9)) for r in ratios.values())
+        bins = np.linspace(0, max(top, 1e-12) * 1.05, 60)
+        for name, r in ratios.items():
+            ax.hist(r[k], bins=bins, histtype="step", density=True, lw=1.2,
+                    label=f"{name}: p99 {np.percentile(r[k], 99):.2f}, max {r[k].max():.2f}")
+        ax.set_yscale("log")
+        ax.set_xlabel(label)
+        ax.set_ylabel("density")
+        ax.legend(fontsize=7)
+    fig.suptitle(f"static elastic solve, uniaxial compression: {title}", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)

@@ -133,7 +133,8 @@ class BatchModel:
                     continue
                 out = self.study / "calibrate" / name / f"ratio{ratio:g}_seed{seed}"
                 rows.append(dict(self.base, **{self.beta2_key: beta2, THRESHOLD_KEY: threshold}, ratio=ratio,
-                                 ucs=self.ucs, seed=seed, out=str(out), description=f"{name}_ratio{ratio:g}_seed{seed}"))
+                                 ucs=self.ucs, seed=seed, out=str(out),
+                                 description=f"{name}_ratio{ratio:g}_seed{seed}"))
         if rows:
             repo = Path(__file__).resolve().parents[2]
             folder = self.study / "calibrate" / name
@@ -216,7 +217,8 @@ def cmd_calibrate_lifetimes(args, params) -> int:
         f"{ucs / 1e6:.2f} MPa, event clock; {model.runs} creep runs made, {len(result.trials)} parameter sets tried.",
         "Lab data used (driving_stress_ratio, lifetime_s, source):",
         *(f"  {r:.4g}, {t:.6g}, {s}" for r, t, s in zip(lab["driving_stress_ratio"], lab["lifetime_s"], lab["source"])),
-        f"Before: beta1 {result.beta1_run:g} Pa/s, beta2 {result.before.beta2:g}, threshold {result.before.threshold:g}; "
+        f"Before: beta1 {result.beta1_run:g} Pa/s, beta2 {result.before.beta2:g}, threshold "
+        f"{result.before.threshold:g}; "
         f"sum of squared ln residuals {_cost(result, result.before, result.beta1_run):.4g}",
         *_fit_lines(result, result.before, result.beta1_run),
         f"After: beta1 {result.beta1:.6g} Pa/s, beta2 {result.beta2:.6g}, threshold {result.threshold:g}; sum of "

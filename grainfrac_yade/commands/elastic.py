@@ -1,8 +1,6 @@
 """``elastic``: static linear-elastic reference of a specimen (no YADE); summary.json and histograms."""
 from __future__ import annotations
 
-import numpy as np
-
 
 #: Static models of the YADE deformable cells and the grain model each one solves.
 CLUSTER_MODELS = {"lattice": "deformable", "fem": "fem"}
@@ -60,6 +58,7 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     ``summary.json`` holds the chosen model's keys at the top level and every solved model under
     ``models``.
     """
+    from ..analysis.figures import contact_stress_histograms
     from ..elastic import contact_ratios, elastic_summary
     from ..runio import code_version, prepare_run_dir, write_json
     from ..specimen import build_specimen
@@ -81,28 +80,6 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     summary.update(models=models, seed=seed, n_cells=specimen.n_cells, platens=platens,
                    stiffness_scale=params.calibration.stiffness_scale, code_version=code_version())
     write_json(out / "summary.json", summary)
-    histogram_figure(ratios, out / "contact_stress_histogram.png",
-                     title=f"{specimen.tessellation.box[0] * 1e3:.1f} x {specimen.tessellation.box[1] * 1e3:.1f} mm, "
-                           f"seed {seed}")
+    size = f"{specimen.tessellation.box[0] * 1e3:.1f} x {specimen.tessellation.box[1] * 1e3:.1f} mm"
+    contact_stress_histograms(ratios, out / "contact_stress_histogram.png", title=f"{size}, seed {seed}")
     return summary
-
-
-def histogram_figure(ratios: dict, path, title: str = ""):
-    """Histograms of contact shear and tension over the applied stress, one line per model."""
-    from ..plotting import plt
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.8))
-    for ax, k, label in ((axes[0], 0, "contact shear stress / applied stress"),
-                         (axes[1], 1, "contact tension / applied stress")):
-        top = max(float(np.percentile(r[k], 99.9)) for r in ratios.values())
-        bins = np.linspace(0, max(top, 1e-12) * 1.05, 60)
-        for name, r in ratios.items():
-            ax.hist(r[k], bins=bins, histtype="step", density=True, lw=1.2,
-                    label=f"{name}: p99 {np.percentile(r[k], 99):.2f}, max {r[k].max():.2f}")
-        ax.set_yscale("log")
-        ax.set_xlabel(label)
-        ax.set_ylabel("density")
-        ax.legend(fontsize=7)
-    fig.suptitle(f"static elastic solve, uniaxial compression: {title}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)

@@ -1,7 +1,5 @@
-"""``ucs``: uniaxial compression test (paper section 3.1); summary.json, history.csv, stress_strain.png, crack map at peak."""
+"""``ucs``: uniaxial compression test (paper section 3.1); summary.json, history.csv, figures, crack map at peak."""
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 
@@ -39,6 +37,7 @@ MEASURES = ("ucs_pa", "peak_axial_strain", "young_pa", "young_method", "poisson"
 
 def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
     """Run a UCS test into ``out``; summary.json is written last (it marks the run finished)."""
+    from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
     from ..plotting import crack_map
     from ..runio import prepare_run_dir, summary_header, write_csv, write_json
@@ -56,7 +55,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
-    stress_strain_figure(history, summary, out / "stress_strain.png")
+    run_stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
     at = "the largest stress before the numerical failure" if result["numerical_failure"] else \
         f"peak ({summary['ucs_pa'] / 1e6:.0f} MPa)"
@@ -80,30 +79,6 @@ def write_cracks(path, scene):
         "x_m": scene.layout.bond_point[idx, 0], "y_m": scene.layout.bond_point[idx, 1],
         "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
     })
-
-
-def stress_strain_figure(history, summary, path):
-    from ..plotting import plt
-    ea = np.asarray(history["axial_strain"]) * 100
-    el = np.asarray(history["lateral_strain"]) * 100
-    s = np.asarray(history["axial_stress_pa"]) / 1e6
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    ax.plot(ea, s, label="axial strain")
-    ax.plot(el, s, label="lateral strain")
-    ax.plot(ea + el, s, "--", lw=0.8, label="volumetric strain (plane)")
-    for key, label in (("crack_initiation_pa", "CI"), ("crack_damage_pa", "CD")):
-        if summary.get(key) is not None and np.isfinite(summary[key]):
-            ax.axhline(summary[key] / 1e6, color="grey", lw=0.6, ls=":")
-            ax.text(ax.get_xlim()[0], summary[key] / 1e6, f" {label}", va="bottom", fontsize=7)
-    ax.set_xlabel("strain [%] (compression positive)")
-    ax.set_ylabel("axial stress [MPa]")
-    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
-                 f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
-                 f"nu {_fmt(summary['poisson'], 1, 2)}")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
 
 
 def run_ucs_in_yade():

@@ -31,8 +31,8 @@ from scipy import special
 
 from . import _time_integral as ti
 from ._common import (LOG_LIMIT, MODE_CORRODED, MODE_SHEAR, MODE_TENSION, arr, check_dt, check_rate_constants,
-                      check_shear, finite, logaddexp, time_from_log)
-from ._interface import EVENT_REL_TOL, BondState, DegradationLaw, Stresses
+                      check_shear, finite, time_from_log)
+from ._interface import EVENT_REL_TOL, BondState, DegradationLaw
 
 NAME = "area"
 AREA_MIN = 1e-250   # a below this counts as 0: keeps u = 1/a finite
@@ -227,7 +227,8 @@ class AreaLaw(DegradationLaw):
         self.beta1, self.beta2 = (float(x) for x in check_rate_constants(beta1, beta2))
 
     def describe(self):
-        return f"area law (Potyondy 2007 idea, rate of paper Eq. 7): beta1 {self.beta1:g} Pa/s, beta2 {self.beta2:g} 1/Pa"
+        return (f"area law (Potyondy 2007 idea, rate of paper Eq. 7): beta1 {self.beta1:g} Pa/s, beta2 "
+                f"{self.beta2:g} 1/Pa")
 
     def initial_state(self, tensile_strength0, cohesion0, tan_friction):
         jt0 = np.asarray(tensile_strength0, float)

@@ -150,7 +150,8 @@ class StressCorrosion:
     def state_dict(self) -> dict:
         """Whole engine state (for checkpoints): the law's arrays as lists, creep time."""
         out = {"creep_time": self.creep_time, "law": self.law.name, "restored": np.flatnonzero(self.restored).tolist()}
-        intact = {"tensile_strength": self.tensile0, "cohesion": self.cohesion0, "area_fraction": np.ones(len(self.restored))}
+        intact = {"tensile_strength": self.tensile0, "cohesion": self.cohesion0,
+                  "area_fraction": np.ones(len(self.restored))}
         for name, key in STATE_KEYS.items():
             values = self.state.arrays.get(name, intact[name])
             out[key] = values.tolist()
