@@ -1,6 +1,6 @@
 """Lever study beyond the parameters: Brazilian 15 mm discs and UCS 10 x 20 mm with the levers of
 grainfrac_yade.yade_adapter.levers (slits, strength scatter, blocked rotation), the contacts' J^T at 0.1,
-the face-lined clumps' UCS (8 spheres per cell), and rotational resistance with J^T x 0.25.  Run by docs/brazilian_study.sh (one YADE run at a
+the face-lined clumps' UCS (8 spheres per cell), and rotational resistance with J^T x 0.25 and 0.1.  Run by docs/brazilian_study.sh (one YADE run at a
 time, in this process); a finished run (summary.json) is skipped.
 
     OMP_NUM_THREADS=1 /usr/bin/python3 docs/brazilian_levers.py results/brazilian_study
@@ -51,6 +51,7 @@ def main(root):
         # combinations: rotational resistance (bound: none; physical: face-lined clumps) with weak tension
         "norotation_tensile0.25": (tensile_scale_overrides(base, 0.25), Levers(block_rotation=True)),
         "spc8_tensile0.25": ([("resolution.spheres_per_cell", 8)] + tensile_scale_overrides(base, 0.25), Levers()),
+        "spc8_tensile0.1": ([("resolution.spheres_per_cell", 8)] + tensile_scale_overrides(base, 0.1), Levers()),
     }
     for name, (overrides, levers) in variants.items():
         for seed in SEEDS:

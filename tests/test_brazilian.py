@@ -132,6 +132,22 @@ def test_central_band_area_fraction_by_counting():
     assert central_band_area_fraction() == pytest.approx(0.4164, abs=1e-4)
 
 
+def test_failure_load_is_the_peak_before_the_split():
+    """A drop below 0.8 x the peak with new breaks is the split; a higher load after it (halves crushed
+    between the jaws) is not the strength. Without breaks a drop is ringing, not a split."""
+    from grainfrac_yade.brazilian_analysis import brazilian_summary, split_peak_index
+    load = [0, 5, 10, 12, 9, 14, 17, 6]
+    broken = [0, 0, 0, 1, 5, 6, 8, 20]
+    assert split_peak_index(load, broken) == (3, 4)
+    assert split_peak_index(load, [0] * 7 + [1]) == (6, 7)      # no break at the first drop: ringing
+    assert split_peak_index([0, 1, 2, 3], [0, 0, 1, 2]) == (3, None)   # no split: the largest load
+    s = brazilian_summary({"load_n": load, "broken_total": broken, "diametral_strain": np.arange(8) * 1e-4},
+                          0.01, 0.001)
+    assert s["peak_load_n"] == 12 and s["split_found"] and s["peak_diametral_strain"] == pytest.approx(3e-4)
+    assert s["tensile_strength_pa"] == pytest.approx(tensile_stress(12, 0.01, 0.001))
+    assert s["max_tensile_stress_pa"] == pytest.approx(tensile_stress(17, 0.01, 0.001))
+
+
 def test_crack_location_counts():
     pts = np.array([[0.0, 0.0], [0.1, 0.5], [0.9, 0.0], [-0.5, 0.1]])   # disc of radius 1 at the origin
     broken = np.array([True, True, True, False])

@@ -189,15 +189,15 @@ def band_guides(tessellation) -> np.ndarray:
 
 
 def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
-    """crack_map_peak.png (broken bonds at the peak load) and crack_map_end.png (at the end of the test),
-    with the central band's edges dashed."""
+    """crack_map_peak.png (broken bonds at the failure load, the peak before the split) and crack_map_end.png
+    (at the end of the test), with the central band's edges dashed."""
     from ..plotting import crack_map
     from ..yade_adapter.scene import bond_segments
     specimen, seed = scene.specimen, summary["seed"]
     guides = band_guides(specimen.tessellation)
     sigma = summary["tensile_strength_pa"]
     at = "the largest load before the numerical failure" if summary["numerical_failure"] else \
-        f"peak (sigma_t {sigma / 1e6:.1f} MPa)"
+        f"the failure load (sigma_t {sigma / 1e6:.1f} MPa)"
     idx = np.flatnonzero(broken_peak)
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}", guides=guides)

@@ -124,12 +124,14 @@ def crack_counts(scene) -> dict:
 
 
 def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
-    """Run the test; return (history columns, result dict, scene, broken-at-peak snapshot).
+    """Run the test; return (history columns, result dict, scene, snapshot at the failure load).
 
-    ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).  Broken
-    counts and the snapshot (bonds broken at the peak load, their modes) leave out slits.
+    The snapshot (bonds broken, their modes) is taken at the failure load: the peak before the split
+    (:func:`grainfrac_yade.brazilian_analysis.split_peak_index`, the same rows), else at the largest
+    load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
+    Broken counts and the snapshot leave out slits.
     """
-    from ..brazilian_analysis import tensile_stress
+    from ..brazilian_analysis import SPLIT_DROP_RATIO, tensile_stress
     t0 = time.time()
     scene = scene or build_scene(specimen, params)
     applied = apply_levers(scene, levers or Levers(), specimen.seed)
@@ -144,6 +146,7 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
                             "tensile_stress_pa", "broken_total", "broken_tensile", "broken_shear", "broken_inter",
                             "broken_intra")}
     peak, broken_at_peak, peak_snapshot = 0.0, 0, (new_breaks(scene), scene.break_mode.copy())
+    split_snapshot = None
     numerical, peak_reached = False, False
     try:
         while True:
@@ -157,9 +160,13 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
                 check_value(k, v, scene.O.iter)
             for k, v in row.items():
                 cols[k].append(v)
+            if (split_snapshot is None and load < SPLIT_DROP_RATIO * peak
+                    and row["broken_total"] > broken_at_peak):   # the split: the failure load is behind us
+                split_snapshot = peak_snapshot
             if load > peak:
                 peak, broken_at_peak = load, row["broken_total"]
-                peak_snapshot = (new_breaks(scene), scene.break_mode.copy())
+                if split_snapshot is None:
+                    peak_snapshot = (new_breaks(scene), scene.break_mode.copy())
             if progress and len(cols["dem_step"]) % 50 == 0:
                 progress(f"strain {strain:.6f}  sigma {row['tensile_stress_pa'] / 1e6:6.2f} MPa  "
                          f"broken {row['broken_total']}")
@@ -180,4 +187,4 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
               "n_bonds": scene.n_bonds, **crack_counts(scene), "numerical_failure": numerical,
               "peak_reached": peak_reached, "end_reason": end,
               "jaw_cells": [len(jaws.top), len(jaws.bottom)], "loaded_arc_deg": jaws.loaded_arc_deg, **applied}
-    return cols, result, scene, peak_snapshot
+    return cols, result, scene, split_snapshot or peak_snapshot
