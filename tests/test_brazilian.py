@@ -275,3 +275,21 @@ def test_levers_off_change_nothing_and_slits_are_not_cracks():
     assert all("Z" in scene.O.bodies[int(b)].state.blockedDOFs for b in scene.cell_body)
     with pytest.raises(GrainfracError, match="slit-fraction"):
         Levers(slit_fraction=1.0)
+
+
+@needs_yade
+@pytest.mark.yade
+def test_batch_row_runs_a_disc_and_a_rerun_skips_it(tmp_path):
+    """yade_scripts/brazilian.py through yade-batch (one job): a 5 mm row writes its run folder; run again, the
+    finished row is skipped."""
+    from grainfrac_yade.batchrun import run_batch, write_table
+    out = tmp_path / "row"
+    table = write_table(tmp_path / "bz.table", [{"brazilian.diameter": 5e-3, "seed": 2, "out": str(out)}])
+    script = ROOT / "yade_scripts" / "brazilian.py"
+    run_batch(table, script, 1, tmp_path / "logs", repo=ROOT)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["seed"] == 2 and s["diameter_m"] == 5e-3 and s["tensile_strength_pa"] > 0
+    stamp = (out / "summary.json").stat().st_mtime_ns
+    run_batch(table, script, 1, tmp_path / "logs2", repo=ROOT)
+    assert (out / "summary.json").stat().st_mtime_ns == stamp
+    assert "already finished, skipped" in "".join(p.read_text() for p in (tmp_path / "logs2").glob("*.log"))
