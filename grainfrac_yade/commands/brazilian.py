@@ -65,9 +65,10 @@ def _reload(args, extra, base, factor):
 def format_result(summary, out) -> str:
     if summary["numerical_failure"]:
         return f"Brazilian: no result ({summary['end_reason']}) -> {out}"
+    ratio = summary["reference_ucs_over_tensile_strength"]
     return (f"Brazilian tensile strength {summary['tensile_strength_pa'] / 1e6:.2f} MPa "
             f"(P/t {summary['peak_load_per_thickness_n_per_m'] / 1e3:.1f} kN/m, D {summary['diameter_m'] * 1e3:g} mm), "
-            f"UCS/sigma_t {summary['reference_ucs_over_tensile_strength']:.1f}; central band "
+            f"calibration.reference_ucs / sigma_t {'-' if ratio is None else f'{ratio:.1f}'}; central band "
             f"{summary['central_band_fraction']:.2f} of {summary['broken_total']} broken bonds "
             f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
 
