@@ -163,8 +163,10 @@ def checkpoint_differences(folder, params, run_values: dict) -> list | None:
 
     None if the folder holds no readable checkpoint; else "key: stored X, now Y" strings ([] if the
     checkpoint continues exactly this run: the folder's params.json and the checkpoint's run values
-    equal the given ones).
+    equal the given ones). A key missing from an older params.json counts as the shipped default,
+    as in :func:`stored_run_differences`.
     """
+    from .params import load_parameters
     state = read_checkpoint_state(folder)
     if state is None:
         return None
@@ -173,9 +175,11 @@ def checkpoint_differences(folder, params, run_values: dict) -> list | None:
     except (OSError, ValueError) as exc:
         return [f"stored parameters unreadable ({type(exc).__name__}: {exc})"]
     now = comparable_parameters(params.to_dict())
+    defaults = comparable_parameters(load_parameters().to_dict())
     missing = "(missing)"
-    diffs = [f"{key}: stored {stored.get(key, missing)!r}, now {now.get(key, missing)!r}"
-             for key in sorted(set(stored) | set(now)) if not _same(stored.get(key, missing), now.get(key, missing))]
+    pairs = {key: (stored.get(key, defaults.get(key, missing)), now.get(key, missing))
+             for key in sorted(set(stored) | set(now))}
+    diffs = [f"{key}: stored {old!r}, now {new!r}" for key, (old, new) in pairs.items() if not _same(old, new)]
     stored_values = state.get("run_values", {})
     for key, value in flatten_values(run_values).items():
         old = flatten_values(stored_values).get(key, missing)

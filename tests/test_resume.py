@@ -213,3 +213,20 @@ def test_a_bad_resume_is_one_line(tmp_path, case):
     expected = {"no folder": "no run here", "no checkpoint": "no checkpoint to resume from",
                 "conflict": "fix: drop --stress", "ucs run": "not a creep run"}[case]
     assert expected in res.stderr and "fix:" in res.stderr
+
+
+def test_a_checkpoint_older_than_a_parameter_section_still_matches(tmp_path):
+    """A key missing from an older params.json counts as the shipped default: a checkpoint written
+    before a section existed is resumed, not restarted."""
+    import json as _json
+    from grainfrac_yade.params import load_parameters as _load
+    from grainfrac_yade.runio import CHECKPOINT, CHECKPOINT_STATE, checkpoint_differences
+    p = _load()
+    stored = p.to_dict()
+    stored.pop("brazilian", None)
+    stored["ucs"].pop(next(iter(stored["ucs"])))
+    (tmp_path / "params.json").write_text(_json.dumps(stored))
+    (tmp_path / CHECKPOINT).mkdir()
+    (tmp_path / CHECKPOINT / CHECKPOINT_STATE).write_text(_json.dumps({"run_values": {"seed": 1}}))
+    assert checkpoint_differences(tmp_path, p, {"seed": 1}) == []
+    assert checkpoint_differences(tmp_path, p, {"seed": 2}) == ["seed: stored 1, now 2"]
