@@ -55,6 +55,7 @@ def test_doubled_strengths_give_a_higher_ucs():
 RATE_SEEDS = (1, 2, 3)
 
 
+@pytest.mark.slow   # three seeds at two rates: a sensitivity check of the default rate, 50 s
 def test_halving_the_loading_rate_changes_the_mean_peak_by_less_than_2_percent():
     p = load_parameters()
     fast = np.mean([_ucs([], seed)[0]["ucs_pa"] for seed in RATE_SEEDS])
