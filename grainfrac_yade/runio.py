@@ -166,26 +166,37 @@ def checkpoint_differences(folder, params, run_values: dict) -> list | None:
     equal the given ones). A key missing from an older params.json counts as the shipped default,
     as in :func:`stored_run_differences`.
     """
-    from .params import load_parameters
     state = read_checkpoint_state(folder)
     if state is None:
         return None
     try:
-        stored = comparable_parameters(json.loads((Path(folder) / "params.json").read_text()))
+        stored = json.loads((Path(folder) / "params.json").read_text())
     except (OSError, ValueError) as exc:
         return [f"stored parameters unreadable ({type(exc).__name__}: {exc})"]
+    pairs = _parameter_pairs(stored, params)
+    stored_values = flatten_values(state.get("run_values", {}))
+    pairs.update({key: (stored_values.get(key, MISSING), value) for key, value in flatten_values(run_values).items()})
+    return _differences(pairs)
+
+
+#: What a comparison shows for a key one side does not have.
+MISSING = "(missing)"
+
+
+def _parameter_pairs(stored_tree: dict, params) -> dict:
+    """{dotted key: (stored value, value of ``params``)} over both parameter trees; a key missing
+    from an older stored tree counts as the shipped default, as the analysis reads it."""
+    from .params import load_parameters
+    stored = comparable_parameters(stored_tree)
     now = comparable_parameters(params.to_dict())
     defaults = comparable_parameters(load_parameters().to_dict())
-    missing = "(missing)"
-    pairs = {key: (stored.get(key, defaults.get(key, missing)), now.get(key, missing))
-             for key in sorted(set(stored) | set(now))}
-    diffs = [f"{key}: stored {old!r}, now {new!r}" for key, (old, new) in pairs.items() if not _same(old, new)]
-    stored_values = state.get("run_values", {})
-    for key, value in flatten_values(run_values).items():
-        old = flatten_values(stored_values).get(key, missing)
-        if not _same(old, value):
-            diffs.append(f"{key}: stored {old!r}, now {value!r}")
-    return diffs
+    return {key: (stored.get(key, defaults.get(key, MISSING)), now.get(key, MISSING))
+            for key in sorted(set(stored) | set(now))}
+
+
+def _differences(pairs: dict) -> list:
+    """"key: stored X, now Y" for each pair of unequal values."""
+    return [f"{key}: stored {old!r}, now {new!r}" for key, (old, new) in pairs.items() if not _same(old, new)]
 
 
 def flatten_values(values: dict) -> dict:
@@ -216,21 +227,15 @@ def stored_run_differences(folder, params, run_values: dict) -> list:
     params.json counts as the shipped default, as the analysis reads it) and its summary.json's
     ``run_values`` keys (e.g. seed, stress_pa). Returns "key: stored X, now Y" strings, [] if equal.
     """
-    from .params import flatten, load_parameters
     folder = Path(folder)
     try:
-        stored = comparable_parameters(json.loads((folder / "params.json").read_text()))
+        stored = json.loads((folder / "params.json").read_text())
         summary = json.loads((folder / SUMMARY).read_text())
     except (OSError, ValueError) as exc:
         return [f"stored run unreadable ({type(exc).__name__}: {exc})"]
-    now = comparable_parameters(params.to_dict())
-    defaults = comparable_parameters(load_parameters().to_dict())
-    missing = "(missing)"
-    pairs = {key: (stored.get(key, defaults.get(key, missing)), now.get(key, missing))
-             for key in sorted(set(stored) | set(now))}
-    pairs.update({key: (summary.get(key, missing), value)
-                  for key, value in flatten(json.loads(json.dumps(_clean(run_values)))).items()})
-    return [f"{key}: stored {old!r}, now {new!r}" for key, (old, new) in pairs.items() if not _same(old, new)]
+    pairs = _parameter_pairs(stored, params)
+    pairs.update({key: (summary.get(key, MISSING), value) for key, value in flatten_values(run_values).items()})
+    return _differences(pairs)
 
 
 def run_digest(params, run_values: dict) -> str:
