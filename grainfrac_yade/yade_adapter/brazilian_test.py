@@ -35,7 +35,7 @@ import numpy as np
 from ..disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
 from .levers import Levers, apply_levers, new_breaks
-from .scene import SHEAR, TENSION, build_scene, check_value
+from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
 #: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
 JAW_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -116,11 +116,7 @@ class DiscJaws:
 def crack_counts(scene) -> dict:
     """Bonds broken during the test by mode and kind (:func:`.scene.broken_counts` without the slits of
     :mod:`.levers`, which are broken before loading)."""
-    b, inter = new_breaks(scene), scene.bond_is_inter
-    return {"broken_total": int(b.sum()),
-            "broken_tensile": int((b & (scene.break_mode == TENSION)).sum()),
-            "broken_shear": int((b & (scene.break_mode == SHEAR)).sum()),
-            "broken_inter": int((b & inter).sum()), "broken_intra": int((b & ~inter).sum())}
+    return broken_counts(scene, new_breaks(scene))
 
 
 def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
@@ -170,8 +166,7 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
             if progress and len(cols["dem_step"]) % 50 == 0:
                 progress(f"strain {strain:.6f}  sigma {row['tensile_stress_pa'] / 1e6:6.2f} MPa  "
                          f"broken {row['broken_total']}")
-            # a drop without a break since the peak is elastic ringing (as in the UCS test), not the split
-            if peak > 0 and load < bz.stop_load_ratio * peak and row["broken_total"] > broken_at_peak:
+            if softened_past_peak(load, peak, row["broken_total"], broken_at_peak, bz.stop_load_ratio):
                 peak_reached = True
                 end = f"post-peak: the load fell below {bz.stop_load_ratio:g} x its peak"
                 break

@@ -281,13 +281,23 @@ def check_value(name, value, dem_step):
         raise NumericalFailure(f"{name} is {value} at DEM step {dem_step}")
 
 
-def broken_counts(scene) -> dict:
-    """Broken bonds by mode (tensile, shear) and kind (inter-, intra-granular)."""
-    b, inter = scene.broken, scene.bond_is_inter
+def broken_counts(scene, broken=None) -> dict:
+    """Broken bonds by mode (tensile, shear) and kind (inter-, intra-granular); ``broken``: a mask of
+    the bonds to count (default: every broken bond; a mode is set only on broken bonds)."""
+    b = scene.broken if broken is None else broken
+    inter = scene.bond_is_inter
     return {"broken_total": int(b.sum()),
-            "broken_tensile": int((scene.break_mode == TENSION).sum()),
-            "broken_shear": int((scene.break_mode == SHEAR).sum()),
+            "broken_tensile": int((b & (scene.break_mode == TENSION)).sum()),
+            "broken_shear": int((b & (scene.break_mode == SHEAR)).sum()),
             "broken_inter": int((b & inter).sum()), "broken_intra": int((b & ~inter).sum())}
+
+
+def softened_past_peak(value, peak, broken_now, broken_at_peak, stop_ratio) -> bool:
+    """True once a strain-controlled test's measured ``value`` has fallen below ``stop_ratio`` x its
+    ``peak`` with bonds broken since the peak.  This model softens only as bonds break: a drop with
+    no break since the peak is the elastic ringing of a specimen set in motion from rest (measured on
+    a one-cell-wide column: 3.4 MPa, then below 2.4 MPa, no bond broken), not a post-peak branch."""
+    return peak > 0 and value < stop_ratio * peak and broken_now > broken_at_peak
 
 
 def bond_segments(scene, indices) -> np.ndarray:

@@ -12,7 +12,7 @@ import time
 
 from ..errors import NumericalFailure
 from .platens import Platens
-from .scene import broken_counts, build_scene, check_value
+from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
 
 def run_ucs(specimen, params, progress=None, scene=None):
@@ -50,9 +50,7 @@ def run_ucs(specimen, params, progress=None, scene=None):
                 peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
             if progress and len(cols["dem_step"]) % 50 == 0:
                 progress(f"strain {strain:.5f}  stress {stress / 1e6:7.1f} MPa  broken {row['broken_total']}")
-            # the stress of this model softens only as bonds break: a drop with no break since the peak is
-            # the elastic ringing of a specimen set in motion from rest, not a post-peak branch
-            if peak > 0 and stress < ucs.stop_stress_ratio * peak and row["broken_total"] > broken_at_peak:
+            if softened_past_peak(stress, peak, row["broken_total"], broken_at_peak, ucs.stop_stress_ratio):
                 peak_reached = True
                 end = f"post-peak: the axial stress fell below {ucs.stop_stress_ratio:g} x its peak"
                 break
