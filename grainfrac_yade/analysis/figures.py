@@ -356,6 +356,23 @@ def run_stress_strain_figure(history, summary, path):
     plt.close(fig)
 
 
+def run_brazilian_load_figure(history, summary, path):
+    """Brazilian stress 2P/(pi D t) against diametral and horizontal strain."""
+    s = np.asarray(history["tensile_stress_pa"]) / 1e6
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(np.asarray(history["diametral_strain"]) * 100, s, label="diametral strain (jaw closure / D)")
+    ax.plot(np.asarray(history["horizontal_strain"]) * 100, s, label="horizontal strain (widening negative)")
+    ax.set_xlabel("strain [%] (compression positive)")
+    ax.set_ylabel("2 P / (pi D t) [MPa]")
+    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
+                 f"sigma_t {summary['tensile_strength_pa'] / 1e6:.1f} MPa, D {summary['diameter_m'] * 1e3:g} mm, "
+                 f"seed {summary['seed']}")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
 def _measure(value, unit=1e6, digits=1) -> str:
     """``value / unit`` with ``digits`` decimals; "-" if not measured (None or NaN)."""
     return "-" if value is None or not np.isfinite(value) else f"{value / unit:.{digits}f}"

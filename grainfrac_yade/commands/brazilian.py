@@ -122,6 +122,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none)."""
     from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
+    from ..analysis.figures import run_brazilian_load_figure
     from ..disc import build_disc_specimen
     from ..runio import prepare_run_dir, summary_header, write_csv, write_json
     from ..yade_adapter.brazilian_test import run_brazilian
@@ -153,7 +154,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
                    thickness_m=specimen.thickness)
     write_csv(out / "history.csv", history)
     write_disc_cracks(out / "cracks.csv", scene)
-    load_figure(history, summary, out / "load_strain.png")
+    run_brazilian_load_figure(history, summary, out / "load_strain.png")
     draw_crack_maps(scene, summary, broken_peak, mode_peak, out)
     write_json(out / "summary.json", summary)   # last: marks the run finished
     return summary
@@ -208,24 +209,6 @@ def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     crack_map(specimen, out / "crack_map_end.png", bond_segments(scene, idx), scene.break_mode[idx],
               title=f"cracks at the end, seed {seed}: {frac if frac is None else round(frac, 2)} in the band "
                     "|x - x_c| <= D/6", guides=guides)
-
-
-def load_figure(history, summary, path):
-    """Brazilian stress 2P/(pi D t) against diametral and horizontal strain."""
-    from ..plotting import plt
-    s = np.asarray(history["tensile_stress_pa"]) / 1e6
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    ax.plot(np.asarray(history["diametral_strain"]) * 100, s, label="diametral strain (jaw closure / D)")
-    ax.plot(np.asarray(history["horizontal_strain"]) * 100, s, label="horizontal strain (widening negative)")
-    ax.set_xlabel("strain [%] (compression positive)")
-    ax.set_ylabel("2 P / (pi D t) [MPa]")
-    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
-                 f"sigma_t {summary['tensile_strength_pa'] / 1e6:.1f} MPa, D {summary['diameter_m'] * 1e3:g} mm, "
-                 f"seed {summary['seed']}")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
 
 
 def run_brazilian_in_yade():
