@@ -208,6 +208,13 @@ class BrazilianParams:
 
 
 @dataclass(frozen=True, kw_only=True)
+class ConfinementParams:
+    """Confined (biaxial) loading: a constant confining stress on the side walls of the plane specimen,
+    sigma_3, for the compression and creep tests; 0 is uniaxial loading (paper section 3.1)."""
+    stress: float = _spec("Pa", "nonnegative", "confining stress sigma_3 held on the side walls; 0 = uniaxial")
+
+
+@dataclass(frozen=True, kw_only=True)
 class CalibrationParams:
     """Scale factors that map the paper's UDEC values (Tables 1 and 2) onto this YADE packing.
 
@@ -231,6 +238,7 @@ class Parameters:
     ucs: UcsParams
     creep: CreepParams
     brazilian: BrazilianParams
+    confinement: ConfinementParams
     calibration: CalibrationParams
     sources: tuple = ()
 
@@ -270,6 +278,7 @@ SECTION_CLASSES = {
     "ucs": UcsParams,
     "creep": CreepParams,
     "brazilian": BrazilianParams,
+    "confinement": ConfinementParams,
     "calibration": CalibrationParams,
 }
 
@@ -576,7 +585,7 @@ def _is_new_pair_key(key: str) -> bool:
 #: parameter tree without one (the params.json of an older run, read back by ``creep --resume`` or the
 #: analysis) takes the shipped values, so that it still loads.  A parameter file never lacks them: files are
 #: merged over the shipped ones.
-LATER_PROTOCOL_SECTIONS = ("brazilian",)
+LATER_PROTOCOL_SECTIONS = ("brazilian", "confinement")
 
 
 def _shipped_section(section: str):

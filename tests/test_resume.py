@@ -43,10 +43,11 @@ def _state(folder):
     return read_checkpoint_state(folder)
 
 
-def _start_and_kill(spec, out, ready, timeout=120):
-    """Start a creep run with a checkpoint at every safe point; SIGKILL it once ``ready(state)``."""
+def _start_and_kill(spec, out, ready, timeout=120, extra=()):
+    """Start a creep run (CLI options ``extra`` added) with a checkpoint at every safe point; SIGKILL it
+    once ``ready(state)``."""
     proc = subprocess.Popen([sys.executable, "-m", "grainfrac_yade", "creep",
-                             *map(str, _creep_args(spec, out, "--set", EVERY_SAFE_POINT))],
+                             *map(str, _creep_args(spec, out, *extra, "--set", EVERY_SAFE_POINT))],
                             cwd=ROOT, env=dict(os.environ, OMP_NUM_THREADS="1"),
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     t0 = time.time()

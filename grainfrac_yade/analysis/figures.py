@@ -347,13 +347,37 @@ def run_stress_strain_figure(history, summary, path):
             ax.text(ax.get_xlim()[0], summary[key] / 1e6, f" {label}", va="bottom", fontsize=7)
     ax.set_xlabel("strain [%] (compression positive)")
     ax.set_ylabel("axial stress [MPa]")
+    confining = summary.get("confining_stress_pa") or 0.0
+    strength = (f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa" if not confining else
+                f"peak {summary['ucs_pa'] / 1e6:.1f} MPa at sigma_3 = {confining / 1e6:g} MPa")
     ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
-                 f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {_measure(summary['young_pa'], 1e9)} GPa, "
-                 f"nu {_measure(summary['poisson'], 1, 2)}")
+                 f"{strength}, E {_measure(summary['young_pa'], 1e9)} GPa, nu {_measure(summary['poisson'], 1, 2)}")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
+
+
+def envelope_figure(path, sigma3, sigma1, mohr_coulomb, hoek_brown, lab_ucs=None, title: str = ""):
+    """Peak axial stress against confining stress: every test, the Mohr-Coulomb line and the
+    Hoek-Brown curve (:mod:`.envelope`), and the lab UCS at sigma_3 = 0 (a LabProperty) if given."""
+    s3, s1 = np.asarray(sigma3, float) / 1e6, np.asarray(sigma1, float) / 1e6
+    x = np.linspace(0.0, s3.max() * 1.1, 100)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(s3, s1, "o", ms=4, color="k", alpha=0.7, label="model: peak of each test")
+    ax.plot(x, mohr_coulomb.peak(x * 1e6) / 1e6, "-", label=(
+        f"Mohr-Coulomb: phi {mohr_coulomb.friction_angle_deg:.1f} deg, c {mohr_coulomb.cohesion / 1e6:.1f} MPa"))
+    if hoek_brown is not None:
+        ax.plot(x, hoek_brown.peak(x * 1e6) / 1e6, "--", label=(
+            f"Hoek-Brown: sigma_ci {hoek_brown.sigma_ci / 1e6:.0f} MPa, m_i {hoek_brown.m_i:.1f}"))
+    if lab_ucs is not None:
+        ax.errorbar([0.0], [lab_ucs.value / 1e6], yerr=[lab_ucs.spread / 1e6], fmt="s", color="tab:red", capsize=3,
+                    label=textwrap.shorten(f"lab UCS ({lab_ucs.source})", 60))
+    ax.set_xlabel("confining stress sigma_3 [MPa]")
+    ax.set_ylabel("peak axial stress sigma_1 [MPa]")
+    ax.legend(fontsize=7)
+    _title(ax, title or "peak strength envelope")
+    _save(fig, path)
 
 
 def run_brazilian_load_figure(history, summary, path):

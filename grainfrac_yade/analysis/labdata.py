@@ -23,6 +23,7 @@ from .fits import check_lifetimes
 #: clone finds them; ``--reference DIR`` reads another folder.
 DEFAULT_REFERENCE_DIR = Path(__file__).resolve().parents[2] / "params" / "reference"
 PAPER_VALUES = "paper_values.csv"
+LAB_PROPERTIES = "ldb_lab_properties.csv"
 LAB_README = "lab_lifetimes_README.md"
 #: Lajtai & Schmidtke (1986) via lab_lifetimes_README.md: long-term strength of humid LdB granite
 #: lies below 60 % of its short-term (dry) UCS, i.e. below driving-stress ratio 0.6.
@@ -112,3 +113,27 @@ def paper_reference(reference_dir=None) -> PaperReference:
                           lab_specimens=values.get("lab_creep_specimens", (np.nan, ""))[0],
                           long_term_strength_ratio=LONG_TERM_STRENGTH_RATIO, values_file=values_file,
                           readme_file=folder / LAB_README, beta1_pa_s=values.get("beta1", (np.nan, ""))[0])
+
+
+@dataclass(frozen=True)
+class LabProperty:
+    """One row of ``ldb_lab_properties.csv``: value and spread in SI units, with its source."""
+    name: str
+    value: float
+    spread: float       # NaN if the file gives none
+    source: str
+
+
+def lab_property(name: str, reference_dir=None) -> LabProperty:
+    """The lab property ``name`` (e.g. "uniaxial_compressive_strength") of ``ldb_lab_properties.csv``."""
+    path = Path(reference_dir or DEFAULT_REFERENCE_DIR) / LAB_PROPERTIES
+    if not path.is_file():
+        raise GrainfracError(f"{path}: lab property file not found; fix: copy {LAB_PROPERTIES} from "
+                             "../shared/reference into that folder")
+    frame = pd.read_csv(path)
+    row = frame[frame["property"] == name]
+    if row.empty:
+        raise GrainfracError(f"{path}: no property '{name}'; fix: one of {', '.join(frame['property'])}")
+    r = row.iloc[0]
+    return LabProperty(name, float(r["value"]), float(r["spread"]) if pd.notna(r["spread"]) else float("nan"),
+                       str(r["source"]))

@@ -1,11 +1,15 @@
-"""``analyze-ucs``: table and figure of UCS tests in a study folder (resolution, size, calibration)."""
+"""``analyze-ucs``: table and figure of UCS tests in a study folder (resolution, size, calibration), and
+the peak-strength envelope of confined tests (Mohr-Coulomb and Hoek-Brown fits) where a model variant
+was tested at two confining stresses or more."""
 from __future__ import annotations
 
 from pathlib import Path
 
 #: Columns that define a model variant in a UCS study.
 VARIANT = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height",
-           "resolution.grain_model", "resolution.nodes_per_face")
+           "resolution.grain_model", "resolution.nodes_per_face", "confinement.stress")
+#: The confining stress column: the envelope's abscissa.
+CONFINEMENT = "confinement.stress"
 MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "dem_steps")
 
 
@@ -27,16 +31,17 @@ def cmd_analyze_ucs(args) -> int:
         raise GrainfracError(f"{folder}: no finished UCS runs (summary.json with ucs_pa); fix: run the study first")
     runs = runs[runs["command"] == "ucs"]
     runs, _ = fill_missing_params(runs)   # keys that older params.json lack: the shipped defaults
+    runs[CONFINEMENT] = runs[CONFINEMENT].fillna(0.0).astype(float)   # runs older than the key were uniaxial
     stats = group_stats(runs, VARIANT, MEASURES)
     runs.to_csv(folder / "ucs_runs.csv", index=False)
     stats.to_csv(folder / "ucs_stats.csv", index=False)
-    lines = ["| cells | spheres/cell | grain [mm] | specimen [mm] | n | UCS [MPa] | E [GPa] | Poisson | CI/UCS "
-             "| CD/UCS | DEM steps | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| cells | spheres/cell | grain [mm] | specimen [mm] | sigma_3 [MPa] | n | peak [MPa] | E [GPa] | Poisson "
+             "| CI/peak | CD/peak | DEM steps | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in stats.iterrows():
         lines.append(
             f"| {cells_label(r['resolution.grain_model'], r['resolution.nodes_per_face'])} "
             f"| {r[VARIANT[0]]:.0f} | {r[VARIANT[1]] * 1e3:.2f} "
-            f"| {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} "
+            f"| {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} | {r[CONFINEMENT] / 1e6:g} "
             f"| {r['ucs_pa_count']:.0f} | {r['ucs_pa_mean'] / 1e6:.1f} +- {r['ucs_pa_std'] / 1e6:.1f} "
             f"| {r['young_pa_mean'] / 1e9:.1f} +- {r['young_pa_std'] / 1e9:.1f} | {r['poisson_mean']:.3f} "
             f"| {r['crack_initiation_pa_mean'] / r['ucs_pa_mean']:.2f} "
@@ -47,9 +52,51 @@ def cmd_analyze_ucs(args) -> int:
         lines.append("")
         lines += [f"numerical failure (no result, not counted): {r['run']}: {r['end_reason']}"
                   for _, r in failed.iterrows()]
+    lines += envelopes(runs, folder)
     (folder / "ucs_stats.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0
+
+
+def envelopes(runs, folder) -> list:
+    """Mohr-Coulomb and Hoek-Brown fits of every model variant tested at two confining stresses or
+    more: envelope.csv (one row per variant), envelope_<k>.png; returns markdown lines."""
+    import pandas as pd
+
+    from ..analysis.envelope import fit_hoek_brown, fit_mohr_coulomb
+    from ..analysis.figures import envelope_figure
+    from ..analysis.labdata import lab_property
+    from ..errors import GrainfracError
+    done = runs[(runs["status"] == "finished") & runs["ucs_pa"].notna()]
+    others = [v for v in VARIANT if v != CONFINEMENT]
+    rows, lines = [], []
+    for key, group in done.groupby(others, dropna=False):
+        if group[CONFINEMENT].nunique() < 2:
+            continue
+        s3, s1 = group[CONFINEMENT].to_numpy(float), group["ucs_pa"].to_numpy(float)
+        mc = fit_mohr_coulomb(s3, s1, str(folder))
+        try:
+            hb, hb_note = fit_hoek_brown(s3, s1, str(folder)), ""
+        except GrainfracError as exc:
+            hb, hb_note = None, str(exc)
+        k = len(rows) + 1
+        label = (f"{cells_label(key[4], key[5])}, {key[0]:.0f} spheres/cell, {key[2] * 1e3:.1f} x {key[3] * 1e3:.1f} mm, "
+                 f"grain {key[1] * 1e3:.2f} mm")
+        rows.append({"variant": label, "n_tests": len(group), "sigma3_max_pa": s3.max(),
+                     "mc_unconfined_strength_pa": mc.unconfined_strength, "mc_passive_coefficient": mc.passive_coefficient,
+                     "mc_friction_angle_deg": mc.friction_angle_deg, "mc_cohesion_pa": mc.cohesion, "mc_r2": mc.line.r2,
+                     "hb_sigma_ci_pa": hb.sigma_ci if hb else None, "hb_m_i": hb.m_i if hb else None,
+                     "hb_r2": hb.r2 if hb else None, "figure": f"envelope_{k}.png"})
+        envelope_figure(folder / f"envelope_{k}.png", s3, s1, mc, hb, lab_property("uniaxial_compressive_strength"),
+                        title=f"peak strength envelope: {label}")
+        lines += ["", f"Envelope {k} ({label}; {len(group)} tests, sigma_3 0-{s3.max() / 1e6:g} MPa; envelope_{k}.png): "
+                  f"Mohr-Coulomb C_0 {mc.unconfined_strength / 1e6:.1f} MPa, q {mc.passive_coefficient:.2f}, "
+                  f"phi {mc.friction_angle_deg:.1f} deg, c {mc.cohesion / 1e6:.1f} MPa (R^2 {mc.line.r2:.3f}); "
+                  + (f"Hoek-Brown sigma_ci {hb.sigma_ci / 1e6:.1f} MPa, m_i {hb.m_i:.1f} (R^2 {hb.r2:.3f})" if hb
+                     else f"Hoek-Brown: no fit ({hb_note})")]
+    if rows:
+        pd.DataFrame(rows).to_csv(folder / "envelope.csv", index=False)
+    return lines
 
 
 def cells_label(grain_model, nodes_per_face) -> str:

@@ -18,6 +18,7 @@ def register(sub, common):
                                                   "calibration.reference_ucs, the calibrated mean UCS)")
     p.add_argument("--ucs", type=float, help="UCS [Pa] that --ratio refers to")
     p.add_argument("--clock", choices=("event", "paper"), help="stress_corrosion.clock")
+    add_confinement_option(p)
     p.add_argument("--vtk-times", type=_times, default=None, metavar="T1,T2,...",
                    help="write VTK files of cells and bonds (state, remaining strength) for ParaView at these "
                         "creep times [s] and at the end, into DIR/vtk/ (e.g. --vtk-times 0,1e7)")
@@ -29,7 +30,20 @@ def register(sub, common):
 
 
 def _clock_override(args) -> list:
-    return [f"stress_corrosion.clock={args.clock}"] if args.clock else []
+    return ([f"stress_corrosion.clock={args.clock}"] if args.clock else []) + confinement_override(args)
+
+
+def add_confinement_option(parser):
+    """``--confinement MPA``: the confining stress sigma_3 (sets confinement.stress)."""
+    parser.add_argument("--confinement", type=float, metavar="MPA",
+                        help="confining stress sigma_3 [MPa] held on the side walls (biaxial test; confinement.stress); "
+                             "default 0: uniaxial")
+
+
+def confinement_override(args) -> list:
+    """The override of ``--confinement MPA`` (none if not given)."""
+    value = getattr(args, "confinement", None)
+    return [] if value is None else [("confinement.stress", value * 1e6)]
 
 
 def outcome(summary: dict) -> str:
@@ -56,25 +70,41 @@ def _times(text: str) -> list:
 
 
 def resolve_stress(params, stress=None, ratio=None, ucs=None):
-    """(stress [Pa], ratio, ucs used [Pa]); the ratio refers to ``ucs`` or the calibrated mean UCS."""
-    ref = ucs if ucs is not None else params.calibration.reference_ucs
+    """(axial stress sigma_1 [Pa], ratio, strength used [Pa]).
+
+    Uniaxial: the ratio is sigma_1 / UCS, the UCS being ``ucs`` or the calibrated mean UCS.  Confined
+    (``confinement.stress`` sigma_3 > 0): the ratio is the deviatoric one, (sigma_1 - sigma_3) /
+    (sigma_peak - sigma_3), and ``ucs`` must be given: the peak axial stress sigma_peak of the
+    compression test at the same sigma_3 (``ucs --confinement``).
+    """
+    confining = params.confinement.stress
     if stress is None and ratio is None:
         raise GrainfracError("no creep load: give a stress [Pa] or a driving-stress ratio (CLI --stress/--ratio, "
                              "batch column stress/ratio); fix: e.g. ratio 0.7")
+    if confining > 0 and ucs is None:
+        raise GrainfracError(f"confinement.stress = {confining:.4g} Pa: the driving-stress ratio refers to the peak "
+                             "strength at this confinement; fix: give --ucs (batch column ucs), the peak axial stress "
+                             "of `ucs --confinement` at the same confining stress")
+    ref = ucs if ucs is not None else params.calibration.reference_ucs
+    if not ref > confining:
+        raise GrainfracError(f"--ucs {ref:.4g} Pa is not above the confining stress {confining:.4g} Pa; fix: give the "
+                             "peak axial stress at this confinement")
     if stress is None:
         if not (0 < ratio < 1):
             raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")
-        stress = ratio * ref
-    if not (math.isfinite(stress) and stress > 0):
-        raise GrainfracError(f"--stress {stress}: must be a positive finite stress in Pa; fix: e.g. --stress 160e6")
+        stress = confining + ratio * (ref - confining)
+    if not (math.isfinite(stress) and stress > confining):
+        raise GrainfracError(f"--stress {stress}: must be a finite stress in Pa above the confining stress "
+                             f"({confining:.4g} Pa); fix: e.g. --stress 160e6")
     if stress >= ref:
-        raise GrainfracError(f"--stress {stress:.4g} Pa is at or above the UCS it refers to ({ref:.4g} Pa): the "
-                             "specimen fails during the ramp; fix: give a stress below the UCS (or --ucs)")
-    return stress, stress / ref, ref
+        raise GrainfracError(f"--stress {stress:.4g} Pa is at or above the strength it refers to ({ref:.4g} Pa): the "
+                             "specimen fails during the ramp; fix: give a stress below it (or --ucs)")
+    return stress, (stress - confining) / (ref - confining), ref
 
 
 #: Options that shape a run: refused with --resume (the run folder holds them).
 RESUME_CONFLICTS = (("stress", "--stress"), ("ratio", "--ratio"), ("ucs", "--ucs"), ("clock", "--clock"),
+                    ("confinement", "--confinement"),
                     ("overrides", "--set"), ("params", "--params"), ("width", "--width"), ("height", "--height"),
                     ("grain_size", "--grain-size"), ("spheres_per_cell", "--spheres-per-cell"),
                     ("vtk_times", "--vtk-times"), ("out", "--out"), ("overwrite", "--overwrite"))
@@ -100,7 +130,8 @@ def cmd_creep(args, params) -> int:
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
     s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
                             vtk_times=args.vtk_times)
-    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
+    confined = f", confinement {params.confinement.stress / 1e6:g} MPa" if params.confinement.stress else ""
+    print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
     return 0
 
@@ -194,6 +225,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
+        "confining_stress_pa": params.confinement.stress, **getattr(run, "consolidation", {}),
         "clock": params.stress_corrosion.clock, "law": params.stress_corrosion.law,
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),

@@ -3,11 +3,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from .creep import add_confinement_option, confinement_override
+
 
 def register(sub, common):
     p = sub.add_parser("ucs", help="strain-controlled uniaxial compression test")
     common(p)
-    p.set_defaults(func=cmd_ucs, with_params=True)
+    add_confinement_option(p)
+    p.set_defaults(func=cmd_ucs, with_params=True, param_overrides=confinement_override)
 
 
 def cmd_ucs(args, params) -> int:
@@ -18,7 +21,9 @@ def cmd_ucs(args, params) -> int:
     if summary["numerical_failure"]:
         print(f"UCS: no result ({summary['end_reason']}) -> {out}")
         return 0
-    print(f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
+    confined = summary["confining_stress_pa"]
+    label = f"peak axial stress at confinement {confined / 1e6:g} MPa:" if confined else "UCS"
+    print(f"{label} {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
           f"nu {_fmt(summary['poisson'], 1, 3)}, CI {_fmt(summary['crack_initiation_pa'])} MPa, "
           f"CD {_fmt(summary['crack_damage_pa'])} MPa, broken {summary['broken_total']} of {summary['n_bonds']} "
           f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")

@@ -235,6 +235,8 @@ def restore(run, where, state: dict, arrays: dict):
                              "run again with --overwrite")
     O.load(str(where / SCENE_FILE))
     rebind_scene(sc)
+    if run.confinement is not None:
+        run.confinement.apply()   # permanent forces are not saved with the scene
     p = state["platens"]
     pl.rebind(p["reaction_pa"])
     pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]

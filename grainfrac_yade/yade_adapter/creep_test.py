@@ -1,5 +1,7 @@
 """Constant-load creep test to failure with stress corrosion (paper section 4.1).
 
+0. Confined tests (``confinement.stress`` sigma_3 > 0): side-wall forces, then the isotropic
+   stage to sigma_1 = sigma_3 at equilibrium (:mod:`.confinement`).
 1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
    stress reaches the target; bonds broken during the ramp are counted apart.
 2. Hold: a servo keeps the axial stress at the target (:class:`StressServo`).
@@ -34,11 +36,12 @@ import numpy as np
 
 from ..clocks import EventClock, PaperClock
 from ..errors import NumericalFailure
-from ..law import check_finite, creep_step, shear_strength
+from ..law import creep_step, shear_strength
 from ..params import unbalanced_threshold
+from .confinement import Confinement, consolidate, young_estimate
 from .corrosion_engine import ContactStiffnessRestorer, StressCorrosion
-from .platens import Platens, StressServo
-from .scene import broken_counts, build_scene, check_value
+from .platens import Platens, StressServo, free_bodies
+from .scene import broken_counts, build_scene, check_value, mean_bond_force, resultant_forces
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
 #: is per metre of thickness; it is scaled by the layer thickness here.
@@ -78,8 +81,14 @@ class CreepRun:
         self.scene = build_scene(specimen, params)
         self.platens = Platens(self.scene, params.ucs.platen_lateral)
         self.scene.extras.append(self.platens)
-        self.free = np.setdiff1d(np.arange(specimen.n_cells), np.union1d(self.platens.top, self.platens.bottom))
-        self._free_ids = [int(b) for b in self.scene.bodies_of(self.free)]
+        #: side-wall forces of a confined test (``confinement.stress`` > 0), else None
+        self.confinement = None
+        #: the isotropic stage of a confined test (:func:`.confinement.consolidate`): steps, equilibrium
+        self.consolidation = {}
+        if params.confinement.stress > 0:
+            self.confinement = Confinement(self.scene, params.confinement.stress)
+            self.scene.extras.append(self.confinement)
+        self._free_ids = free_bodies(self.scene, self.platens)
         self.rows, self.ramp_broken = [], 0
         self.failed, self.failure_reason = False, ""
         self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
@@ -105,18 +114,13 @@ class CreepRun:
     def unbalanced(self, mean_bond_force):
         """Largest resultant force on a free body [N], and mean / mean_bond_force (bodies: cells, or the
         spheres of deformable cells)."""
-        f = self.scene.O.forces.f
-        res = np.array([f(b).norm() for b in self._free_ids])
-        check_finite("resultant force", res, self._free_ids, item="body")
-        rel = res.mean() / mean_bond_force if mean_bond_force > 0 else math.inf
-        return res.max(), rel
+        largest, mean = resultant_forces(self.scene, self._free_ids)
+        rel = mean / mean_bond_force if mean_bond_force > 0 else math.inf
+        return largest, rel
 
     def mean_bond_force(self):
         idx = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
-        sample = idx[:: max(1, len(idx) // 500)]
-        fn, fs = self.scene.bond_forces(sample)
-        check_finite("bond force", np.hypot(fn, fs), sample)
-        return float(np.mean(np.hypot(fn, fs))) if len(sample) else 0.0
+        return mean_bond_force(self.scene, idx)
 
     def at_equilibrium(self, servo):
         _, rel = self.unbalanced(self.mean_bond_force())
@@ -276,6 +280,9 @@ class CreepRun:
     def _run(self):
         phase, loop = self.resumed or (None, None)
         if phase is None:
+            if self.confinement is not None:
+                self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params.creep,
+                                                 young_estimate(self.params))
             self.ramp()
             self.record(0.0)
             self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp

@@ -109,6 +109,12 @@ class Platens:
         return 0.5 * (top - bottom) / self.cross_section
 
 
+def free_bodies(scene, platens) -> list:
+    """Body ids of the cells that are not platen cells (their resultant forces measure balance)."""
+    free = np.setdiff1d(np.arange(scene.specimen.n_cells), np.union1d(platens.top, platens.bottom))
+    return [int(b) for b in scene.bodies_of(free)]
+
+
 class StressServo:
     """Holds the axial stress at a target by moving the platens (a driver, called before each step).
 

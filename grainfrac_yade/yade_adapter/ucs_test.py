@@ -1,4 +1,7 @@
-"""Strain-controlled uniaxial compression between rigid platens (the UCS of paper section 3.1).
+"""Strain-controlled uniaxial compression between rigid platens (the UCS of paper section 3.1), or
+confined (biaxial) compression with ``confinement.stress`` sigma_3 > 0 on the side walls
+(:mod:`.confinement`: isotropic stage to sigma_1 = sigma_3 first, then the same axial loading; the
+post-peak stop rule then applies to the deviator sigma_1 - sigma_3).
 
 The test ends once the axial stress falls below ``ucs.stop_stress_ratio`` of its peak with bonds
 broken since the peak (post-peak; a drop without a break is elastic ringing, e.g. of a one-cell-wide
@@ -11,6 +14,7 @@ from __future__ import annotations
 import time
 
 from ..errors import NumericalFailure
+from .confinement import Confinement, consolidate, young_estimate
 from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
@@ -34,7 +38,13 @@ def run_ucs(specimen, params, progress=None, scene=None):
                             "broken_total", "broken_tensile", "broken_shear", "broken_inter", "broken_intra")}
     peak, broken_at_peak, peak_snapshot = 0.0, 0, (scene.broken.copy(), scene.break_mode.copy())
     numerical, peak_reached = False, False
+    confining = params.confinement.stress
+    consolidation = {}
     try:
+        if confining > 0:
+            scene.extras.append(Confinement(scene, confining))
+            consolidation = consolidate(scene, platens, confining, params.creep, young_estimate(params))
+            platens.set_axial_velocity(closing_speed)
         while True:
             scene.run(steps_per_row)
             stress = platens.axial_stress()
@@ -50,9 +60,11 @@ def run_ucs(specimen, params, progress=None, scene=None):
                 peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
             if progress and len(cols["dem_step"]) % 50 == 0:
                 progress(f"strain {strain:.5f}  stress {stress / 1e6:7.1f} MPa  broken {row['broken_total']}")
-            if softened_past_peak(stress, peak, row["broken_total"], broken_at_peak, ucs.stop_stress_ratio):
+            if softened_past_peak(stress - confining, peak - confining, row["broken_total"], broken_at_peak,
+                                  ucs.stop_stress_ratio):
                 peak_reached = True
-                end = f"post-peak: the axial stress fell below {ucs.stop_stress_ratio:g} x its peak"
+                end = (f"post-peak: the axial stress fell below {ucs.stop_stress_ratio:g} x its peak" if confining == 0
+                       else f"post-peak: the deviator fell below {ucs.stop_stress_ratio:g} x its peak")
                 break
             if strain >= ucs.max_strain:
                 end = (f"axial strain reached ucs.max_strain = {ucs.max_strain:g} before the stress fell below "
@@ -64,5 +76,5 @@ def run_ucs(specimen, params, progress=None, scene=None):
             progress(end)
     result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "dem_timestep_s": dt,
               "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
-              "peak_reached": peak_reached, "end_reason": end}
+              "peak_reached": peak_reached, "end_reason": end, "confining_stress_pa": confining, **consolidation}
     return cols, result, scene, peak_snapshot
