@@ -80,7 +80,7 @@ def envelopes(runs, folder) -> list:
         except GrainfracError as exc:
             hb, hb_note = None, str(exc)
         k = len(rows) + 1
-        label = (f"{cells_label(key[4], key[5])}, {key[0]:.0f} spheres/cell, {key[2] * 1e3:.1f} x {key[3] * 1e3:.1f} mm, "
+        label = (f"{cells_label(key[4], key[5])} cells, spheres per cell {key[0]:.0f}, {key[2] * 1e3:.1f} x {key[3] * 1e3:.1f} mm, "
                  f"grain {key[1] * 1e3:.2f} mm")
         rows.append({"variant": label, "n_tests": len(group), "sigma3_max_pa": s3.max(),
                      "mc_unconfined_strength_pa": mc.unconfined_strength, "mc_passive_coefficient": mc.passive_coefficient,
