@@ -106,3 +106,26 @@ def representatives(runs: pd.DataFrame) -> pd.DataFrame:
         survived = g[g["outcome"] == "not failed"].sort_values("creep_time_end_s")
         keep.append(survived.index[-1] if len(survived) else g.sort_values("seed").index[0])
     return runs.loc[keep].sort_values(["variant", "ratio"])
+
+
+#: Columns of the lifetime-against-confinement table.
+CONFINEMENT_COLUMNS = ("law", "ratio", "confining_stress_mpa", "n", "n_failed", "lifetime_geomean_s",
+                       "lifetime_min_s", "lifetime_max_s")
+
+
+def confinement_lifetimes(runs: pd.DataFrame) -> pd.DataFrame:
+    """Creep lifetimes per degradation law, driving-stress ratio and confining stress sigma_3: runs
+    (``outcome`` failed, failed at load or not failed), failed ones, and the geometric mean, minimum
+    and maximum of the failed runs' lifetimes (a lifetime of 0, failed at load, gives a mean of 0)."""
+    usable = runs[runs["outcome"].isin(["failed", "not failed", "failed at load"]) & runs["ratio"].notna()].copy()
+    usable["confining_stress_mpa"] = pd.to_numeric(usable.get("confinement.stress", 0.0), errors="coerce").fillna(0.0) / 1e6
+    usable["law"] = usable.get("stress_corrosion.law", "hillig_charles")
+    usable["law"] = usable["law"].fillna("hillig_charles")
+    rows = []
+    for (law, ratio, s3), g in usable.groupby(["law", "ratio", "confining_stress_mpa"]):
+        failed = g[g["outcome"].isin(["failed", "failed at load"])]
+        t = pd.to_numeric(failed["lifetime_s"], errors="coerce").to_numpy(float)
+        geo = float(np.exp(np.mean(np.log(t)))) if len(t) and np.all(t > 0) else (0.0 if len(t) else np.nan)
+        rows.append((law, ratio, s3, len(g), len(failed), geo, t.min() if len(t) else np.nan,
+                     t.max() if len(t) else np.nan))
+    return pd.DataFrame(rows, columns=CONFINEMENT_COLUMNS)

@@ -61,6 +61,11 @@ RUN_COLUMNS = {
     "wall_s": ("wall [s]", ".0f"), "problem": ("problem", ""),
 }
 
+CONFINEMENT_TABLE = {
+    "law": ("law", ""), "ratio": ("ratio", ".3f"), "confining_stress_mpa": ("sigma_3 [MPa]", "g"), "n": ("n", "d"),
+    "n_failed": ("failed", "d"), "lifetime_geomean_s": ("geometric mean lifetime [s]", ".3g"),
+    "lifetime_min_s": ("min [s]", ".3g"), "lifetime_max_s": ("max [s]", ".3g"),
+}
 STATS_COLUMNS = {
     "dataset": ("data set", ""), "driving_stress_ratio": ("ratio", ".4f"), "n": ("n", "d"),
     "geomean_lifetime_s": ("geometric mean lifetime [s]", ".4g"),
