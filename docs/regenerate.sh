@@ -27,6 +27,7 @@ declare -A WHAT=(
   [lifetime_ldb]="README 'Lifetime studies' paper size, 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
   [creep_numerics]="README 'creep numerics' (params/creep_numerics_small.table): about 1 h"
   [brazilian]="README 'Brazilian test' (params/brazilian_ldb.table, docs/brazilian_study.sh)"
+  [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
 run_target() {
@@ -57,6 +58,12 @@ run_target() {
     creep_numerics) batch params/creep_numerics_small.table creep.py creep_numerics ;;
     brazilian) if [ -f docs/brazilian_study.sh ]; then bash docs/brazilian_study.sh
                else batch params/brazilian_ldb.table brazilian.py brazilian_ldb; fi ;;
+    confined) batch params/confined_ucs_small.table ucs.py confined_ucs
+              $PY -m grainfrac_yade analyze-ucs results/confined_ucs
+              batch params/confined_creep_small.table creep.py confined_creep
+              batch params/confined_creep_normalised_small.table creep.py confined_creep_normalised
+              $PY -m grainfrac_yade analyze results/confined_creep results/confined_creep_normalised \
+                  --out results/confined_creep_both ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
   esac
 }
@@ -67,7 +74,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
 fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration resolution fem_ucs fem_creep lattice lifetime_small
-                           lifetime_ldb creep_numerics brazilian)
+                           lifetime_ldb creep_numerics brazilian confined)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
