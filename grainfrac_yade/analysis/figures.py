@@ -348,10 +348,12 @@ def run_stress_strain_figure(history, summary, path):
     ax.set_xlabel("strain [%] (compression positive)")
     ax.set_ylabel("axial stress [MPa]")
     confining = summary.get("confining_stress_pa") or 0.0
-    strength = (f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa" if not confining else
-                f"peak {summary['ucs_pa'] / 1e6:.1f} MPa at sigma_3 = {confining / 1e6:g} MPa")
-    ax.set_title("numerical failure: no result" if summary["numerical_failure"] else
-                 f"{strength}, E {_measure(summary['young_pa'], 1e9)} GPa, nu {_measure(summary['poisson'], 1, 2)}")
+    if summary["numerical_failure"]:
+        ax.set_title("numerical failure: no result")
+    else:
+        strength = (f"UCS {summary['ucs_pa'] / 1e6:.1f} MPa" if not confining else
+                    f"peak {summary['ucs_pa'] / 1e6:.1f} MPa at sigma_3 = {confining / 1e6:g} MPa")
+        ax.set_title(f"{strength}, E {_measure(summary['young_pa'], 1e9)} GPa, nu {_measure(summary['poisson'], 1, 2)}")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=150)

@@ -97,7 +97,8 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None):
         raise GrainfracError(f"--stress {stress}: must be a finite stress in Pa above the confining stress "
                              f"({confining:.4g} Pa); fix: e.g. --stress 160e6")
     if stress >= ref:
-        raise GrainfracError(f"--stress {stress:.4g} Pa is at or above the strength it refers to ({ref:.4g} Pa): the "
+        strength = "the UCS" if confining == 0 else "the peak strength at this confinement"
+        raise GrainfracError(f"--stress {stress:.4g} Pa is at or above {strength} it refers to ({ref:.4g} Pa): the "
                              "specimen fails during the ramp; fix: give a stress below it (or --ucs)")
     return stress, (stress - confining) / (ref - confining), ref
 
