@@ -184,6 +184,13 @@ class CreepParams:
     check_period: int = _spec("1", "positive_int", "DEM steps between equilibrium checks")
     max_relaxation_steps: int = _spec("1", "positive_int",
                                       "no equilibrium at the held load within this many steps = failure")
+    collapse_strain_increment: float = _spec("1", "nonnegative",
+                                             "collapse = failure: the servo closes the platens at its speed limit "
+                                             "on every DEM step while the axial strain grows by more than this; "
+                                             "0 = criterion off")
+    collapse_stress_ratio: float = _spec("1", "unit_interval",
+                                         "collapse also needs the held stress below this fraction of the target "
+                                         "(a cascade the specimen arrests keeps it higher); 1 = saturation alone")
     failure_strain: float = _spec("1", "positive", "axial strain at which a run counts as failed (safety cap)")
     record_period: int = _spec("1", "positive_int", "paper clock: law applications between history rows")
     checkpoint_interval: float = _spec("s", "nonnegative",

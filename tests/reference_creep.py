@@ -30,8 +30,14 @@ SUMMARY_KEYS = ("lifetime_s", "failed", "failure_reason", "n_events", "broken_ra
 WALL = ["wall_s"]
 
 
-def run(name, out):
-    """Run reference ``name`` into folder ``out``; (summary dict, history frame, cracks frame)."""
+#: The stored runs ended by the failure "no equilibrium within creep.max_relaxation_steps" (the
+#: collapse criterion came later): they are rerun with it off, and compared with it on apart.
+WITHOUT_COLLAPSE = ["creep.collapse_strain_increment=0"]
+
+
+def run(name, out, extra=WITHOUT_COLLAPSE):
+    """Run reference ``name`` into folder ``out`` (``extra``: overrides after the reference's own);
+    (summary dict, history frame, cracks frame)."""
     import json
 
     import pandas as pd
@@ -39,9 +45,10 @@ def run(name, out):
     sys.path.insert(0, str(ROOT))
     from grainfrac_yade.commands.creep import run_creep_to_folder
     from grainfrac_yade.params import load_parameters
-    seed, width, height, ratio, extra = RUNS[name]
+    seed, width, height, ratio, _ = RUNS[name]
     p = load_parameters(overrides=[("specimen.width", width), ("specimen.height", height),
-                                   "stress_corrosion.creep_time_limit=1e30", "creep.checkpoint_interval=0", *extra])
+                                   "stress_corrosion.creep_time_limit=1e30", "creep.checkpoint_interval=0",
+                                   *RUNS[name][4], *extra])
     run_creep_to_folder(p, seed, out, ratio * UCS, ratio, UCS, overwrite=True)
     out = Path(out)
     summary = json.loads((out / "summary.json").read_text())

@@ -12,10 +12,13 @@
    the threshold, applied every ``engine_period`` DEM steps).  This module reads
    forces and writes strengths (:mod:`.corrosion_engine`); the law is not here.
 
-Failure: the platens cannot hold the load at equilibrium -- no equilibrium at the
-held stress within ``creep.max_relaxation_steps`` DEM steps (the strain runs
-away) -- or the axial strain exceeds ``creep.failure_strain``.  Lifetime is the
-creep time at failure.  Creep time is separate from DEM time.
+Failure: the platens cannot hold the load.  Collapse (:class:`CollapseWatch`): the
+servo closes the platens at its speed limit on every DEM step while the axial strain
+grows by more than ``creep.collapse_strain_increment`` (the specimen carries less
+than the load however far it is squeezed; 0 = criterion off).  Backstop: no
+equilibrium at the held stress within ``creep.max_relaxation_steps`` DEM steps (the
+strain runs away).  Safety cap: the axial strain exceeds ``creep.failure_strain``.
+Lifetime is the creep time at failure.  Creep time is separate from DEM time.
 
 Numerical failure: NaN or infinite forces, stresses or strains (the DEM blew
 up), or ``MAX_STALLED_INTERVALS`` creep intervals of length 0 in a row that
@@ -62,6 +65,69 @@ MAX_STALLED_INTERVALS = 10
 #: fraction of the load fails on loading at ``creep.failure_strain`` instead.
 RAMP_DROP_FRACTION = 0.7
 RAMP_DROP_MIN_PEAK = 0.5
+
+
+class CollapseWatch:
+    """Collapse of a specimen under the held load, recognised from the stress servo.
+
+    A servo saturated closing (its command clipped at +max speed) drives the platens together as
+    fast as it may because the specimen carries less than the target stress; when that lasts while
+    the axial strain grows by more than ``strain_increment``, the specimen is shortening without
+    regaining the load: it has collapsed.  A transient stress drop after a break that the specimen
+    recovers from ends the saturation before that, and any interruption starts the count again.
+
+    Fed once per check with ``saturated`` (the servo was clipped closing on every DEM step since the
+    previous check) and the axial strain at the check; :meth:`update` says whether collapse is
+    reached.  A saturated stretch is measured from the strain at the check before its first
+    saturated one (where the saturated DEM steps began).  ``strain_increment`` 0: criterion off.
+    """
+
+    def __init__(self, strain_increment: float, strain: float):
+        self.strain_increment = float(strain_increment)
+        #: axial strain at the previous check [1]
+        self.previous = float(strain)
+        #: axial strain where the current saturated stretch began [1]; None: not saturated
+        self.start = None
+        #: saturated checks in a row
+        self.checks = 0
+
+    @property
+    def growth(self) -> float:
+        """Axial strain gained in the current saturated stretch [1] (0 when not saturated)."""
+        return 0.0 if self.start is None else self.previous - self.start
+
+    def update(self, saturated: bool, strain: float) -> bool:
+        """One check; True when the saturated stretch has gained more than ``strain_increment``."""
+        if saturated:
+            if self.start is None:
+                self.start = self.previous
+            self.checks += 1
+        else:
+            self.start, self.checks = None, 0
+        self.previous = float(strain)
+        return self.strain_increment > 0 and self.start is not None and self.growth > self.strain_increment
+
+    def reason(self, steps_per_check: int) -> str:
+        """The failure reason once collapse is reached."""
+        return (f"collapse: servo at its closing speed limit for {self.checks * steps_per_check} DEM steps while "
+                f"the axial strain grew by {self.growth:.6g} > collapse_strain_increment {self.strain_increment:g}")
+
+    def state_dict(self) -> dict:
+        return {"previous": self.previous, "start": self.start, "checks": self.checks}
+
+    @classmethod
+    def from_state(cls, strain_increment: float, state: dict) -> "CollapseWatch":
+        watch = cls(strain_increment, state["previous"])
+        watch.start, watch.checks = state["start"], int(state["checks"])
+        return watch
+
+
+def collapsing(servo, steps: int, stress_ratio: float) -> bool:
+    """One check of :class:`CollapseWatch`: the servo closed the platens at its speed limit on each of the
+    last ``steps`` DEM steps and the held stress is below ``stress_ratio`` x its target (the specimen
+    carries a fraction of the load; a cascade it arrests keeps more)."""
+    return servo.closing_clipped_steps >= steps and servo.stress < stress_ratio * servo.target
+
 
 class CreepRun:
     """State and bookkeeping of one creep test."""
@@ -193,16 +259,24 @@ class CreepRun:
         self.scene.drivers.append(self.servo)
 
     def relax(self, creep_time):
-        """Run DEM steps until equilibrium at the held load; False (and failed) if it never comes."""
+        """Run DEM steps until equilibrium at the held load; False (and failed) at collapse
+        (:class:`CollapseWatch`, checked every ``creep.check_period`` steps) or if equilibrium does not
+        come within ``creep.max_relaxation_steps``."""
         cp = self.params.creep
         done = 0
         self.last_relaxation_steps = 0
+        watch = (CollapseWatch(cp.collapse_strain_increment, self.platens.axial_strain())
+                 if cp.collapse_strain_increment > 0 else None)
         while done < cp.max_relaxation_steps:
             self.scene.run(cp.check_period)
             done += cp.check_period
             self.last_relaxation_steps = done
             self.mark_breaks(creep_time)
             if self.check_failure():
+                return False
+            if watch is not None and watch.update(collapsing(self.servo, cp.check_period, cp.collapse_stress_ratio),
+                                                  self.platens.axial_strain()):
+                self.failed, self.failure_reason = True, watch.reason(cp.check_period)
                 return False
             if self.at_equilibrium(self.servo):
                 return True
@@ -382,7 +456,9 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
 
     One notion of balance: F_u below the clock's threshold (:meth:`PaperClock.balanced`) both
     doubles the step and resets the count of DEM steps without balance; more than
-    ``creep.max_relaxation_steps`` such steps in a row is the failure "no equilibrium".
+    ``creep.max_relaxation_steps`` such steps in a row is the failure "no equilibrium".  Before
+    that, collapse (:class:`CollapseWatch`, checked every ``engine_period`` DEM steps) ends the run
+    when ``creep.collapse_strain_increment`` > 0 and the holder has a stress servo.
 
     F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
     thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
@@ -390,13 +466,24 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     """
     scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
     safe_point = getattr(holder, "safe_point", _no_checkpoint)
+    increment = getattr(cp, "collapse_strain_increment", 0.0)
+    servo = getattr(holder, "servo", None)
+    watch = None
     if resume is None:
         holder.record_now(0.0)
         applications, not_balanced_steps = 0, 0
+        if increment > 0 and servo is not None:
+            watch = CollapseWatch(increment, holder.platens.axial_strain())
     else:
         applications, not_balanced_steps = int(resume["applications"]), int(resume["not_balanced_steps"])
+        if increment > 0 and servo is not None:
+            watch = (CollapseWatch.from_state(increment, resume["collapse"]) if resume.get("collapse")
+                     else CollapseWatch(increment, holder.platens.axial_strain()))
     while True:
-        safe_point("paper", {"applications": applications, "not_balanced_steps": not_balanced_steps})
+        counters = {"applications": applications, "not_balanced_steps": not_balanced_steps}
+        if watch is not None:
+            counters["collapse"] = watch.state_dict()
+        safe_point("paper", counters)
         corr.scene.run(sc.engine_period)
         # a bond breaks in these DEM steps because the last creep step took it past its failure point
         # (or its neighbours' did): it broke at the creep time that step reached, not at the next one;
@@ -422,7 +509,11 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
         if applications % (PROGRESS_EVERY * 100) == 0:
             holder.progress(f"t {clock.creep_time:.4g} s  step {clock.dt:.3g} s  F_u {f_u:.3g}  broken "
                             f"{int(corr.scene.broken.sum())}  applications {applications}")
-        if not holder.check_failure() and not_balanced_steps > cp.max_relaxation_steps:
+        collapsed = watch is not None and watch.update(collapsing(servo, sc.engine_period, cp.collapse_stress_ratio),
+                                                       holder.platens.axial_strain())
+        if not holder.check_failure() and collapsed:
+            holder.failed, holder.failure_reason = True, watch.reason(sc.engine_period)
+        elif not holder.failed and not_balanced_steps > cp.max_relaxation_steps:
             holder.failed, holder.failure_reason = True, (
                 f"no equilibrium at the held load (strain runs away): F_u at or above the paper clock's "
                 f"threshold {clock.unbalanced_force_threshold:g} for {not_balanced_steps} DEM steps")

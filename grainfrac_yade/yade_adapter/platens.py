@@ -125,6 +125,12 @@ class StressServo:
         v = (target - stress) * height / (young * response_steps * dt)
 
     clipped to +-``max_speed``.
+
+    Saturation: a command clipped at +``max_speed``: the specimen carries so much less than the
+    target that the servo closes the platens as fast as it may.
+    ``clipped`` is the sign of the clip of the last command (+1 closing at the limit, -1 opening at
+    the limit, 0 within the limits); ``closing_clipped_steps`` counts the DEM steps in a row, up to
+    and including the last one, whose command was clipped closing (0 after any other command).
     """
 
     name = "StressServo"
@@ -134,8 +140,12 @@ class StressServo:
         self.gain = platens.height / (young * response_steps)
         self.max_speed = max_speed
         self.stress = 0.0
+        self.clipped = 0
+        self.closing_clipped_steps = 0
 
     def before_step(self, scene):
         self.stress = self.platens.axial_stress()
         speed = (self.target - self.stress) * self.gain / scene.O.dt
+        self.clipped = 1 if speed > self.max_speed else (-1 if speed < -self.max_speed else 0)
+        self.closing_clipped_steps = self.closing_clipped_steps + 1 if self.clipped == 1 else 0
         self.platens.set_axial_velocity(float(np.clip(speed, -self.max_speed, self.max_speed)))
