@@ -148,4 +148,5 @@ class StressServo:
         speed = (self.target - self.stress) * self.gain / scene.O.dt
         self.clipped = 1 if speed > self.max_speed else (-1 if speed < -self.max_speed else 0)
         self.closing_clipped_steps = self.closing_clipped_steps + 1 if self.clipped == 1 else 0
-        self.platens.set_axial_velocity(float(np.clip(speed, -self.max_speed, self.max_speed)))
+        # min/max, not np.clip: the same double, without numpy's per-call overhead (3 % of a creep run's time)
+        self.platens.set_axial_velocity(float(min(max(speed, -self.max_speed), self.max_speed)))
