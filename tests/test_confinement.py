@@ -151,7 +151,7 @@ def test_a_confined_creep_run_killed_mid_creep_resumes_to_the_uninterrupted_resu
 def test_confinement_lifetimes_group_by_law_ratio_and_sigma3():
     import pandas as pd
 
-    from grainfrac_yade.analysis.lifetimes import confinement_lifetimes
+    from grainfrac_yade.analysis.lifetimes import confinement_lifetimes, with_confinement_columns
     runs = pd.DataFrame({
         "outcome": ["failed", "failed", "not failed", "failed", "failed", "unfinished"],
         "ratio": [0.8] * 6,
@@ -159,7 +159,7 @@ def test_confinement_lifetimes_group_by_law_ratio_and_sigma3():
         "stress_corrosion.law": ["hillig_charles"] * 6,
         "lifetime_s": [1e6, 1e4, None, 10.0, 1000.0, None],
     })
-    t = confinement_lifetimes(runs).set_index("confining_stress_mpa")
+    t = confinement_lifetimes(with_confinement_columns(runs)).set_index("confining_stress_mpa")
     assert t.loc[0.0, "n"] == 3 and t.loc[0.0, "n_failed"] == 2
     assert t.loc[0.0, "lifetime_geomean_s"] == pytest.approx(1e5)
     assert t.loc[20.0, "n"] == 2 and t.loc[20.0, "lifetime_geomean_s"] == pytest.approx(100.0)

@@ -20,6 +20,8 @@ import math
 import numpy as np
 import pandas as pd
 
+from ..law.hillig_charles import NAME as PAPER_LAW
+
 from .fits import RATIO_DECIMALS
 
 #: Minimum number of failed runs at one ratio for a scatter statistic (three seeds per ratio, as the lifetime studies run).
@@ -113,16 +115,26 @@ CONFINEMENT_COLUMNS = ("law", "ratio", "confining_stress_mpa", "n", "n_failed", 
                        "lifetime_min_s", "lifetime_max_s")
 
 
+def with_confinement_columns(runs: pd.DataFrame) -> pd.DataFrame:
+    """Copy of ``runs`` with ``confining_stress_mpa`` (confinement.stress in MPa; 0 where a run's
+    params.json predates the key: it was uniaxial) and ``law_label`` (stress_corrosion.law; the
+    paper's law where missing, the only one there was)."""
+    out = runs.copy()
+    s3 = out["confinement.stress"] if "confinement.stress" in out else pd.Series(0.0, index=out.index)
+    out["confining_stress_mpa"] = pd.to_numeric(s3, errors="coerce").fillna(0.0) / 1e6
+    law = out["stress_corrosion.law"] if "stress_corrosion.law" in out else pd.Series(PAPER_LAW, index=out.index)
+    out["law_label"] = law.fillna(PAPER_LAW)
+    return out
+
+
 def confinement_lifetimes(runs: pd.DataFrame) -> pd.DataFrame:
-    """Creep lifetimes per degradation law, driving-stress ratio and confining stress sigma_3: runs
-    (``outcome`` failed, failed at load or not failed), failed ones, and the geometric mean, minimum
-    and maximum of the failed runs' lifetimes (a lifetime of 0, failed at load, gives a mean of 0)."""
-    usable = runs[runs["outcome"].isin(["failed", "not failed", "failed at load"]) & runs["ratio"].notna()].copy()
-    usable["confining_stress_mpa"] = pd.to_numeric(usable.get("confinement.stress", 0.0), errors="coerce").fillna(0.0) / 1e6
-    usable["law"] = usable.get("stress_corrosion.law", "hillig_charles")
-    usable["law"] = usable["law"].fillna("hillig_charles")
+    """Creep lifetimes per degradation law, driving-stress ratio and confining stress sigma_3 of
+    ``runs`` (with :func:`with_confinement_columns`): runs (``outcome`` failed, failed at load or not
+    failed), failed ones, and the geometric mean, minimum and maximum of the failed runs' lifetimes
+    (a lifetime of 0, failed at load, gives a mean of 0)."""
+    usable = runs[runs["outcome"].isin(["failed", "not failed", "failed at load"]) & runs["ratio"].notna()]
     rows = []
-    for (law, ratio, s3), g in usable.groupby(["law", "ratio", "confining_stress_mpa"]):
+    for (law, ratio, s3), g in usable.groupby(["law_label", "ratio", "confining_stress_mpa"]):
         failed = g[g["outcome"].isin(["failed", "failed at load"])]
         t = pd.to_numeric(failed["lifetime_s"], errors="coerce").to_numpy(float)
         geo = float(np.exp(np.mean(np.log(t)))) if len(t) and np.all(t > 0) else (0.0 if len(t) else np.nan)

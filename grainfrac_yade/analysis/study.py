@@ -20,7 +20,8 @@ from .collect import code_version_note, collect_runs, flatten
 from .figures import MAP_FRACTIONS, Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
-from .lifetimes import _num, classify_runs, confinement_lifetimes, lifetime_stats, representatives
+from .lifetimes import (_num, classify_runs, confinement_lifetimes, lifetime_stats, representatives,
+                        with_confinement_columns)
 from .report import CONFINEMENT_TABLE, ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
 from .runparams import default_tree, rebuild_specimen
 
@@ -411,15 +412,12 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     content.figures.append(("lifetime.png", "Lifetime vs driving-stress ratio with static-fatigue fits (Fig. 4)"))
 
     # lifetime against confinement (confined creep runs at fixed deviatoric ratios)
-    s3 = pd.to_numeric(runs.get("confinement.stress", pd.Series(0.0, index=runs.index)), errors="coerce").fillna(0.0)
-    if s3[runs["outcome"].isin(CREEP_OUTCOMES)].nunique() > 1:
-        table = confinement_lifetimes(runs)
+    confined = with_confinement_columns(runs)
+    if confined.loc[confined["outcome"].isin(CREEP_OUTCOMES), "confining_stress_mpa"].nunique() > 1:
+        table = confinement_lifetimes(confined)
         write_csv(out / "lifetime_confinement.csv", table)
         (out / "lifetime_confinement.md").write_text(markdown_table(table, CONFINEMENT_TABLE) + "\n")
-        shown = runs.assign(confining_stress_mpa=s3 / 1e6,
-                            law_label=runs.get("stress_corrosion.law", pd.Series("hillig_charles", index=runs.index))
-                            .fillna("hillig_charles"))
-        figures.confinement_lifetime_figure(out / "lifetime_confinement.png", shown, table, time_note=time_note)
+        figures.confinement_lifetime_figure(out / "lifetime_confinement.png", confined, table, time_note=time_note)
         content.figures.append(("lifetime_confinement.png", "Lifetime vs confining stress at fixed deviatoric "
                                                             "driving-stress ratios"))
         content.tables.append("lifetime_confinement.md")

@@ -43,8 +43,8 @@ from ..law import creep_step, shear_strength
 from ..params import unbalanced_threshold
 from .confinement import Confinement, consolidate, young_estimate
 from .corrosion_engine import ContactStiffnessRestorer, StressCorrosion
-from .platens import Platens, StressServo, free_bodies
-from .scene import broken_counts, build_scene, check_value, mean_bond_force, resultant_forces
+from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
+from .scene import broken_counts, build_scene, check_value, resultant_forces
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
 #: is per metre of thickness; it is scaled by the layer thickness here.
@@ -184,15 +184,9 @@ class CreepRun:
         rel = mean / mean_bond_force if mean_bond_force > 0 else math.inf
         return largest, rel
 
-    def mean_bond_force(self):
-        idx = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
-        return mean_bond_force(self.scene, idx)
-
     def at_equilibrium(self, servo):
-        _, rel = self.unbalanced(self.mean_bond_force())
-        check_value("held axial stress", servo.stress, self.scene.O.iter)
-        return rel < self.params.creep.equilibrium_tolerance and \
-            abs(servo.stress - self.target) < self.params.creep.stress_tolerance * self.target
+        bonds = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
+        return held_at_equilibrium(self.scene, servo, self._free_ids, bonds, self.params.creep)
 
     def record(self, creep_time, stress=None):
         """Append a history row; NumericalFailure (and no row) if a value is NaN or infinite."""
@@ -468,17 +462,16 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     safe_point = getattr(holder, "safe_point", _no_checkpoint)
     increment = getattr(cp, "collapse_strain_increment", 0.0)
     servo = getattr(holder, "servo", None)
-    watch = None
     if resume is None:
         holder.record_now(0.0)
         applications, not_balanced_steps = 0, 0
-        if increment > 0 and servo is not None:
-            watch = CollapseWatch(increment, holder.platens.axial_strain())
     else:
         applications, not_balanced_steps = int(resume["applications"]), int(resume["not_balanced_steps"])
-        if increment > 0 and servo is not None:
-            watch = (CollapseWatch.from_state(increment, resume["collapse"]) if resume.get("collapse")
-                     else CollapseWatch(increment, holder.platens.axial_strain()))
+    watch = None
+    if increment > 0 and servo is not None:
+        saved = (resume or {}).get("collapse")
+        watch = (CollapseWatch.from_state(increment, saved) if saved
+                 else CollapseWatch(increment, holder.platens.axial_strain()))
     while True:
         counters = {"applications": applications, "not_balanced_steps": not_balanced_steps}
         if watch is not None:

@@ -12,7 +12,11 @@ means over the side cells' spheres.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from .scene import check_value, mean_bond_force, resultant_forces
 
 #: DOFs blocked on platen cells: y prescribed, z and all rotations blocked (pseudo-2D, flat platen).
 PLATEN_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -113,6 +117,18 @@ def free_bodies(scene, platens) -> list:
     """Body ids of the cells that are not platen cells (their resultant forces measure balance)."""
     free = np.setdiff1d(np.arange(scene.specimen.n_cells), np.union1d(platens.top, platens.bottom))
     return [int(b) for b in scene.bodies_of(free)]
+
+
+def held_at_equilibrium(scene, servo, free_ids, bonds, creep_params) -> bool:
+    """The servo holds its target at equilibrium: mean resultant force on ``free_ids`` / mean force of
+    ``bonds`` below ``creep.equilibrium_tolerance``, and the held stress within
+    ``creep.stress_tolerance`` x the target.  NumericalFailure if a force or the stress is not finite."""
+    reference = mean_bond_force(scene, bonds)
+    _, mean_resultant = resultant_forces(scene, free_ids)
+    rel = mean_resultant / reference if reference > 0 else math.inf
+    check_value("held axial stress", servo.stress, scene.O.iter)
+    return rel < creep_params.equilibrium_tolerance and \
+        abs(servo.stress - servo.target) < creep_params.stress_tolerance * servo.target
 
 
 class StressServo:
