@@ -27,6 +27,7 @@ declare -A WHAT=(
   [lifetime_ldb]="README 'Lifetime studies' paper size, 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
   [creep_numerics]="README 'creep numerics' (params/creep_numerics_small.table): about 1 h"
   [brazilian]="README 'Brazilian test' (params/brazilian_ldb.table, docs/brazilian_study.sh)"
+  [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 3 h on 2 cores"
   [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -64,6 +65,9 @@ run_target() {
               batch params/confined_creep_normalised_small.table creep.py confined_creep_normalised
               $PY -m grainfrac_yade analyze results/confined_creep results/confined_creep_normalised \
                   --out results/confined_creep_both ;;
+    accuracy_cost) $PY -m grainfrac_yade accuracy-cost --jobs 2
+                   cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
+                   cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
   esac
 }
@@ -74,7 +78,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
 fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration resolution fem_ucs fem_creep lattice lifetime_small
-                           lifetime_ldb creep_numerics brazilian confined)
+                           lifetime_ldb creep_numerics brazilian confined accuracy_cost)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)

@@ -142,6 +142,8 @@ class StressCorrosionParams:
     unbalanced_force_reference: str = _spec("", "choice", "F_u absolute [N] or relative",
                                             ("absolute", "relative"))
     engine_period: int = _spec("1", "positive_int", "DEM steps between applications of the law")
+    unbalanced_engine_period: int = _spec("1", "positive_int", "paper clock: DEM steps between applications of the "
+                                          "law while F_u is at or above the threshold (the step sits at dt_min)")
     max_strength_loss_fraction: float = _spec("1", "unit_interval_open",
                                               "event clock: largest relative strength loss per interval")
     creep_time_limit: float = _spec("s", "positive", "creep time after which a run stops unfailed")
@@ -192,6 +194,8 @@ class CreepParams:
                                          "collapse also needs the held stress below this fraction of the target "
                                          "(a cascade the specimen arrests keeps it higher); 1 = saturation alone")
     failure_strain: float = _spec("1", "positive", "axial strain at which a run counts as failed (safety cap)")
+    relaxation_damping: float = _spec("1", "fraction_below_one", "Cundall damping of the creep phase (after the "
+                                      "ramp: every relaxation); 0 = numerics.damping, as in the ramp")
     record_period: int = _spec("1", "positive_int", "paper clock: law applications between history rows")
     checkpoint_interval: float = _spec("s", "nonnegative",
                                        "wall time between checkpoints of a creep run (for creep --resume); "

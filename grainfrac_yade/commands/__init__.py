@@ -5,7 +5,7 @@ def register_all(subparsers, common):
     """Add later commands (ucs, creep, analyze, demo) to the CLI as they exist."""
     import importlib
     for name in ("ucs", "calibrate", "calibrate_beta1", "calibrate_lifetimes", "analyze_ucs", "creep", "analyze", "demo",
-                 "elastic", "bench",
+                 "elastic", "bench", "accuracy_cost",
                  "submit", "status", "brazilian"):
         try:
             module = importlib.import_module(f"{__name__}.{name}")

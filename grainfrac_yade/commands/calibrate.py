@@ -102,8 +102,11 @@ def write_calibration_file(path: Path, rows, args, overrides):
     lines = ["# Calibration of the YADE packing to the paper's granite (UCS and E of paper section 3.1), written by",
              "#   python3 -m grainfrac_yade calibrate --seeds " + " ".join(map(str, args.seeds))
              + f" --rounds {args.rounds} " + " ".join(f"--set {k}={v}" for k, v in overrides).strip(),
-             f"# seeds {args.seeds}; targets: UCS {args.target_ucs / 1e6:.1f} MPa (paper, simulated),",
-             f"# E {args.target_young / 1e9:.1f} GPa (LdB lab). Table 1 and 2 stay as printed; these factors scale",
+             f"# seeds {args.seeds}; targets: UCS {args.target_ucs / 1e6:.1f} MPa"
+             + (" (paper, simulated)," if args.target_ucs == TARGET_UCS else " (--target-ucs),"),
+             f"# E {args.target_young / 1e9:.1f} GPa" + (" (LdB lab)." if args.target_young == TARGET_YOUNG
+                                                        else " (--target-young).")
+             + " Table 1 and 2 stay as printed; these factors scale",
              "# every bond alike. Why: rigid Voronoi cells bonded across faces are weaker and softer than",
              "# UDEC's deformable blocks with the same contact values (README, 'Calibration').",
              "#",

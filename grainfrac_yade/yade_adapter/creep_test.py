@@ -246,7 +246,11 @@ class CreepRun:
         self.break_time[self.scene.broken] = -1.0  # ramp cracks: before creep time 0
 
     def hold_servo(self):
+        """Hold the load with the stress servo from here on; the creep phase's damping
+        (``creep.relaxation_damping``, if set) replaces the ramp's."""
         cp = self.params.creep
+        if cp.relaxation_damping > 0:
+            self.scene.newton.damping = cp.relaxation_damping
         young = max(self.target / max(self.platens.axial_strain(), 1e-6), 1e9)
         self.servo = StressServo(self.platens, self.target, young, cp.servo_response_steps,
                                  cp.servo_max_strain_rate * self.platens.height)
@@ -457,16 +461,21 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
     thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
     the mean bond force.  With ``engine_period`` k > 1 the k steps share the F_u of the last one.
+    While F_u is at or above the threshold the law is applied every ``unbalanced_engine_period`` DEM
+    steps instead (the step then sits at dt_min: the steps add k x dt_min of creep time).
     """
     scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
     safe_point = getattr(holder, "safe_point", _no_checkpoint)
     increment = getattr(cp, "collapse_strain_increment", 0.0)
+    unbalanced_period = getattr(sc, "unbalanced_engine_period", sc.engine_period)
     servo = getattr(holder, "servo", None)
     if resume is None:
         holder.record_now(0.0)
         applications, not_balanced_steps = 0, 0
+        period = sc.engine_period
     else:
         applications, not_balanced_steps = int(resume["applications"]), int(resume["not_balanced_steps"])
+        period = int(resume.get("period", sc.engine_period))
     watch = None
     if increment > 0 and servo is not None:
         saved = (resume or {}).get("collapse")
@@ -474,10 +483,12 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
                  else CollapseWatch(increment, holder.platens.axial_strain()))
     while True:
         counters = {"applications": applications, "not_balanced_steps": not_balanced_steps}
+        if period != sc.engine_period:
+            counters["period"] = period
         if watch is not None:
             counters["collapse"] = watch.state_dict()
         safe_point("paper", counters)
-        corr.scene.run(sc.engine_period)
+        corr.scene.run(period)
         # a bond breaks in these DEM steps because the last creep step took it past its failure point
         # (or its neighbours' did): it broke at the creep time that step reached, not at the next one;
         # the steps run after the last creep step too, so no bond ends the run past its failure point
@@ -493,25 +504,27 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
         mean_force = float(np.mean(np.hypot(stresses.normal, stresses.shear) * corr.area0[idx]))
         f_max, rel = holder.unbalanced(mean_force)
         f_u = f_max / scale if sc.unbalanced_force_reference == "absolute" else rel
-        dt_b = clock.advance_many([f_u] * sc.engine_period)
+        dt_b = clock.advance_many([f_u] * period)
         corr.degrade(dt_b, stresses)
         applications += 1
-        not_balanced_steps = 0 if clock.balanced(f_u) else not_balanced_steps + sc.engine_period
+        balanced = clock.balanced(f_u)
+        not_balanced_steps = 0 if balanced else not_balanced_steps + period
         if applications % cp.record_period == 0:
             holder.record_now(clock.creep_time)
         if applications % (PROGRESS_EVERY * 100) == 0:
             holder.progress(f"t {clock.creep_time:.4g} s  step {clock.dt:.3g} s  F_u {f_u:.3g}  broken "
                             f"{int(corr.scene.broken.sum())}  applications {applications}")
-        collapsed = watch is not None and watch.update(collapsing(servo, sc.engine_period, cp.collapse_stress_ratio),
+        collapsed = watch is not None and watch.update(collapsing(servo, period, cp.collapse_stress_ratio),
                                                        holder.platens.axial_strain())
         if not holder.check_failure() and collapsed:
-            holder.failed, holder.failure_reason = True, watch.reason(sc.engine_period)
+            holder.failed, holder.failure_reason = True, watch.reason(period)
         elif not holder.failed and not_balanced_steps > cp.max_relaxation_steps:
             holder.failed, holder.failure_reason = True, (
                 f"no equilibrium at the held load (strain runs away): F_u at or above the paper clock's "
                 f"threshold {clock.unbalanced_force_threshold:g} for {not_balanced_steps} DEM steps")
         if holder.failed:
             break
+        period = sc.engine_period if balanced else unbalanced_period
     holder.record_now(clock.creep_time)
 
 
