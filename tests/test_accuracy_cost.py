@@ -136,7 +136,7 @@ def _runs(study, lifetimes, ucs=None, wall=10.0):
     for (name, ratio, seed), t in lifetimes.items():
         folder = study.run_folder(study.setting(name), "creep", seed, ratio)
         row = {"folder": str(folder), "command": "creep", "status": "finished", "numerical_failure": False,
-               "failed_on_loading": False, "dem_steps": 1000, "wall_s": wall, "broken_total": 10, "macrocracks": 4,
+               "failed_on_loading": False, "dem_steps": 1000, "wall_s": wall, "cpu_s": wall, "broken_total": 10, "macrocracks": 4,
                "n_events": 3}
         if t is None:
             row.update(failed=False, lifetime_s=float("nan"), creep_time_end_s=1e13)
@@ -211,7 +211,7 @@ def test_quick_study_end_to_end(tmp_path):
     assert (table["creep_runs_finished"] == table["creep_runs_planned"]).all()
     refs = table[table["setting"] == table["reference"]]
     assert np.allclose(refs["error_ln_mean"], 0.0)
-    assert np.isfinite(table["wall_s_per_run"]).all() and (table["dem_steps_per_run"] > 0).all()
+    assert np.isfinite(table["cpu_s_per_run"]).all() and (table["dem_steps_per_run"] > 0).all()
     assert (out / "accuracy_cost.png").stat().st_size > 1000
     # a second call keeps every finished row (nothing reruns) and gives the same table
     again = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)

@@ -372,7 +372,7 @@ def assert_same_runs(a, b):
     """summary.json equal but for wall time and code version; every CSV equal but for wall time."""
     sa, sb = (json.loads((d / "summary.json").read_text()) for d in (a, b))
     for s in (sa, sb):
-        del s["wall_s"], s["code_version"]   # the tree may change between runs (others commit)
+        del s["wall_s"], s["cpu_s"], s["code_version"]   # the tree may change between runs (others commit)
     assert sa == sb
     names = sorted(p.name for p in a.glob("*.csv"))
     assert names == sorted(p.name for p in b.glob("*.csv")) and "history.csv" in names

@@ -6,7 +6,9 @@ of the same ratio and seed under the knob's reference setting; ``error_pct`` = e
 on the lifetime, in %).  Pairs where either run has no lifetime (failed at load, not failed, numerical
 failure, unfinished) are left out and counted in ``note``.  The slope b is that of the pooled fit
 ln t_f = a - b r over the setting's failed runs (Schmidtke & Lajtai's form, paper Eq. 9's exponential
-alternative); its change is b - b_ref.  Costs are means per creep run (DEM steps, wall time).
+alternative); its change is b - b_ref.  Costs are means per creep run: DEM steps, wall time and the
+process's CPU time (``cpu_s``, which neither other jobs on the machine nor a paused run inflate; the
+Pareto figure's abscissa where every run has it).
 """
 from __future__ import annotations
 
@@ -119,7 +121,8 @@ def _row(study, labelled, life, strain, knob, setting, ref) -> dict:
     out["creep_strain_before_tertiary"] = _mean([strain.get((setting.name, r, s)) for r, s in pairs])
     done = creep[creep["status"] == "finished"] if len(creep) else creep
     for col, name in (("broken_total", "microcracks_at_end"), ("macrocracks", "macrocracks_at_end"),
-                      ("n_events", "events"), ("dem_steps", "dem_steps_per_run"), ("wall_s", "wall_s_per_run")):
+                      ("n_events", "events"), ("dem_steps", "dem_steps_per_run"), ("wall_s", "wall_s_per_run"),
+                      ("cpu_s", "cpu_s_per_run")):
         out[name] = _mean(done[col].astype(float)) if len(done) and col in done else float("nan")
     notes = []
     if missing:
@@ -137,7 +140,7 @@ def markdown_table(table: pd.DataFrame, ratios) -> str:
     life_cols = [f"lifetime_geomean_r{r:g}_s" for r in ratios]
     head = (["knob", "setting", "UCS [MPa]", "E [GPa]"] + [f"t_f r={r:g} [s]" for r in ratios]
             + ["error (mean abs d ln t_f)", "error [%]", "b", "db", "creep strain to tertiary", "micro / macro cracks",
-               "DEM steps / run", "wall [s] / run", "runs", "note"])
+               "DEM steps / run", "CPU [s] / run", "wall [s] / run", "runs", "note"])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
 
     def f(v, fmt):
@@ -150,7 +153,7 @@ def markdown_table(table: pd.DataFrame, ratios) -> str:
                  + [f(r["error_ln_mean"], ".3f"), f(r["error_pct"], ".1f"), f(r["slope_b"], ".1f"),
                     f(r["slope_b_change"], "+.1f"), f(r["creep_strain_before_tertiary"], ".2e"),
                     f"{f(r['microcracks_at_end'], '.0f')} / {f(r['macrocracks_at_end'], '.0f')}",
-                    f(r["dem_steps_per_run"], ".0f"), f(r["wall_s_per_run"], ".1f"),
+                    f(r["dem_steps_per_run"], ".0f"), f(r["cpu_s_per_run"], ".1f"), f(r["wall_s_per_run"], ".1f"),
                     f"{r['creep_runs_finished']}/{r['creep_runs_planned']}", r["note"] or ""])
         lines.append("| " + " | ".join(str(c) for c in cells) + " |")
     lines.append("")
@@ -159,28 +162,29 @@ def markdown_table(table: pd.DataFrame, ratios) -> str:
 
 
 def pareto_figure(table: pd.DataFrame, path, title: str = "What accuracy costs in time"):
-    """Error against wall time per creep run, log axes, one series per knob; a reference (error 0) sits at
-    :data:`ZERO_ERROR_FLOOR`, drawn hollow."""
+    """Error against cost per creep run (CPU time where every run has it, else wall time), log axes, one
+    series per knob; a reference (error 0) sits at :data:`ZERO_ERROR_FLOOR`, drawn hollow."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    cost = "cpu_s_per_run" if np.isfinite(table["cpu_s_per_run"]).all() else "wall_s_per_run"
     fig, ax = plt.subplots(figsize=(7.5, 5))
     markers = "osD^vP*X"
     for i, (knob, group) in enumerate(table.groupby("knob", sort=False)):
-        g = group[np.isfinite(group["wall_s_per_run"]) & np.isfinite(group["error_ln_mean"])]
+        g = group[np.isfinite(group[cost]) & np.isfinite(group["error_ln_mean"])]
         if g.empty:
             continue
         err = np.maximum(g["error_ln_mean"].to_numpy(float), ZERO_ERROR_FLOOR)
-        line = ax.plot(g["wall_s_per_run"], err, ls="none", marker=markers[i % len(markers)], label=knob)[0]
+        line = ax.plot(g[cost], err, ls="none", marker=markers[i % len(markers)], label=knob)[0]
         zero = g["error_ln_mean"].to_numpy(float) <= 0
         if zero.any():
-            ax.plot(g["wall_s_per_run"][zero], err[zero], ls="none", marker=markers[i % len(markers)], ms=11,
+            ax.plot(g[cost][zero], err[zero], ls="none", marker=markers[i % len(markers)], ms=11,
                     mfc="none", color=line.get_color())
-        for w, e, name in zip(g["wall_s_per_run"], err, g["setting"]):
+        for w, e, name in zip(g[cost], err, g["setting"]):
             ax.annotate(name, (w, e), fontsize=6, xytext=(3, 3), textcoords="offset points")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("wall time per creep run [s] (one core)")
+    ax.set_xlabel(("CPU" if cost == "cpu_s_per_run" else "wall") + " time per creep run [s] (one core)")
     ax.set_ylabel("error: mean |ln t_f - ln t_f,ref| over seeds and ratios")
     ax.set_title(title + f"\n(reference of each knob: hollow marker at {ZERO_ERROR_FLOOR:g})", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)

@@ -191,7 +191,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..specimen import build_specimen
     from ..yade_adapter.creep_test import resume_creep, run_creep
     from ..yade_adapter.scene import bond_segments, broken_counts
-    t0 = time.time()
+    t0, c0 = time.time(), time.process_time()
     require_plane(params, "creep")
     out = Path(out) if resume else prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
@@ -203,6 +203,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
             outputs.update(vtk_folder=out / "vtk")
         run = resume_creep(specimen, params, stress, out, progress=progress, **outputs)
         t0 -= state.get("wall_s", 0.0)   # wall time of the run up to its checkpoint
+        c0 -= state.get("cpu_s", 0.0)    # CPU time of this process up to it (checkpoints older than the key: 0)
     else:
         if vtk_times is not None:
             outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
@@ -231,6 +232,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
+        "cpu_s": time.process_time() - c0,
         "primary_end_s": primary_end, "tertiary_start_s": tertiary_start,
         "vtk_creep_times_s": run.vtk_written,
         **summary_header(params, seed),

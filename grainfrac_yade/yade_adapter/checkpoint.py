@@ -138,7 +138,7 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
     state = {
         "format": FORMAT, "phase": phase, "loop": dict(loop), "run_values": run_values,
         "code_version": version, "written": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "dem_steps": int(O.iter), "wall_s": time.time() - run.t0,
+        "dem_steps": int(O.iter), "wall_s": time.time() - run.t0, "cpu_s": time.process_time() - run.c0,
         "creep_time_s": run.rows[-1]["creep_time_s"] if run.rows else 0.0,
         "run": {"rows": run.rows, "ramp_broken": run.ramp_broken, "failed": run.failed,
                 "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
@@ -255,6 +255,7 @@ def restore(run, where, state: dict, arrays: dict):
                                    "phase": state["phase"], "checkpoint_written": state["written"]}]
     run.break_time, run.macro_time = np.array(arrays["break_time"]), np.array(arrays["macro_time"])
     run.t0 = time.time() - state["wall_s"]
+    run.c0 = time.process_time() - state.get("cpu_s", 0.0)
     if state["servo"] is not None:
         s = state["servo"]
         servo = StressServo(pl, s["target"], 1.0, 1, s["max_speed"])

@@ -143,7 +143,7 @@ class CreepRun:
         #: called with the rows so far every HISTORY_FLUSH_ROWS rows (partial history.csv)
         self.history_sink = history_sink
         self.progress = progress or (lambda msg: None)
-        self.t0 = time.time()
+        self.t0, self.c0 = time.time(), time.process_time()   # wall and CPU time of the run's start
         self.scene = build_scene(specimen, params)
         self.platens = Platens(self.scene, params.ucs.platen_lateral)
         self.scene.extras.append(self.platens)

@@ -25,7 +25,7 @@ def run_ucs(specimen, params, progress=None, scene=None):
     The history holds only finite rows (a row with a NaN or infinite value ends the run as a
     numerical failure instead).
     """
-    t0 = time.time()
+    t0, c0 = time.time(), time.process_time()
     scene = scene or build_scene(specimen, params)
     ucs = params.ucs
     platens = Platens(scene, ucs.platen_lateral)
@@ -74,7 +74,7 @@ def run_ucs(specimen, params, progress=None, scene=None):
         numerical, end = True, f"numerical failure: {exc}"
         if progress:
             progress(end)
-    result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "dem_timestep_s": dt,
+    result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "cpu_s": time.process_time() - c0, "dem_timestep_s": dt,
               "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
               "peak_reached": peak_reached, "end_reason": end, "confining_stress_pa": confining, **consolidation}
     return cols, result, scene, peak_snapshot
