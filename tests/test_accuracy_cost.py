@@ -13,8 +13,8 @@ import pytest
 from conftest import ROOT, needs_yade
 from grainfrac_yade.accuracy_study import (DEFAULT_SETTING, creep_rows, load_study, setting_of_folder,
                                            ucs_rows)
-from grainfrac_yade.analysis.accuracy import (creep_strain_before_tertiary, label_runs, markdown_table,
-                                              pareto_figure, setting_rows, slope_b)
+from grainfrac_yade.analysis.accuracy import (creep_strain_before_tertiary, history_measures, label_runs,
+                                              markdown_table, pareto_figure, setting_rows, slope_b)
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import default_files, flatten, read_toml
 
@@ -195,6 +195,16 @@ def test_creep_strain_before_tertiary_is_read_from_the_history():
     assert creep_strain_before_tertiary(history, 15.0) == pytest.approx(0.2e-3)
     assert math.isnan(creep_strain_before_tertiary(history, float("nan")))
     assert math.isnan(creep_strain_before_tertiary(None, 5.0))
+
+
+def test_steps_per_relaxation_count_the_relaxations_to_equilibrium_of_the_event_clock():
+    history = pd.DataFrame({"creep_time_s": [0.0, 0.0, 5.0, 9.0], "axial_strain": [1e-3] * 4,
+                            "dem_steps": [40000, 40600, 41500, 52000]})
+    m = history_measures(history, None, "event")
+    # rows: after the ramp, after each relaxation; the last relaxation (10,500 steps) is the collapse
+    assert m["creep_dem_steps"] == 12000 and m["final_relaxation_steps"] == 10500
+    assert m["steps_per_relaxation"] == 750
+    assert math.isnan(history_measures(history, None, "paper")["steps_per_relaxation"])
 
 
 # ------------------------------------------------------------------ one quick study through yade-batch

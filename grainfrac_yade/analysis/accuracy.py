@@ -48,6 +48,25 @@ def creep_strain_before_tertiary(history: pd.DataFrame | None, tertiary_start_s)
     return float(np.interp(float(tertiary_start_s), t, eps) - eps[0])
 
 
+def history_measures(history: pd.DataFrame | None, tertiary_start_s, clock: str) -> dict:
+    """Per-run measures read from history.csv of a run that failed in creep: the creep strain before tertiary
+    creep, the DEM steps of the creep phase (after the ramp's row), those of the final relaxation (the
+    collapse) and, for the event clock (one history row per relaxation), the mean DEM steps of the
+    relaxations that reached equilibrium (every one but the last)."""
+    out = {"creep_strain_before_tertiary": creep_strain_before_tertiary(history, tertiary_start_s),
+           "creep_dem_steps": float("nan"), "final_relaxation_steps": float("nan"),
+           "steps_per_relaxation": float("nan")}
+    if history is None or len(history) < 2:
+        return out
+    steps = history["dem_steps"].to_numpy(float)
+    out["creep_dem_steps"] = float(steps[-1] - steps[0])
+    if clock == "event":
+        out["final_relaxation_steps"] = float(steps[-1] - steps[-2])
+        if len(history) >= 3:
+            out["steps_per_relaxation"] = float(steps[-2] - steps[0]) / (len(history) - 2)
+    return out
+
+
 def lifetimes(labelled: pd.DataFrame) -> dict:
     """{(setting, ratio, seed): lifetime [s]} of the creep runs that failed in creep (t_f > 0)."""
     creep = labelled[(labelled["test"] == "creep") & (labelled["outcome"] == "failed")]
@@ -71,14 +90,14 @@ def _mean(values) -> float:
     return float(np.mean(values)) if values else float("nan")
 
 
-def setting_rows(study: Study, labelled: pd.DataFrame, strain_before_tertiary=None) -> pd.DataFrame:
+def setting_rows(study: Study, labelled: pd.DataFrame, measures=None) -> pd.DataFrame:
     """One row per (knob, setting): the default setting once per knob, every other setting under its own
     (a knob none of whose settings is in ``study``, e.g. in the quick subset, is left out).
 
-    ``strain_before_tertiary``: {(setting, ratio, seed): creep strain} (optional; NaN where missing).
+    ``measures``: {(setting, ratio, seed): :func:`history_measures` of that run} (optional; NaN where missing).
     """
     life = lifetimes(labelled)
-    strain_before_tertiary = strain_before_tertiary or {}
+    measures = measures or {}
     rows = []
     for knob in study.knobs.values():
         if not any(s.knob == knob.name for s in study.settings):
@@ -86,11 +105,11 @@ def setting_rows(study: Study, labelled: pd.DataFrame, strain_before_tertiary=No
         ref = knob.reference
         members = [s for s in study.settings if s.knob == knob.name or s.name in (DEFAULT_SETTING, ref)]
         for s in members:
-            rows.append(_row(study, labelled, life, strain_before_tertiary, knob, s, ref))
+            rows.append(_row(study, labelled, life, measures, knob, s, ref))
     return pd.DataFrame(rows)
 
 
-def _row(study, labelled, life, strain, knob, setting, ref) -> dict:
+def _row(study, labelled, life, measures, knob, setting, ref) -> dict:
     mine = labelled[labelled["setting"] == setting.name] if len(labelled) else labelled
     creep = mine[mine["test"] == "creep"] if len(mine) else mine
     ucs_source = setting.name if setting.ucs_test else DEFAULT_SETTING
@@ -118,7 +137,8 @@ def _row(study, labelled, life, strain, knob, setting, ref) -> dict:
     out.update(error_ln_mean=_mean(errors), error_ln_max=max(errors) if errors else float("nan"),
                error_pct=(math.exp(_mean(errors)) - 1) * 100 if errors else float("nan"),
                pairs_compared=len(errors), slope_b=b_here, slope_b_change=b_here - b_ref)
-    out["creep_strain_before_tertiary"] = _mean([strain.get((setting.name, r, s)) for r, s in pairs])
+    for key in ("creep_strain_before_tertiary", "creep_dem_steps", "final_relaxation_steps", "steps_per_relaxation"):
+        out[key] = _mean([measures.get((setting.name, r, s), {}).get(key) for r, s in pairs])
     done = creep[creep["status"] == "finished"] if len(creep) else creep
     for col, name in (("broken_total", "microcracks_at_end"), ("macrocracks", "macrocracks_at_end"),
                       ("n_events", "events"), ("dem_steps", "dem_steps_per_run"), ("wall_s", "wall_s_per_run"),
@@ -140,7 +160,7 @@ def markdown_table(table: pd.DataFrame, ratios) -> str:
     life_cols = [f"lifetime_geomean_r{r:g}_s" for r in ratios]
     head = (["knob", "setting", "UCS [MPa]", "E [GPa]"] + [f"t_f r={r:g} [s]" for r in ratios]
             + ["error (mean abs d ln t_f)", "error [%]", "b", "db", "creep strain to tertiary", "micro / macro cracks",
-               "DEM steps / run", "CPU [s] / run", "wall [s] / run", "runs", "note"])
+               "DEM steps / run", "steps / relaxation", "final relaxation steps", "CPU [s] / run", "wall [s] / run", "runs", "note"])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
 
     def f(v, fmt):
@@ -153,7 +173,8 @@ def markdown_table(table: pd.DataFrame, ratios) -> str:
                  + [f(r["error_ln_mean"], ".3f"), f(r["error_pct"], ".1f"), f(r["slope_b"], ".1f"),
                     f(r["slope_b_change"], "+.1f"), f(r["creep_strain_before_tertiary"], ".2e"),
                     f"{f(r['microcracks_at_end'], '.0f')} / {f(r['macrocracks_at_end'], '.0f')}",
-                    f(r["dem_steps_per_run"], ".0f"), f(r["cpu_s_per_run"], ".1f"), f(r["wall_s_per_run"], ".1f"),
+                    f(r["dem_steps_per_run"], ".0f"), f(r["steps_per_relaxation"], ".0f"),
+                    f(r["final_relaxation_steps"], ".0f"), f(r["cpu_s_per_run"], ".1f"), f(r["wall_s_per_run"], ".1f"),
                     f"{r['creep_runs_finished']}/{r['creep_runs_planned']}", r["note"] or ""])
         lines.append("| " + " | ".join(str(c) for c in cells) + " |")
     lines.append("")

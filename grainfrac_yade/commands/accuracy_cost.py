@@ -58,8 +58,7 @@ def cmd_accuracy_cost(args) -> int:
 
 def summarise(study) -> int:
     """Write the study's table (CSV, markdown) and Pareto figure from the runs in its folder."""
-    from ..analysis.accuracy import (creep_strain_before_tertiary, label_runs, markdown_table, pareto_figure,
-                                     setting_rows)
+    from ..analysis.accuracy import history_measures, label_runs, markdown_table, pareto_figure, setting_rows
     from ..analysis.collect import code_version_note, collect_runs
     from ..analysis.study import read_history
     from ..errors import GrainfracError
@@ -70,11 +69,11 @@ def summarise(study) -> int:
     if labelled.empty:
         raise GrainfracError(f"{folder}: no run of the study yet; fix: run python3 -m grainfrac_yade accuracy-cost "
                              "without --analyze-only")
-    strain = {}
+    measures = {}
     for r in labelled[(labelled["test"] == "creep") & (labelled["outcome"] == "failed")].itertuples():
-        strain[(r.setting, float(r.ratio_planned), int(r.seed_planned))] = creep_strain_before_tertiary(
-            read_history(r.folder), getattr(r, "tertiary_start_s", None))
-    table = setting_rows(study, labelled, strain)
+        measures[(r.setting, float(r.ratio_planned), int(r.seed_planned))] = history_measures(
+            read_history(r.folder), getattr(r, "tertiary_start_s", None), getattr(r, "clock", ""))
+    table = setting_rows(study, labelled, measures)
     write_csv(folder / "accuracy_cost.csv", table)
     note = code_version_note(labelled)
     text = markdown_table(table, study.ratios) + (f"\n{note}\n" if note else "")
