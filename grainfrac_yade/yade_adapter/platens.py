@@ -48,6 +48,7 @@ class Platens:
             b.state.blockedDOFs = PLATEN_BLOCKED[lateral]
             b.state.vel = (0, 0, 0)
             b.state.angVel = (0, 0, 0)
+        self._cache_handles()
         self.y0_top = np.mean([b.state.pos[1] for b in self._top_bodies])
         self.y0_bottom = np.mean([b.state.pos[1] for b in self._bottom_bodies])
         self.x0_gap = self._side_gap()
@@ -65,15 +66,26 @@ class Platens:
         self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies = (
             [O.bodies[b.id] for b in bodies]
             for bodies in (self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies))
+        self._cache_handles()
         self._restored_reaction = (O.iter, float(reaction))
+
+    def _cache_handles(self):
+        """Body ids and state handles of the platen bodies, fetched once: the servo reads their forces
+        and sets their velocities before every DEM step, and each ``body.state`` / ``body.id`` lookup
+        from Python costs a wrapper (same values, same order of summation)."""
+        self._top_ids = [b.id for b in self._top_bodies]
+        self._bottom_ids = [b.id for b in self._bottom_bodies]
+        self._top_states = [b.state for b in self._top_bodies]
+        self._bottom_states = [b.state for b in self._bottom_bodies]
 
     def set_axial_velocity(self, closing_speed: float):
         """Platens approach each other at ``closing_speed`` [m/s] (half each)."""
         self.velocity = closing_speed
-        for b in self._top_bodies:
-            b.state.vel = (b.state.vel[0], -0.5 * closing_speed, 0)
-        for b in self._bottom_bodies:
-            b.state.vel = (b.state.vel[0], 0.5 * closing_speed, 0)
+        down, up = -0.5 * closing_speed, 0.5 * closing_speed
+        for st in self._top_states:
+            st.vel = (st.vel[0], down, 0)
+        for st in self._bottom_states:
+            st.vel = (st.vel[0], up, 0)
 
     def shift(self, closing: float):
         """Move both platens towards each other by ``closing`` [m] in one jump (servo/creep hold)."""
@@ -108,8 +120,8 @@ class Platens:
                 return self._restored_reaction[1]
             self._restored_reaction = None
         f = self.scene.O.forces.f
-        top = sum(f(b.id)[1] for b in self._top_bodies)
-        bottom = sum(f(b.id)[1] for b in self._bottom_bodies)
+        top = sum(f(i)[1] for i in self._top_ids)
+        bottom = sum(f(i)[1] for i in self._bottom_ids)
         return 0.5 * (top - bottom) / self.cross_section
 
 
