@@ -11,6 +11,7 @@ partial table: missing runs are counted in its ``note`` column).
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -49,9 +50,10 @@ def cmd_accuracy_cost(args) -> int:
     if args.tables_only:
         return 0
     if not args.analyze_only:
+        logs = folder / "logs" / time.strftime("%Y%m%d-%H%M%S")   # one folder per call: a rerun keeps earlier logs
         for table, script, n in tables:
-            print(f"running {table.name}: {n} rows, {args.jobs} at a time (logs in {folder / 'logs'})", flush=True)
-            run_batch(table, REPO / "yade_scripts" / script, args.jobs, folder / "logs" / table.stem, repo=REPO,
+            print(f"running {table.name}: {n} rows, {args.jobs} at a time (logs in {logs})", flush=True)
+            run_batch(table, REPO / "yade_scripts" / script, args.jobs, logs / table.stem, repo=REPO,
                       watch=[], progress=None)
     return summarise(study)
 
