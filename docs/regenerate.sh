@@ -27,7 +27,7 @@ declare -A WHAT=(
   [lifetime_ldb]="README 'Lifetime studies' paper size, 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
   [creep_numerics]="README 'creep numerics' (params/creep_numerics_small.table): about 1 h"
   [brazilian]="README 'Brazilian test' (params/brazilian_ldb.table, docs/brazilian_study.sh)"
-  [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 3 h on 2 cores"
+  [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
   [accuracy_cost_paper_size]="README 'What accuracy costs in time', paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )

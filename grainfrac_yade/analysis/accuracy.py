@@ -184,7 +184,7 @@ def markdown_table(table: pd.DataFrame, ratios) -> str:
 
 def pareto_figure(table: pd.DataFrame, path, title: str = "What accuracy costs in time"):
     """Error against cost per creep run (CPU time where every run has it, else wall time), log axes, one
-    series per knob; a reference (error 0) sits at :data:`ZERO_ERROR_FLOOR`, drawn hollow."""
+    series per knob; an error of 0 (a reference, or a setting equal to it) sits at :data:`ZERO_ERROR_FLOOR`, hollow."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -207,7 +207,8 @@ def pareto_figure(table: pd.DataFrame, path, title: str = "What accuracy costs i
     ax.set_yscale("log")
     ax.set_xlabel(("CPU" if cost == "cpu_s_per_run" else "wall") + " time per creep run [s] (one core)")
     ax.set_ylabel("error: mean |ln t_f - ln t_f,ref| over seeds and ratios")
-    ax.set_title(title + f"\n(reference of each knob: hollow marker at {ZERO_ERROR_FLOOR:g})", fontsize=9)
+    ax.set_title(title + f"\n(error 0, each knob's reference and settings equal to it: hollow, at {ZERO_ERROR_FLOOR:g})",
+                 fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
