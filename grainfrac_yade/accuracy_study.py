@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import GrainfracError
-from .params import default_files, flatten, load_parameters, read_toml
+from .params import flat_values, load_parameters, read_toml, shipped_values
 
 #: The shipped defaults' setting: in every knob's series, never itself a knob.
 DEFAULT_SETTING = "default"
@@ -170,19 +170,13 @@ def geometry_overrides(study: Study) -> dict:
 
 def setting_columns(study: Study, setting: Setting, repo) -> dict:
     """{"section.key": value} of the setting: its files, then its overrides, then the study's geometry."""
-    out = {}
-    for f in setting.files:
-        out.update(flatten(read_toml(Path(repo) / f)))
-    out.update(setting.overrides)
-    out.update(geometry_overrides(study))
-    return out
+    return flat_values([Path(repo) / f for f in setting.files],
+                       list(setting.overrides.items()) + list(geometry_overrides(study).items()))
 
 
 def _fill(rows: list) -> list:
     """Every row with every column: a key a row does not set gets its shipped value."""
-    shipped = {}
-    for f in default_files():
-        shipped.update(flatten(read_toml(f)))
+    shipped = shipped_values()
     keys = []
     for r in rows:
         keys += [k for k in r if k not in keys]
@@ -209,14 +203,17 @@ def creep_rows(study: Study, repo) -> list:
     return _fill(rows)
 
 
-def setting_of_folder(study: Study, folder) -> tuple:
-    """(setting name, test, ratio or None, seed) of a run folder of the study; None if not one of its runs."""
-    folder = Path(folder)
+def run_index(study: Study) -> dict:
+    """{run folder: (setting name, test, ratio or None, seed)} of every run the study plans."""
+    index = {}
     for s in study.settings:
         for seed in study.seeds:
-            if folder == study.run_folder(s, "ucs", seed):
-                return s.name, "ucs", None, seed
+            index[study.run_folder(s, "ucs", seed)] = (s.name, "ucs", None, seed)
             for ratio in study.ratios:
-                if folder == study.run_folder(s, "creep", seed, ratio):
-                    return s.name, "creep", ratio, seed
-    return None
+                index[study.run_folder(s, "creep", seed, ratio)] = (s.name, "creep", ratio, seed)
+    return index
+
+
+def setting_of_folder(study: Study, folder) -> tuple:
+    """(setting name, test, ratio or None, seed) of a run folder of the study; None if not one of its runs."""
+    return run_index(study).get(Path(folder))

@@ -558,6 +558,23 @@ def default_files() -> list:
     return [PARAMS_DIR / name for name in DEFAULT_FILES]
 
 
+def shipped_values() -> dict:
+    """The shipped parameters, flattened: {"section.key": value} (unvalidated, as the files write them)."""
+    return flat_values(default_files())
+
+
+def flat_values(files, overrides=()) -> dict:
+    """Parameter ``files`` merged in order, then ``overrides`` (``section.key=value`` strings or (key, value)
+    pairs), as {"section.key": value}: the columns of a yade-batch row."""
+    out = {}
+    for path in files:
+        out.update(flatten(read_toml(path)))
+    for item in overrides:
+        key, value = parse_override(item) if isinstance(item, str) else item
+        out[key] = value
+    return out
+
+
 def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
     """Load, merge and validate parameters.
 

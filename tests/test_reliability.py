@@ -378,8 +378,9 @@ def test_a_key_older_params_files_lack_counts_as_its_default(tmp_path):
                                              ("beta1", "stress_corrosion.beta1"), ("sed", "seed"),
                                              ("on_chnage", "on_change"), ("specimen.widht", "specimen.width")])
 def test_a_misspelt_column_names_the_nearest_valid_key(column, nearest):
-    from grainfrac_yade.yade_adapter.batch import RUN_COLUMNS, check_columns, parameter_defaults
-    valid = {**parameter_defaults(), **RUN_COLUMNS, "ratio": 0.0}
+    from grainfrac_yade.params import shipped_values
+    from grainfrac_yade.yade_adapter.batch import RUN_COLUMNS, check_columns
+    valid = {**shipped_values(), **RUN_COLUMNS, "ratio": 0.0}
     check_columns(["specimen.width", "seed", "description", "!note"], valid, "t.table:2")   # all valid: quiet
     with pytest.raises(GrainfracError) as err:
         check_columns(["seed", column], valid, "t.table:2")

@@ -13,11 +13,12 @@ Pareto figure's abscissa where every run has it).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..accuracy_study import DEFAULT_SETTING, Study, setting_of_folder
+from ..accuracy_study import DEFAULT_SETTING, Study, run_index
 from .lifetimes import outcome
 
 #: Where a zero error (the reference itself) sits on the log axis of the Pareto figure.
@@ -27,9 +28,10 @@ ZERO_ERROR_FLOOR = 1e-3
 def label_runs(study: Study, runs: pd.DataFrame) -> pd.DataFrame:
     """``runs`` (:func:`~grainfrac_yade.analysis.collect.collect_runs` of the study folder) with the columns
     setting, test, ratio_planned, seed_planned and outcome; folders that are not the study's are dropped."""
+    index = run_index(study)
     rows = []
     for _, row in runs.iterrows():
-        where = setting_of_folder(study, row["folder"])
+        where = index.get(Path(row["folder"]))
         if where is None:
             continue
         d = row.to_dict()

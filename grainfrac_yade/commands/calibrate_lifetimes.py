@@ -105,10 +105,10 @@ class BatchModel:
     yade-batch (missing rows only) or reused from the study."""
 
     def __init__(self, args, params, ratios, seeds, ucs, study: Path, progress=print):
-        from .demo import _flat_overrides
+        from ..params import flat_values
         self.args, self.params, self.ratios, self.seeds, self.ucs = args, params, ratios, seeds, ucs
         self.study, self.progress = study, progress
-        self.base = _flat_overrides(args.params, args.resolved_overrides)
+        self.base = flat_values(args.params, args.resolved_overrides)
         self.beta2_key = BETA2_KEY[params.stress_corrosion.law]
         self.runs = 0
 

@@ -48,7 +48,7 @@ def _say(t0, msg):
 def cmd_demo(args, params) -> int:
     from ..batchrun import run_batch, write_table
     from ..errors import GrainfracError
-    from ..params import require_plane
+    from ..params import flat_values, require_plane
     from .specimen import run_specimen
     t0 = time.time()
     repo = Path(__file__).resolve().parents[2]
@@ -56,7 +56,7 @@ def cmd_demo(args, params) -> int:
     if out.exists() and any(out.iterdir()) and not args.overwrite:
         raise GrainfracError(f"{out} already holds results; fix: choose another --out or add --overwrite")
     require_plane(params, "demo")   # params: loaded (--params/--set validated) before anything runs
-    extra = _flat_overrides(args.params, args.resolved_overrides)   # --set and --width/--height
+    extra = flat_values(args.params, args.resolved_overrides)   # --params, --set and --width/--height
     _say(t0, f"specimen {args.width * 1e3:.0f} x {args.height * 1e3:.0f} mm, seeds {args.seeds}, "
              f"ratios {args.ratios}, {args.jobs} jobs -> {out}")
     rec = run_specimen(params, args.seeds[0], out / "specimen", overwrite=args.overwrite)
@@ -87,18 +87,6 @@ def cmd_demo(args, params) -> int:
     report = analyze_study(out / "creep")
     _say(t0, f"done. Report: {report}")
     return 0
-
-
-def _flat_overrides(files, overrides) -> dict:
-    """``--params`` files and ``section.key=value`` overrides as {path: value} columns of table rows."""
-    from ..params import flatten, parse_override, read_toml
-    out = {}
-    for path in files:
-        out.update(flatten(read_toml(path)))
-    for item in overrides:
-        key, value = parse_override(item) if isinstance(item, str) else item
-        out[key] = value
-    return out
 
 
 def _read(folder: Path) -> dict:

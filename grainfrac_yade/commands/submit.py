@@ -57,14 +57,15 @@ def choose_script(table, script) -> Path:
 
 def check_table_columns(table, command: str) -> None:
     """Columns must be parameter paths or run columns the script reads (one line naming the column)."""
-    from ..yade_adapter.batch import RUN_COLUMNS, check_columns, parameter_defaults   # pure: no YADE import
+    from ..params import shipped_values
+    from ..yade_adapter.batch import RUN_COLUMNS, check_columns   # pure: no YADE import
     extra = {}
     if command == "creep":
         from .creep import CREEP_ROW_COLUMNS
         extra = CREEP_ROW_COLUMNS
     elif command not in ("ucs",):
         return   # another script: its own columns
-    valid = {**parameter_defaults(), **RUN_COLUMNS, **extra}
+    valid = {**shipped_values(), **RUN_COLUMNS, **extra}
     check_columns(table.columns, valid, str(table.path))
 
 

@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..errors import GrainfracError
-from ..params import default_files, flatten, nearest_key, read_toml
+from ..params import nearest_key, shipped_values
 from ..runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
 from . import load_yade
 
@@ -30,14 +30,6 @@ from . import load_yade
 RUN_COLUMNS = {"seed": 1, "out": "", "study": "default", "description": "", "on_change": "stop"}
 #: What a row does when its folder holds a finished run with other parameters (column ``on_change``).
 ON_CHANGE = ("stop", "new_folder")
-
-
-def parameter_defaults() -> dict:
-    """Flattened shipped parameters: {"section.key": value}."""
-    merged = {}
-    for path in default_files():
-        merged.update(flatten(read_toml(path)))
-    return merged
 
 
 def check_columns(columns, valid, where: str) -> None:
@@ -59,7 +51,7 @@ def read_table(extra_columns=None) -> tuple:
     """
     yade = load_yade()
     from yade import utils
-    defaults = parameter_defaults()
+    defaults = shipped_values()
     run_defaults = dict(RUN_COLUMNS, **(extra_columns or {}))
     spec = os.environ.get("YADE_BATCH", "")
     if spec:
