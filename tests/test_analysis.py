@@ -270,6 +270,14 @@ def test_cli_analyze_writes_report_and_all_figures(tmp_path):
         _check_png(study / "report" / name)
         assert f"]({name})" in text
     assert "paper_values.csv" in text and "Lajtai & Schmidtke (1986)" in text and "none are drawn or invented" in text
+    # cracks by phase of the life: every failed run's cracks, each counted once over ramp + four phases
+    phases = pd.read_csv(study / "report" / "crack_phases.csv")
+    assert "](crack_phases.md)" in text and (study / "report" / "crack_phases.md").exists()
+    failed = sorted(f"ratio{r}_seed{s}" for r in RATIOS for s in (1, 2, 3))
+    assert sorted(phases["run"].unique()) == failed
+    for run, block in phases.groupby("run"):
+        n_cracks = len(pd.read_csv(study / run / "cracks.csv"))
+        assert block["cracks"].iloc[:5].sum() == n_cracks, run
     assert folder_digest(study) == before
 
 

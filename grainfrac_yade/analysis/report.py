@@ -66,6 +66,11 @@ CONFINEMENT_TABLE = {
     "n_failed": ("failed", "d"), "lifetime_geomean_s": ("geometric mean lifetime [s]", ".3g"),
     "lifetime_min_s": ("min [s]", ".3g"), "lifetime_max_s": ("max [s]", ".3g"),
 }
+CRACK_PHASE_TABLE = {
+    "run": ("run", ""), "seed": ("seed", ""), "driving_stress_ratio": ("ratio", ".3f"), "phase": ("phase", ""),
+    "cracks": ("cracks (bonds)", "d"), "tensile_share": ("tensile", ".2f"),
+    "axial_share": ("axial (plane within 30 deg of the load)", ".2f"), "inter_share": ("inter-granular", ".2f"),
+}
 STATS_COLUMNS = {
     "dataset": ("data set", ""), "driving_stress_ratio": ("ratio", ".4f"), "n": ("n", "d"),
     "geomean_lifetime_s": ("geometric mean lifetime [s]", ".4g"),

@@ -15,14 +15,14 @@ import pandas as pd
 
 from ..errors import GrainfracError
 from ..runio import RESULT_NEUTRAL_KEYS, write_csv
-from . import crackmaps, figures, rescale
+from . import crack_phases, crackmaps, figures, rescale
 from .collect import code_version_note, collect_runs, flatten
 from .figures import MAP_FRACTIONS, Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
 from .lifetimes import (_num, classify_runs, confinement_lifetimes, lifetime_stats, representatives,
                         with_confinement_columns)
-from .report import CONFINEMENT_TABLE, ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
+from .report import CONFINEMENT_TABLE, CRACK_PHASE_TABLE, ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
 from .runparams import default_tree, rebuild_specimen
 
 #: Parameters that do not make a different model (a longer time limit is the same model; how often a run
@@ -309,6 +309,28 @@ def _grains(focus, cracks) -> tuple:
     return rebuilt.specimen, f"Crack maps drawn on the run's grains (cells coloured by mineral): {rebuilt.note}."
 
 
+def crack_phase_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Cracks by phase of the life (:func:`.crack_phases.crack_phases`) of every failed run with a
+    cracks.csv, one block of rows per run; the inter-granular share of all bonds from the run's
+    bond_stresses_start.csv where it has one."""
+    blocks = []
+    for r in runs[runs["outcome"] == "failed"].to_dict("records"):
+        cracks = read_cracks(r["folder"], _factor(r))
+        life = _num(r.get("lifetime_s"))
+        if cracks is None or not (math.isfinite(life) and life > 0):
+            continue
+        bonds = _read_csv(Path(r["folder"]) / "bond_stresses_start.csv", ("inter",))
+        inter = None if bonds is None else bonds["inter"].astype(str).str.lower().eq("true").to_numpy()
+        block = crack_phases.crack_phases(cracks, life, inter)
+        blocks.append(block.assign(run=r["run"], seed=r.get("seed"), variant=r.get("variant"),
+                                   driving_stress_ratio=r.get("driving_stress_ratio"), lifetime_s=life))
+    if not blocks:
+        return pd.DataFrame(columns=["run", "seed", "variant", "driving_stress_ratio", "lifetime_s",
+                                     *crack_phases.COLUMNS])
+    table = pd.concat(blocks, ignore_index=True)
+    return table[["run", "seed", "variant", "driving_stress_ratio", "lifetime_s", *crack_phases.COLUMNS]]
+
+
 def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=None,
                   map_fractions=MAP_FRACTIONS, beta1=None, beta1_source=None, grains=True) -> Path:
     """Write figures, tables and report.md for the study in ``folder``; return the report's path.
@@ -505,9 +527,15 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     other = int((runs["outcome"] == "not creep").sum())
     if other:
         content.notes.append(f"{other} run folder(s) of other commands (e.g. UCS) are listed but not analysed here.")
+    phases = crack_phase_table(runs)
+    if len(phases):
+        write_csv(out / "crack_phases.csv", phases)
+        (out / "crack_phases.md").write_text(markdown_table(phases, CRACK_PHASE_TABLE) + "\n")
+        content.tables += ["crack_phases.csv", "crack_phases.md"]
     table = runs[[c for c in RUN_TABLE if c in runs]]
     write_csv(out / "runs.csv", table)
-    content.tables = ["runs.csv", "lifetime_fits.csv", "lifetime_fits.md", "lifetime_stats.csv", "lifetime_stats.md"]
+    content.tables = ["runs.csv", "lifetime_fits.csv", "lifetime_fits.md", "lifetime_stats.csv",
+                      "lifetime_stats.md"] + content.tables
     report = out / "report.md"
     report.write_text(render_report(content))
     return report
