@@ -251,6 +251,22 @@ def cell_mass_inertia(specimen: Specimen, params: Parameters, density_scale: flo
     return mass, 0.4 * mass * r**2
 
 
+def step_floor_factors(cell_step, quantile: float) -> np.ndarray:
+    """(n,) factors >= 1 on each cell's mass and inertia that raise every cell's own critical DEM step
+    to at least the ``quantile`` of all cells' steps (per-cell density scaling; a step sqrt(m / k)
+    grows as the square root of the factor).  ``quantile`` 0: all ones (off).  Statics do not depend
+    on masses; only how fast the few stiffest, lightest cells (slivers) oscillate changes."""
+    step = np.asarray(cell_step, float)
+    if not 0.0 <= quantile <= 1.0:
+        raise ValueError(f"quantile must lie in [0, 1], got {quantile!r}")
+    if step.size == 0 or not np.all(np.isfinite(step) & (step > 0)):
+        raise ValueError("every cell's critical step must be finite and positive")
+    if quantile == 0.0:
+        return np.ones_like(step)
+    floor = float(np.quantile(step, quantile))
+    return np.maximum(1.0, (floor / step) ** 2)
+
+
 def _polygon_polar_moment(v: np.ndarray) -> float:
     """Polar second moment of area J_z = I_x + I_y of a CCW polygon about the origin [m^4]."""
     x, y = v[:, 0], v[:, 1]

@@ -115,6 +115,10 @@ class NumericsParams:
     damping: float = _spec("1", "unit_interval_open", "Cundall non-viscous damping")
     timestep_safety: float = _spec("1", "unit_interval_open", "fraction of the critical time step")
     density_scale: float = _spec("1", "positive", "mass scaling factor for quasi-static runs")
+    step_floor_quantile: float = _spec("1", "fraction", "per-cell mass scaling: the cells whose own critical DEM "
+                                       "step lies below this quantile of all cells' steps get their mass and "
+                                       "inertia multiplied so that their step equals it (statics unchanged; the "
+                                       "DEM step of the scene is then that quantile's); 0 = off")
 
 
 @dataclass(frozen=True, kw_only=True)

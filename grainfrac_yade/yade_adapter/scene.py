@@ -36,7 +36,8 @@ import numpy as np
 
 from ..errors import GrainfracError, NumericalFailure
 from ..law import check_finite
-from ..layout import BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for
+from ..layout import (BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for,
+                      step_floor_factors)
 from ..params import Parameters
 from ..specimen import Specimen
 from . import load_yade
@@ -339,9 +340,10 @@ def _blocked_dofs(dim: int) -> str:
     return "zXY" if dim == 2 else ""
 
 
-def _oscillation_step(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq: np.ndarray,
-                      mass: np.ndarray, inertia: np.ndarray) -> float:
-    """min over bodies of sqrt(m/K) and sqrt(I/K_rot) for springs of stiffness ``k`` joining ``ends`` (c, 2).
+def _oscillation_steps(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq: np.ndarray,
+                       mass: np.ndarray, inertia: np.ndarray | None) -> np.ndarray:
+    """(n_bodies,) the smaller of sqrt(m/K) and sqrt(I/K_rot) of each body, for springs of stiffness ``k``
+    joining ``ends`` (c, 2).
 
     K sums k over a body's springs, K_rot sums k x ``lever_sq`` ((2c,): the first ends' squared
     lever arms, then the second ends').  ``inertia`` None: bodies that do not rotate, sqrt(m/K) only.
@@ -350,11 +352,11 @@ def _oscillation_step(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq: 
     with np.errstate(divide="ignore"):
         t_trans = np.sqrt(mass / k_body)
         if inertia is None:
-            return float(t_trans.min())
+            return t_trans
         k_rot = np.bincount(np.concatenate([ends[:, 0], ends[:, 1]]), weights=np.tile(k, 2) * lever_sq,
                             minlength=n_bodies)
         t_rot = np.sqrt(inertia / k_rot)
-    return float(min(t_trans.min(), t_rot.min()))
+    return np.minimum(t_trans, t_rot)
 
 
 def _links(layout: ClumpLayout):
@@ -364,10 +366,10 @@ def _links(layout: ClumpLayout):
     return layout.link_spheres, layout.link_normal_stiffness, layout.link_shear_stiffness
 
 
-def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
-                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
-                      rotating: bool = True, ratcheting_guard: bool = True) -> float:
-    """Conservative critical DEM time step [s]: min over bodies of sqrt(m/K) and sqrt(I/K_rot).
+def body_steps(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
+               mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
+               rotating: bool = True, ratcheting_guard: bool = True) -> np.ndarray:
+    """Each body's own critical DEM step [s]: sqrt(m/K), and sqrt(I/K_rot) where it rotates.
 
     Rigid cells: the bodies are the cells (``mass``, ``inertia`` per cell; ``body_pos`` (n, 3)
     the cell bodies' positions).  K sums k_n + k_s of a cell's bonds; K_rot sums
@@ -385,8 +387,8 @@ def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Spec
         cells = specimen.tessellation.face_cells[layout.bond_face]
         lever = np.concatenate([layout.bond_point - body_pos[cells[:, 0]],
                                 layout.bond_point - body_pos[cells[:, 1]]])
-        return _oscillation_step(specimen.n_cells, cells, props.normal_stiffness + props.shear_stiffness,
-                                 (lever**2).sum(1), mass, inertia)
+        return _oscillation_steps(specimen.n_cells, cells, props.normal_stiffness + props.shear_stiffness,
+                                  (lever**2).sum(1), mass, inertia)
     link_spheres, link_kn, link_ks = _links(layout)
     ends = np.concatenate([layout.bond_spheres, link_spheres]).astype(np.int64)
     k = np.concatenate([props.normal_stiffness + props.shear_stiffness, link_kn + link_ks])
@@ -394,17 +396,28 @@ def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Spec
     d = np.linalg.norm(layout.sphere_center[ends[:, 0]] - layout.sphere_center[ends[:, 1]], axis=1)
     torque_lever = np.maximum(r, 0.5 * (d[:, None] + r - r[:, ::-1]))
     lever_sq = ((r if ratcheting_guard else torque_lever) * torque_lever).T.ravel()
-    return _oscillation_step(layout.n_spheres, ends, k, lever_sq, mass, inertia if rotating else None)
+    return _oscillation_steps(layout.n_spheres, ends, k, lever_sq, mass, inertia if rotating else None)
 
 
-def fem_critical_timestep(specimen: Specimen, params: Parameters, layout: ClumpLayout, mass: np.ndarray) -> float:
-    """Conservative critical DEM step of finite-element cells [s]: min over spheres of sqrt(m / K),
-    K the Gershgorin bound of the sphere's stiffness row (elements and bonds,
-    :func:`grainfrac_yade.elastic.node_stiffness`)."""
+def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
+                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
+                      rotating: bool = True, ratcheting_guard: bool = True) -> float:
+    """Conservative critical DEM time step [s]: the smallest of the bodies' own steps (:func:`body_steps`)."""
+    return float(body_steps(layout, props, specimen, mass, inertia, body_pos, rotating, ratcheting_guard).min())
+
+
+def fem_node_stiffness(specimen: Specimen, params: Parameters, layout: ClumpLayout) -> np.ndarray:
+    """(s,) Gershgorin bound of each sphere's stiffness row in finite-element cells [N/m] (elements and
+    bonds, :func:`grainfrac_yade.elastic.node_stiffness`): a sphere's own step is sqrt(m / K)."""
     from ..elastic import cluster_network, node_stiffness
-    k = node_stiffness(cluster_network(specimen, params, layout))
-    with np.errstate(divide="ignore"):
-        return float(np.sqrt(mass / k).min())
+    return node_stiffness(cluster_network(specimen, params, layout))
+
+
+def cell_steps(body_step: np.ndarray, body_cell: np.ndarray, n_cells: int) -> np.ndarray:
+    """(n_cells,) the smallest own step of each cell's bodies [s]."""
+    steps = np.full(n_cells, np.inf)
+    np.minimum.at(steps, body_cell, body_step)
+    return steps
 
 
 def _cell_spheres(layout: ClumpLayout, n_cells: int) -> list:
@@ -623,12 +636,27 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         newton,
     ]
     blocked = _blocked_dofs(dim) if layout.rigid_cells else DEFORMABLE_BLOCKED_DOFS
+    rotating = "Z" not in blocked
+    floor = params.numerics.step_floor_quantile
+    fem_k = fem_node_stiffness(specimen, params, layout) if layout.n_elements else None
     if layout.rigid_cells:
         sphere_body, cell_body, body_pos3, inertia = _append_rigid_cells(
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
         cell_bodies = [cell_body[c:c + 1] for c in range(specimen.n_cells)]
+        if floor > 0:
+            f = step_floor_factors(body_steps(layout, props, specimen, mass, inertia, body_pos3, rotating,
+                                              geometry.avoidGranularRatcheting), floor)
+            mass, inertia = mass * f, inertia * f
+            for cell, body in enumerate(cell_body):
+                st = O.bodies[int(body)].state
+                st.mass, st.inertia = float(mass[cell]), Vector3(*([float(inertia[cell])] * 3))
     else:
         mass, inertia = sphere_mass_inertia(specimen, layout, mass)
+        if floor > 0:
+            own = (np.sqrt(mass / fem_k) if fem_k is not None else
+                   body_steps(layout, props, specimen, mass, inertia, None, rotating, geometry.avoidGranularRatcheting))
+            f = step_floor_factors(cell_steps(own, layout.sphere_cell, specimen.n_cells), floor)[layout.sphere_cell]
+            mass, inertia = mass * f, inertia * f
         body_pos3 = None
         sphere_body, cell_body, cell_bodies = _append_deformable_cells(
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
@@ -660,9 +688,10 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             moving[s] = clump_id
         cell_body = np.array([moving[np.flatnonzero(sphere_body == b)[0]] for b in cell_body], dtype=np.int64)
         cell_bodies = [moving[m] for m in _cell_spheres(layout, specimen.n_cells)]
-        dt_crit = fem_critical_timestep(specimen, params, layout, mass)
+        with np.errstate(divide="ignore"):
+            dt_crit = float(np.sqrt(mass / fem_k).min())
     else:
-        dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating="Z" not in blocked,
+        dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating=rotating,
                                     ratcheting_guard=geometry.avoidGranularRatcheting)
     if not 0 < dt_crit < math.inf:
         raise GrainfracError(f"the scene's critical DEM step is {dt_crit:g} s (a cell without mass, or no bond "
