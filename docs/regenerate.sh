@@ -29,6 +29,7 @@ declare -A WHAT=(
   [brazilian]="README 'Brazilian test' (params/brazilian_ldb.table, docs/brazilian_study.sh)"
   [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
   [accuracy_cost_paper_size]="README 'What accuracy costs in time', paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
+  [step_floor]="README 'What accuracy costs in time', per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
   [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -69,6 +70,7 @@ run_target() {
     accuracy_cost) $PY -m grainfrac_yade accuracy-cost --jobs 2
                    cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
+    step_floor) $PY docs/step_floor_steps.py ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
                               $PY -m grainfrac_yade analyze results/accuracy_cost_paper_size ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
@@ -81,7 +83,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
 fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration resolution fem_ucs fem_creep lattice lifetime_small
-                           lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size)
+                           lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
