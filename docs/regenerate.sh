@@ -19,9 +19,10 @@ declare -A WHAT=(
   [elastic]="README 'Deformable grains' tables, docs/elastic_reference.md (static solves, no YADE): about 5 min on one core"
   [bench]="README 'Benchmark', docs/bench.json: about 6 min on one core"
   [calibration]="README 'Calibration', params/calibration.toml (rigid cells, 5 seeds x 2 rounds): about 35 min"
+  [calibration_check]="README 'Calibration' and 'Resolution' paper-size rows: the shipped factors measured again (params/calibration_check_ldb.table): about 25 min on one core"
   [resolution]="README 'Resolution' (params/resolution_small.table): about 20 min"
   [fem_ucs]="README 'Finite-element grains' UCS table (params/fem_ucs_small.table): about 30 min"
-  [fem_creep]="README 'Finite-element grains' creep table (params/fem_creep_small.table): 2-4 h"
+  [fem_creep]="README 'Finite-element grains' creep table and the fem beta1 (params/fem_creep_small.table): about 20 min on 2 cores"
   [lattice]="README 'spring-lattice option' (params/deformable_*.table): about 3 h"
   [lifetime_small]="README 'Lifetime studies' 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
   [lifetime_ldb]="README 'Lifetime studies' paper size, 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
@@ -38,12 +39,15 @@ run_target() {
     elastic) bash docs/elastic_study.sh ;;
     bench) $PY -m grainfrac_yade bench ;;
     calibration) $PY -m grainfrac_yade calibrate --seeds 1 2 3 4 5 --rounds 2 --jobs 2 ;;
+    calibration_check) batch params/calibration_check_ldb.table ucs.py calibration_check
+                       $PY -m grainfrac_yade analyze-ucs results/calibration_check ;;
     resolution) batch params/resolution_small.table ucs.py resolution
                 $PY -m grainfrac_yade analyze-ucs results/resolution ;;
     fem_ucs) batch params/fem_ucs_small.table ucs.py fem_ucs
              $PY -m grainfrac_yade analyze-ucs results/fem_ucs ;;
     fem_creep) batch params/fem_creep_small.table creep.py fem_creep
-               $PY -m grainfrac_yade analyze results/fem_creep ;;
+               $PY -m grainfrac_yade analyze results/fem_creep
+               $PY -m grainfrac_yade calibrate-beta1 results/fem_creep --out params/presets/fem_stress_corrosion_calibrated.toml ;;
     lattice) batch params/deformable_ucs_small.table ucs.py deformable_ucs
              batch params/deformable_creep_small.table creep.py deformable_creep
              batch params/deformable_scaled_small.table ucs.py deformable_scaled
@@ -82,7 +86,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
   exit 0
 fi
 targets=("$@")
-[ "$1" = all ] && targets=(elastic bench calibration resolution fem_ucs fem_creep lattice lifetime_small
+[ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lattice lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
