@@ -420,6 +420,16 @@ def cell_steps(body_step: np.ndarray, body_cell: np.ndarray, n_cells: int) -> np
     return steps
 
 
+def lift_short_steps(quantile: float, body_step: np.ndarray, body_cell: np.ndarray, mass: np.ndarray,
+                     inertia: np.ndarray) -> tuple:
+    """Per-body ``mass`` and ``inertia`` with ``numerics.step_floor_quantile`` applied: every body of a cell
+    whose smallest own step (``body_step``, bodies of cell ``body_cell``) lies below the quantile of the
+    cells' steps is made heavier by the cell's :func:`grainfrac_yade.layout.step_floor_factors`."""
+    n_cells = int(body_cell.max()) + 1
+    f = step_floor_factors(cell_steps(body_step, body_cell, n_cells), quantile)[body_cell]
+    return mass * f, inertia * f
+
+
 def _cell_spheres(layout: ClumpLayout, n_cells: int) -> list:
     """Sphere indices of each cell, ascending."""
     order = np.argsort(layout.sphere_cell, kind="stable")
@@ -644,9 +654,9 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
         cell_bodies = [cell_body[c:c + 1] for c in range(specimen.n_cells)]
         if floor > 0:
-            f = step_floor_factors(body_steps(layout, props, specimen, mass, inertia, body_pos3, rotating,
-                                              geometry.avoidGranularRatcheting), floor)
-            mass, inertia = mass * f, inertia * f
+            own = body_steps(layout, props, specimen, mass, inertia, body_pos3, rotating,
+                             geometry.avoidGranularRatcheting)
+            mass, inertia = lift_short_steps(floor, own, np.arange(specimen.n_cells), mass, inertia)
             for cell, body in enumerate(cell_body):
                 st = O.bodies[int(body)].state
                 st.mass, st.inertia = float(mass[cell]), Vector3(*([float(inertia[cell])] * 3))
@@ -655,8 +665,7 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         if floor > 0:
             own = (np.sqrt(mass / fem_k) if fem_k is not None else
                    body_steps(layout, props, specimen, mass, inertia, None, rotating, geometry.avoidGranularRatcheting))
-            f = step_floor_factors(cell_steps(own, layout.sphere_cell, specimen.n_cells), floor)[layout.sphere_cell]
-            mass, inertia = mass * f, inertia * f
+            mass, inertia = lift_short_steps(floor, own, layout.sphere_cell, mass, inertia)
         body_pos3 = None
         sphere_body, cell_body, cell_bodies = _append_deformable_cells(
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
