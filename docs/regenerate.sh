@@ -61,6 +61,8 @@ run_target() {
     lifetime_ldb) batch params/lifetime_ldb.table creep.py lifetime_ldb
                   batch params/lifetime_ldb_beta2x3.table creep.py lifetime_ldb_beta2x3
                   $PY -m grainfrac_yade analyze results/lifetime_ldb
+                  $PY -m grainfrac_yade analyze results/lifetime_ldb_beta2x3
+                  cp results/lifetime_ldb_beta2x3/report/lifetime.png docs/figures/lifetime_ldb_beta2x3_seed1.png
                   $PY -m grainfrac_yade calibrate-beta1 results/lifetime_ldb ;;
     creep_numerics) batch params/creep_numerics_small.table creep.py creep_numerics ;;
     brazilian) if [ -f docs/brazilian_study.sh ]; then bash docs/brazilian_study.sh
