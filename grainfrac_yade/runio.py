@@ -10,6 +10,7 @@ claims completion.
 from __future__ import annotations
 
 import datetime as _dt
+import functools
 import hashlib
 import json
 import math
@@ -40,8 +41,13 @@ CHECKPOINT_STATE = "state.json"
 CHECKPOINT_TMP, CHECKPOINT_OLD = CHECKPOINT + ".tmp", CHECKPOINT + ".old"
 
 
+@functools.lru_cache(maxsize=None)
 def code_version() -> str:
-    """Package version plus the git commit of the source tree (``+dirty`` if modified)."""
+    """Package version plus the git commit of the source tree (``+dirty`` if modified).
+
+    Read once per process: a process runs the code it imported at its start, so a run's summary.json
+    names that code even when the checkout changes while it runs (found: a 20-minute creep run whose
+    summary named a commit made during the run)."""
     root = Path(__file__).resolve().parent.parent
     try:
         rev = subprocess.run(["git", "-C", str(root), "describe", "--always", "--dirty", "--abbrev=12"],

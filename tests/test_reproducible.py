@@ -107,3 +107,12 @@ def test_analysis_warns_when_a_study_mixes_code_versions():
     note = code_version_note(mixed)
     assert "2 code versions" in note and "0.1.0+bbb-dirty: 1 run(s)" in note
     assert code_version_note(mixed.iloc[:2]) is None
+
+
+def test_code_version_is_read_once_per_process(monkeypatch):
+    """A run's summary names the code its process imported, even if the checkout changes meanwhile."""
+    from grainfrac_yade import runio
+    first = runio.code_version()
+    calls = []
+    monkeypatch.setattr(runio.subprocess, "run", lambda *a, **k: calls.append(a) or (_ for _ in ()).throw(OSError))
+    assert runio.code_version() == first and calls == []
