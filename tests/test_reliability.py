@@ -177,6 +177,20 @@ def test_zero_intervals_that_break_bonds_are_progress_not_a_stall():
     assert n_events == 1 and clock.n_events == 1 and bonds.scene.broken.all() and holder.relaxations == 2
 
 
+def test_a_run_failing_in_its_first_relaxation_records_that_state():
+    """A specimen that fails in the relaxation right after its ramp (fem cells, 10 x 20 mm, seed 3 at
+    0.85: a slow cascade that never settles) ends at creep time 0 with a history row of that state, so
+    its cracks count; the row was missing and the summary counted only the ramp's cracks."""
+    class FailingFirst(StandInHolder):
+        def relax(self, creep_time):
+            super().relax(creep_time)
+            self.failed, self.failure_reason = True, "no equilibrium at the held load (strain runs away)"
+            return False
+    holder = FailingFirst()
+    n_events, holder, clock = _event_loop(StandInBonds([1e6], [0.0], JT, JC), holder)
+    assert n_events == 0 and holder.rows == [0.0] and holder.relaxations == 1 and clock.creep_time == 0.0
+
+
 def test_event_loop_on_nan_stresses_raises_instead_of_ending_not_failed():
     bonds = StandInBonds([1e6, math.nan], [0.0, 0.0], JT, JC)
     holder = StandInHolder()

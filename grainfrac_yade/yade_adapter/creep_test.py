@@ -408,9 +408,10 @@ def event_clock_loop(holder, corr, clock, resume=None) -> int:
     safe_point = getattr(holder, "safe_point", _no_checkpoint)
     if resume is None:
         n_events = stalled = 0
-        if not holder.relax(0.0):
+        ok = holder.relax(0.0)
+        holder.record_now(0.0)   # also when that first relaxation fails: its cracks belong to the run
+        if not ok:
             return n_events
-        holder.record_now(0.0)
     else:
         n_events, stalled = int(resume["n_events"]), int(resume["stalled"])
     while True:
