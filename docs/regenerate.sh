@@ -36,7 +36,8 @@ declare -A WHAT=(
 
 run_target() {
   case "$1" in
-    elastic) bash docs/elastic_study.sh ;;
+    elastic) bash docs/elastic_study.sh
+             cp results/elastic_study/w31.7e-3_s2_deformable_k2_r1_cells/contact_stress_histogram.png docs/figures/elastic_contact_stress_ldb_seed2.png ;;
     bench) $PY -m grainfrac_yade bench ;;
     calibration) $PY -m grainfrac_yade calibrate --seeds 1 2 3 4 5 --rounds 2 --jobs 2 ;;
     calibration_check) batch params/calibration_check_ldb.table ucs.py calibration_check
