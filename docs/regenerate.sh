@@ -31,6 +31,7 @@ declare -A WHAT=(
   [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
   [accuracy_cost_paper_size]="README 'What accuracy costs in time', paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="README 'What accuracy costs in time', per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
+  [threshold]="README 'Long-term strength (activation threshold)' table (params/threshold_study_tiny.table, 4 x 8 mm): about 10 min on 2 cores"
   [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -78,6 +79,11 @@ run_target() {
                    cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
     step_floor) $PY docs/step_floor_steps.py ;;
+    threshold) for s in 1 2; do $PY -m grainfrac_yade ucs --width 4e-3 --height 8e-3 --seed $s \
+                   --out results/threshold_tiny/ucs_seed$s --overwrite; done
+               batch params/threshold_study_tiny.table creep.py threshold_tiny
+               $PY -m grainfrac_yade analyze results/threshold_tiny
+               cp results/threshold_tiny/report/lifetime.png docs/figures/threshold_tiny_lifetime.png ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
                               $PY -m grainfrac_yade analyze results/accuracy_cost_paper_size ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
@@ -90,7 +96,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
 fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lattice lifetime_small
-                           lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor)
+                           lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
