@@ -31,7 +31,7 @@ declare -A WHAT=(
   [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
   [accuracy_cost_paper_size]="README 'What accuracy costs in time', paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="README 'What accuracy costs in time', per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
-  [threshold]="README 'Long-term strength (activation threshold)' table (params/threshold_study_tiny.table, 4 x 8 mm): about 10 min on 2 cores"
+  [threshold]="README 'Long-term strength (activation threshold)' table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
   [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
