@@ -461,12 +461,18 @@ def _append_rigid_cells(O, utils, Vector3, specimen, layout, mats, mass, inertia
     centroid = specimen.tessellation.cell_centroid
     # polygon inertia about the body's reference point (parallel-axis theorem)
     inertia = inertia + mass * ((body_pos - centroid) ** 2).sum(1)
-    for cell, body in enumerate(cell_body):
-        st = O.bodies[int(body)].state
-        st.mass = float(mass[cell])
-        st.inertia = Vector3(*([float(inertia[cell])] * 3))
-        st.blockedDOFs = blocked
+    _set_mass_inertia(O, Vector3, cell_body, mass, inertia, blocked)
     return sphere_body, cell_body, body_pos3, inertia
+
+
+def _set_mass_inertia(O, Vector3, bodies, mass, inertia, blocked=None):
+    """Body ``bodies[i]`` gets ``mass[i]`` and ``inertia[i]`` on all three axes (and ``blocked`` DOFs if given)."""
+    for i, body in enumerate(bodies):
+        st = O.bodies[int(body)].state
+        st.mass = float(mass[i])
+        st.inertia = Vector3(*([float(inertia[i])] * 3))
+        if blocked is not None:
+            st.blockedDOFs = blocked
 
 
 def sphere_mass_inertia(specimen: Specimen, layout: ClumpLayout, cell_mass: np.ndarray):
@@ -489,11 +495,7 @@ def _append_deformable_cells(O, utils, Vector3, specimen, layout, mats, mass, in
     spheres = [utils.sphere(Vector3(*layout.sphere_center[m]), float(layout.sphere_radius[m]),
                             material=mats[specimen.mineral[layout.sphere_cell[m]]]) for m in range(layout.n_spheres)]
     sphere_body = np.asarray(O.bodies.append(spheres), dtype=np.int64)
-    for m, body in enumerate(sphere_body):
-        st = O.bodies[int(body)].state
-        st.mass = float(mass[m])
-        st.inertia = Vector3(*([float(inertia[m])] * 3))
-        st.blockedDOFs = blocked
+    _set_mass_inertia(O, Vector3, sphere_body, mass, inertia, blocked)
     members = _cell_spheres(layout, specimen.n_cells)
     if any(len(m) == 0 for m in members):
         raise GrainfracError("deformable layout: a cell has no sphere; fix: the layout builder must give every "
@@ -657,9 +659,7 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             own = body_steps(layout, props, specimen, mass, inertia, body_pos3, rotating,
                              geometry.avoidGranularRatcheting)
             mass, inertia = lift_short_steps(floor, own, np.arange(specimen.n_cells), mass, inertia)
-            for cell, body in enumerate(cell_body):
-                st = O.bodies[int(body)].state
-                st.mass, st.inertia = float(mass[cell]), Vector3(*([float(inertia[cell])] * 3))
+            _set_mass_inertia(O, Vector3, cell_body, mass, inertia)
     else:
         mass, inertia = sphere_mass_inertia(specimen, layout, mass)
         if floor > 0:
