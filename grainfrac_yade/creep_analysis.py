@@ -5,19 +5,48 @@ be step-like (the event clock moves strain only at events):
 
 1. Normalise time by the lifetime, tau = t / t_f, and interpolate the strain
    linearly onto ``STAGE_GRID`` points of tau in [0, 1].
-2. Strain rate at each grid point = slope of a least-squares line through the
+2. Strain rate at each grid point = slope of the least-squares line through the
    strain within a window of ``STAGE_WINDOW`` of the lifetime centred on it
    (a step inside the window becomes a finite rate, so steps do not make spikes).
+   The slope is the closed form sum((x - mean x) (y - y_0)) / sum((x - mean x)^2):
+   a window where the strain does not change has a rate of exactly 0.
 3. Secondary creep is where the rate is within ``STAGE_RATE_FACTOR`` x its
-   minimum: primary ends at the first such point, tertiary starts after the last.
+   minimum, the minimum taken no lower than ``STAGE_RATE_FLOOR`` x the mean
+   creep rate of the life: primary ends at the first such point, tertiary
+   starts after the last.
+
+The floor is what makes the stages a property of the curve rather than of its
+last bits.  Between two events of the event clock the strain is constant, so the
+smallest local rate is 0, or a rounding residue of 0 from the fit; "within
+1.5 x the minimum" of a residue picks grid points at random, and a 1e-12 change
+of the history (another CPU's rounding) moved the stages by 10 % of the life.
+
+The stages are *not resolved* (None, with the reason) when the history before
+the collapse has fewer than ``STAGE_MIN_EVENTS`` creep times after the start
+(three per stage), when it shows no creep strain, or when no secondary stage
+lies between primary and tertiary creep.
 """
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
 STAGE_GRID = 201          # points on the normalised time axis
 STAGE_WINDOW = 0.1        # fraction of the lifetime used for each local rate
 STAGE_RATE_FACTOR = 1.5   # rate within this factor of the minimum counts as secondary creep
+#: Smallest minimum rate, as a fraction of the mean creep rate over the life (see module doc).
+STAGE_RATE_FLOOR = 0.1
+#: Fewest creep times after the start (events, or records of the paper clock) for three stages:
+#: three per stage.
+STAGE_MIN_EVENTS = 9
+
+
+class CreepStages(NamedTuple):
+    """End of primary and start of tertiary creep [s], or None with ``unresolved`` saying why."""
+    primary_end_s: float | None
+    tertiary_start_s: float | None
+    unresolved: str | None = None
 
 
 def local_rates(time, strain, t_end=None):
@@ -27,30 +56,48 @@ def local_rates(time, strain, t_end=None):
     tau = np.linspace(0.0, 1.0, STAGE_GRID)
     eps = np.interp(tau * t_end, time, strain)
     half = STAGE_WINDOW / 2
-    rate = np.empty_like(tau)
+    rate = np.full_like(tau, np.nan)
     for i, c in enumerate(tau):
         sel = (tau >= c - half) & (tau <= c + half)
-        x = tau[sel] * t_end
-        rate[i] = np.polyfit(x, eps[sel], 1)[0] if np.ptp(x) > 0 else np.nan
+        x, y = tau[sel] * t_end, eps[sel]
+        dx = x - x.mean()
+        sxx = float(np.dot(dx, dx))
+        if sxx > 0:
+            rate[i] = float(np.dot(dx, y - y[0])) / sxx
     return tau, rate
 
 
-def creep_stages(time, strain, t_end=None):
-    """Ends of primary and start of tertiary creep [s]; (None, None) if too few points."""
-    time = np.asarray(time, float)
-    if len(time) < 3 or not np.isfinite(time[-1]) or time[-1] <= 0:
-        return None, None
+def resolve_creep_stages(time, strain, t_end=None) -> CreepStages:
+    """Creep stages of a strain-time history (see module doc); ``t_end`` defaults to the last time."""
+    time, strain = np.asarray(time, float), np.asarray(strain, float)
+    if len(time) < 2 or not np.isfinite(time[-1]):
+        return CreepStages(None, None, "no creep history")
     t_end = float(time[-1]) if t_end is None else float(t_end)
+    if not np.isfinite(t_end) or t_end <= 0:
+        return CreepStages(None, None, "no creep time")
+    n_events = len(np.unique(time[(time > 0) & (time < t_end)]))
+    if n_events < STAGE_MIN_EVENTS:
+        return CreepStages(None, None, f"{n_events} creep times before the collapse, "
+                                       f"at least {STAGE_MIN_EVENTS} needed for three stages")
     tau, rate = local_rates(time, strain, t_end)
-    inner = (tau >= STAGE_WINDOW / 2) & (tau <= 1 - STAGE_WINDOW / 2)
-    r = np.where(inner, rate, np.nan)
-    if not np.any(np.isfinite(r)):
-        return None, None
-    rmin = np.nanmin(np.abs(r))
-    secondary = np.flatnonzero(inner & (np.abs(rate) <= STAGE_RATE_FACTOR * max(rmin, 1e-300)))
-    if not len(secondary):
-        return None, None
-    return float(tau[secondary[0]] * t_end), float(tau[secondary[-1]] * t_end)
+    mean_rate = abs(float(np.interp(t_end, time, strain) - strain[0])) / t_end
+    if not mean_rate > 0:
+        return CreepStages(None, None, "no creep strain")
+    inner = (tau >= STAGE_WINDOW / 2) & (tau <= 1 - STAGE_WINDOW / 2) & np.isfinite(rate)
+    if not inner.any():
+        return CreepStages(None, None, "no local strain rate")
+    magnitude = np.abs(rate)
+    rmin = max(float(np.min(magnitude[inner])), STAGE_RATE_FLOOR * mean_rate)
+    secondary = np.flatnonzero(inner & (magnitude <= STAGE_RATE_FACTOR * rmin))
+    if len(secondary) < 2:
+        return CreepStages(None, None, "no secondary stage between primary and tertiary creep")
+    return CreepStages(float(tau[secondary[0]] * t_end), float(tau[secondary[-1]] * t_end))
+
+
+def creep_stages(time, strain, t_end=None):
+    """(end of primary, start of tertiary creep) [s]; (None, None) when not resolved."""
+    stages = resolve_creep_stages(time, strain, t_end)
+    return stages.primary_end_s, stages.tertiary_start_s
 
 
 def damage_index(broken_count, broken_at_failure):

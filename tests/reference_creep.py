@@ -1,10 +1,13 @@
-"""Reference creep runs of the default law (paper Eq. 7, strength degraded, rigid cells), stored in
-tests/data/ and compared bit for bit by tests/test_reference_creep.py.
+"""Reference creep runs of the default law (paper Eq. 7, strength degraded, rigid cells), stored per
+machine fingerprint in tests/data/reference/<set>/ and compared bit for bit by
+tests/test_reference_creep.py on a machine of the same fingerprint (tests/platform_fingerprint.py).
 
-Made once with ``/usr/bin/python3 tests/reference_creep.py write`` at commit 7e91240 (before the
-degradation laws became the package ``grainfrac_yade.law``); the same command with ``check``
-recomputes them with the code checked out and compares.  One thread (OMP_NUM_THREADS=1), one run
-at a time.
+The set ``intel_xeon`` was made at commit 7e91240 (before the degradation laws became the package
+``grainfrac_yade.law``); ``amd_epyc_avx512_icl`` at commit 8fd3e33, whose default model is the same
+(the intel_xeon set passed its exact test there, on the Intel machine).  On a new machine, at a
+commit known to keep the default model, ``/usr/bin/python3 tests/reference_creep.py write`` adds
+this machine's set (the creep runs and the reproducible UCS run); ``check`` recomputes and compares.
+One thread (OMP_NUM_THREADS=1), one run at a time.
 """
 import os
 import sys
@@ -12,7 +15,8 @@ from pathlib import Path
 
 os.environ["OMP_NUM_THREADS"] = "1"
 ROOT = Path(__file__).resolve().parent.parent
-DATA = Path(__file__).resolve().parent / "data"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from platform_fingerprint import matching_set, set_name, this_platform, write_platform  # noqa: E402
 
 #: name -> (seed, width [m], height [m], driving-stress ratio of 300 MPa, extra overrides)
 RUNS = {
@@ -57,32 +61,58 @@ def run(name, out, extra=WITHOUT_COLLAPSE):
     return {k: summary.get(k) for k in SUMMARY_KEYS}, history, cracks
 
 
-def stored(name):
+def stored(name, folder):
+    """(summary, history, cracks) of reference ``name`` in the stored set ``folder``."""
     import json
 
     import pandas as pd
-    summary = json.loads((DATA / f"reference_creep_{name}.json").read_text())
-    history = pd.read_csv(DATA / f"reference_creep_{name}_history.csv", float_precision="round_trip")
-    cracks = pd.read_csv(DATA / f"reference_creep_{name}_cracks.csv", float_precision="round_trip")
+    summary = json.loads((folder / f"reference_creep_{name}.json").read_text())
+    history = pd.read_csv(folder / f"reference_creep_{name}_history.csv", float_precision="round_trip")
+    cracks = pd.read_csv(folder / f"reference_creep_{name}_cracks.csv", float_precision="round_trip")
     return summary, history, cracks
 
 
-def write(name, tmp):
+def write(name, tmp, folder):
     import json
     summary, history, cracks = run(name, Path(tmp) / name)
-    DATA.mkdir(exist_ok=True)
-    (DATA / f"reference_creep_{name}.json").write_text(json.dumps(summary, indent=1) + "\n")
-    history.to_csv(DATA / f"reference_creep_{name}_history.csv", index=False)
-    cracks.to_csv(DATA / f"reference_creep_{name}_cracks.csv", index=False)
+    (folder / f"reference_creep_{name}.json").write_text(json.dumps(summary, indent=1) + "\n")
+    history.to_csv(folder / f"reference_creep_{name}_history.csv", index=False)
+    cracks.to_csv(folder / f"reference_creep_{name}_cracks.csv", index=False)
     print(name, summary["lifetime_s"], summary["n_events"], summary["dem_steps"])
 
 
+#: The reproducible UCS run of tests/test_reproducible.py (one thread).
+UCS_COMMAND = ["ucs", "--width", "3e-3", "--height", "6e-3", "--seed", "1"]
+
+
+def write_ucs(tmp, folder):
+    import shutil
+    import subprocess
+    out = Path(tmp) / "ucs"
+    subprocess.run([sys.executable, "-m", "grainfrac_yade", *UCS_COMMAND, "--out", str(out)], cwd=ROOT, check=True,
+                   env={**os.environ, "OMP_NUM_THREADS": "1"})
+    (folder / "reproducible_ucs").mkdir(exist_ok=True)
+    for f in ("summary.json", "history.csv"):
+        shutil.copy(out / f, folder / "reproducible_ucs" / f)
+
+
 if __name__ == "__main__":
+    import subprocess
     import tempfile
     with tempfile.TemporaryDirectory() as tmp:
-        for n in (sys.argv[2:] or RUNS):
-            if sys.argv[1] == "write":
-                write(n, tmp)
-            else:
-                a, b = run(n, Path(tmp) / n), stored(n)
-                print(n, a[0] == b[0], a[1].equals(b[1]), a[2].equals(b[2]))
+        if sys.argv[1] == "write":
+            commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                    cwd=ROOT).stdout.strip()
+            folder = write_platform(matching_set() or ROOT / "tests" / "data" / "reference" / set_name(this_platform()),
+                                    note=f"written by tests/reference_creep.py write at commit {commit}")
+            for n in (sys.argv[2:] or RUNS):
+                write(n, tmp, folder)
+            if not sys.argv[2:]:
+                write_ucs(tmp, folder)
+        else:
+            folder = matching_set()
+            if folder is None:
+                sys.exit("no stored set for this machine's fingerprint: `write` one at a commit known to be right")
+            for n in (sys.argv[2:] or RUNS):
+                a, b = run(n, Path(tmp) / n), stored(n, folder)
+                print(n, a[0] == {k: b[0].get(k) for k in a[0]}, a[1].equals(b[1]), a[2].equals(b[2]))

@@ -183,7 +183,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     import time
 
     from ..analysis.figures import MAP_FRACTIONS, run_bond_stress_figure, run_strain_time_figure
-    from ..creep_analysis import creep_stages, damage_index
+    from ..creep_analysis import CreepStages, damage_index, resolve_creep_stages
     from ..params import require_plane
     from ..plotting import crack_map
     from ..runio import (prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
@@ -215,8 +215,9 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     t_end = float(hist["creep_time_s"][-1])
     lifetime = t_end if run.failed and not numerical else None
     # stages from the history before the collapse row (the failure itself would dominate every rate)
-    primary_end, tertiary_start = (creep_stages(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end)
-                                   if lifetime is not None and len(rows) > 3 else (None, None))
+    stages = (resolve_creep_stages(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end)
+              if lifetime is not None and len(rows) > 3
+              else CreepStages(None, None, "no lifetime" if lifetime is None else "too short a history"))
     hist["broken_creep"] = broken_creep
     hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
     if run.rows:
@@ -233,7 +234,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
         "cpu_s": time.process_time() - c0,
-        "primary_end_s": primary_end, "tertiary_start_s": tertiary_start,
+        "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
+        "creep_stages": stages.unresolved or "resolved",
         "vtk_creep_times_s": run.vtk_written,
         **summary_header(params, seed),
     }

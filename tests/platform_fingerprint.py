@@ -1,0 +1,80 @@
+"""The software and CPU a stored exact result was made on, and the stored set matching this machine.
+
+A one-thread YADE run is deterministic on one machine, but not across CPUs: numpy dispatches its
+ufuncs (exp, log, ...) to the widest SIMD extension the CPU has, and glibc picks its libm variants
+by CPU, so a last bit can differ, and past the first bond break the DEM is chaotic.  Measured: the
+reference creep runs made on an Intel Xeon, rerun on an AMD EPYC with AVX-512 (same Debian
+packages), gave lifetimes x 2.2 and x 1.001 apart and a 6 x 12 mm UCS 1e-6 apart.  So exact
+results are stored per fingerprint under ``tests/data/reference/<set>/`` and compared exactly only
+on a machine with the same fingerprint; elsewhere each test states what it compares instead.
+"""
+import json
+import platform
+import re
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+REFERENCE = Path(__file__).resolve().parent / "data" / "reference"
+#: What must be equal for an exact comparison (see module doc).
+FINGERPRINT_KEYS = ("machine", "cpu", "simd", "libc", "python", "numpy", "yade_package")
+
+
+def cpu_model() -> str:
+    """The CPU's model name as the kernel reports it (``/proc/cpuinfo``), or the platform's processor."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def numpy_simd() -> str:
+    """The widest SIMD target numpy dispatches to on this CPU (e.g. ``AVX512_ICL``, ``AVX2``)."""
+    try:
+        from numpy.core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    except ImportError:
+        return "unknown"
+    usable = [t for t in __cpu_dispatch__ if __cpu_features__.get(t)]
+    return usable[-1] if usable else "baseline"
+
+
+def this_platform() -> dict:
+    yade = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "yade"], capture_output=True, text=True).stdout
+    return {"machine": platform.machine(), "cpu": cpu_model(), "simd": numpy_simd(),
+            "libc": "-".join(platform.libc_ver()), "python": platform.python_version(), "numpy": np.__version__,
+            "yade_package": yade}
+
+
+def fingerprint(record: dict) -> tuple:
+    return tuple(record.get(k) for k in FINGERPRINT_KEYS)
+
+
+def set_name(record: dict) -> str:
+    """A folder name for a stored set: CPU model and SIMD target."""
+    return re.sub(r"[^a-z0-9]+", "_", f"{record['cpu']} {record['simd']}".lower()).strip("_")
+
+
+def stored_sets() -> list:
+    """Every stored set's folder, oldest first by name."""
+    return sorted(p.parent for p in REFERENCE.glob("*/platform.json"))
+
+
+def matching_set():
+    """The folder of the stored set made on this machine's fingerprint, or None."""
+    here = fingerprint(this_platform())
+    for folder in stored_sets():
+        if fingerprint(json.loads((folder / "platform.json").read_text())) == here:
+            return folder
+    return None
+
+
+def write_platform(folder: Path, note: str = "") -> Path:
+    """Create ``folder`` (if needed) with this machine's ``platform.json``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    record = {**this_platform(), **({"note": note} if note else {})}
+    (folder / "platform.json").write_text(json.dumps(record, indent=1) + "\n")
+    return folder
