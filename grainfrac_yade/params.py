@@ -119,6 +119,12 @@ class NumericsParams:
                                        "step lies below this quantile of all cells' steps get their mass and "
                                        "inertia multiplied so that their step equals it (statics unchanged; the "
                                        "DEM step of the scene is then that quantile's); 0 = off")
+    verlet_fraction: float = _spec("1", "positive", "the collider's Verlet distance (InsertionSortCollider."
+                                   "verletDist) as a fraction of the sphere radius named by verlet_radius_quantile: "
+                                   "bounding boxes are enlarged by it, and the collider sorts again only once a body "
+                                   "has moved farther (YADE's default: 0.5)")
+    verlet_radius_quantile: float = _spec("1", "fraction", "quantile of the sphere radii the Verlet distance refers "
+                                          "to: 0 = the smallest sphere (YADE's own rule), 0.5 = the median sphere")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -5,6 +5,7 @@ solve of that cluster must converge to the mesh reference as the inset goes to z
 scene must be that cluster (a slow elastic ramp agrees with the static solve, as for rigid cells).
 """
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +17,8 @@ from grainfrac_yade.elastic import (cluster_network, contact_statistics, deforma
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
 
+FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem.toml"
+MEDIAN_VERLET = ["numerics.verlet_radius_quantile=0.5", "numerics.verlet_fraction=0.5"]
 SMALL = ["specimen.width=4e-3", "specimen.height=8e-3", "resolution.grain_model=fem"]
 
 
@@ -148,6 +151,45 @@ def test_fem_scene_agrees_with_the_static_solve_after_a_small_elastic_ramp():
     from test_elastic import _assert_yade_ramp_matches_static_solve
     p = load_parameters(overrides=SMALL + ["numerics.damping=0.7"])
     _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=20000)
+
+
+@needs_yade
+@pytest.mark.yade
+def test_a_verlet_distance_of_the_median_sphere_keeps_the_static_solve():
+    """The collider's Verlet distance only decides how often it sorts and which pairs it hands over as
+    possible contacts, never a force: with 0.5 x the median sphere radius the slow elastic ramp still
+    equals the static solve, with the tolerances of the default scene's test."""
+    from test_elastic import _assert_yade_ramp_matches_static_solve
+    p = load_parameters(overrides=SMALL + ["numerics.damping=0.7", *MEDIAN_VERLET])
+    _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=20000)
+
+
+@needs_yade
+@pytest.mark.yade
+@pytest.mark.slow
+def test_a_verlet_distance_of_the_median_sphere_stops_the_resorting():
+    """The collider holds the distance asked for, and over 1,000 DEM steps of a UCS ramp it sorts far less
+    often than with YADE's rule (0.5 x the smallest sphere, which fem cells make tiny next to sliver
+    faces).  10 x 20 mm seed 3 with the fem preset (smallest sphere 2.7e-3 of the median): 543 sorts
+    in 1,000 steps after 200 warm-up steps with YADE's rule, 1 with the median's."""
+    from grainfrac_yade.yade_adapter.platens import Platens
+    from grainfrac_yade.yade_adapter.scene import build_scene
+    sorts = {}
+    for name, extra in (("yade_rule", []), ("median", MEDIAN_VERLET)):
+        q = load_parameters(extra_files=[FEM_PRESET], overrides=["specimen.width=10e-3", "specimen.height=20e-3",
+                                                                  *extra])
+        scene = build_scene(build_specimen(q, 3), q)
+        collider = next(e for e in scene.O.engines if type(e).__name__ == "InsertionSortCollider")
+        if name == "median":
+            assert collider.verletDist == pytest.approx(0.5 * np.median(scene.layout.sphere_radius), rel=1e-15)
+        else:
+            assert collider.verletDist == -0.5
+        platens = Platens(scene)
+        scene.extras.append(platens)
+        platens.set_axial_velocity(q.ucs.strain_rate * platens.height)
+        scene.run(1200)
+        sorts[name] = collider.numAction
+    assert sorts["median"] * 10 < sorts["yade_rule"]
 
 
 @needs_yade

@@ -601,6 +601,16 @@ def _create_links(utils, specimen, layout, params, sphere_body) -> list:
     return links
 
 
+def verlet_distance(layout: ClumpLayout, numerics) -> float:
+    """``InsertionSortCollider.verletDist``: ``numerics.verlet_fraction`` x the sphere radius at quantile
+    ``numerics.verlet_radius_quantile``.  At quantile 0 it is YADE's own relative form (a negative value:
+    that fraction of the smallest radius, which the collider finds itself), so the default scene is
+    YADE's default; otherwise an absolute distance [m]."""
+    if numerics.verlet_radius_quantile == 0:
+        return -numerics.verlet_fraction
+    return float(numerics.verlet_fraction * np.quantile(layout.sphere_radius, numerics.verlet_radius_quantile))
+
+
 def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | None = None) -> GrainScene:
     """Build the plain mechanical YADE scene of ``specimen`` (replaces any current scene)."""
     yade = load_yade()
@@ -641,7 +651,8 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
                 if layout.n_elements else [])
     O.engines = [
         w.ForceResetter(),
-        w.InsertionSortCollider([w.Bo1_Sphere_Aabb()], avoidSelfInteractionMask=CELL_MASK_BIT if per_cell_masks else 0),
+        w.InsertionSortCollider([w.Bo1_Sphere_Aabb()], avoidSelfInteractionMask=CELL_MASK_BIT if per_cell_masks else 0,
+                                verletDist=verlet_distance(layout, params.numerics)),
         w.InteractionLoop([geometry],
                           [w.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)], [law]),
         *elements,
