@@ -1,10 +1,10 @@
 #!/bin/bash
-# Regenerates the study numbers and figures quoted in README.md and docs/ from the code you have.
+# Regenerates the study numbers and figures quoted in docs/studies/ and docs/ from the code you have.
 #   bash docs/regenerate.sh list          # the targets, what each feeds and its cost
 #   bash docs/regenerate.sh TARGET ...    # run targets (results/ folders, then their analysis)
 #   bash docs/regenerate.sh all           # everything: about a day on this 2-core machine
-# Costs are wall times measured on this machine (2 cores, yade-batch -j 2 unless said); the README
-# section each target feeds says which of its numbers came from which run. Every run folder records
+# Costs are wall times measured on this machine (2 cores, yade-batch -j 2 unless said); the docs/studies
+# page each target feeds says which of its numbers came from which run. Every run folder records
 # its code version (run.json), and `analyze` warns when a study mixes versions.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,23 +16,23 @@ batch() {  # batch TABLE SCRIPT STUDY
 }
 
 declare -A WHAT=(
-  [elastic]="README 'Deformable grains' tables, docs/elastic_reference.md (static solves, no YADE): about 5 min on one core"
-  [bench]="README 'Benchmark', docs/bench.json: about 6 min on one core"
-  [calibration]="README 'Calibration', params/calibration.toml (rigid cells, 5 seeds x 2 rounds): about 35 min"
-  [calibration_check]="README 'Calibration' and 'Resolution' paper-size rows: the shipped factors measured again (params/calibration_check_ldb.table): about 25 min on one core"
-  [resolution]="README 'Resolution' (params/resolution_small.table): about 20 min"
-  [fem_ucs]="README 'Finite-element grains' UCS table (params/fem_ucs_small.table): about 30 min"
-  [fem_creep]="README 'Finite-element grains' creep table and the fem beta1 (params/fem_creep_small.table): about 20 min on 2 cores"
-  [lattice]="README 'spring-lattice option' (params/deformable_*.table): about 3 h"
-  [lifetime_small]="README 'Lifetime studies' 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
-  [lifetime_ldb]="README 'Lifetime studies' paper size, 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
-  [creep_numerics]="README 'creep numerics' (params/creep_numerics_small.table): about 1 h"
-  [brazilian]="README 'Brazilian test' (params/brazilian_ldb.table, docs/brazilian_study.sh)"
-  [accuracy_cost]="README 'What accuracy costs in time', docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
-  [accuracy_cost_paper_size]="README 'What accuracy costs in time', paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
-  [step_floor]="README 'What accuracy costs in time', per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
-  [threshold]="README 'Long-term strength (activation threshold)' table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
-  [confined]="README 'Confined (biaxial) compression and creep' (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
+  [elastic]="docs/studies/deformable_grains.md static tables, docs/elastic_reference.md (static solves, no YADE): about 5 min on one core"
+  [bench]="docs/studies/benchmark.md, docs/bench.json: about 6 min on one core"
+  [calibration]="docs/studies/ucs_calibration.md calibration, params/calibration.toml (rigid cells, 5 seeds x 2 rounds): about 35 min"
+  [calibration_check]="docs/studies/ucs_calibration.md, calibration and resolution paper-size rows: the shipped factors measured again (params/calibration_check_ldb.table): about 25 min on one core"
+  [resolution]="docs/studies/ucs_calibration.md resolution (params/resolution_small.table): about 20 min"
+  [fem_ucs]="docs/studies/deformable_grains.md fem UCS table (params/fem_ucs_small.table): about 30 min"
+  [fem_creep]="docs/studies/deformable_grains.md fem creep table and the fem beta1 (params/fem_creep_small.table): about 20 min on 2 cores"
+  [lattice]="docs/studies/spring_lattice.md (params/deformable_*.table): about 3 h"
+  [lifetime_small]="docs/studies/lifetime.md 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
+  [lifetime_ldb]="docs/studies/lifetime.md paper size, docs/studies/creep.md 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
+  [creep_numerics]="docs/studies/creep.md creep numerics (params/creep_numerics_small.table): about 1 h"
+  [brazilian]="docs/studies/brazilian.md (params/brazilian_ldb.table, docs/brazilian_study.sh)"
+  [accuracy_cost]="docs/studies/accuracy_cost.md, docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
+  [accuracy_cost_paper_size]="docs/studies/accuracy_cost.md paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
+  [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
+  [threshold]="docs/studies/creep.md long-term strength table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
+  [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
 run_target() {

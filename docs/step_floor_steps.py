@@ -1,5 +1,5 @@
 """DEM step and stepping speed with per-cell mass scaling (``numerics.step_floor_quantile``), by model
-and specimen size: README, "What accuracy costs in time".
+and specimen size: docs/studies/accuracy_cost.md.
 
 For each (model, specimen, seed, quantile) the scene is built, its critical step and DEM step read,
 and a short loading ramp of ``--steps`` DEM steps timed in CPU seconds (one thread).  The cost of a

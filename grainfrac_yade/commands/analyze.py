@@ -27,7 +27,7 @@ def register(sub, common):
                                                 "without it the paper's UDEC value and the 1986 bound are drawn")
     p.add_argument("--out", help="report folder (default FOLDER/report)")
     p.add_argument("--reference", metavar="DIR", help="folder of paper_values.csv and lab_lifetimes_README.md "
-                                                      "(default: params/reference, copies of shared/reference)")
+                                                      "(default: params/reference: copies of the reference values the project ships)")
     p.add_argument("--focus-ratio", type=float, metavar="R",
                    help="driving-stress ratio of the run shown in the one-load figures (default: the paper's "
                         "160 MPa point's ratio)")

@@ -25,7 +25,7 @@ def register(sub, common):
     p = sub.add_parser("calibrate-beta1", help="fit one factor on beta1 to the paper's lifetime at 160 MPa")
     p.add_argument("folder", help="study folder with event-clock, strength-mode creep runs at the paper's load")
     p.add_argument("--out", default=None, help="TOML to write (default params/stress_corrosion_calibrated.toml)")
-    p.add_argument("--reference", default=None, help="folder holding paper_values.csv (default params/reference, copies of shared/reference)")
+    p.add_argument("--reference", default=None, help="folder holding paper_values.csv (default params/reference: copies of the reference values the project ships)")
     p.set_defaults(func=cmd_calibrate_beta1)
 
 
