@@ -11,6 +11,7 @@ not depend on the terminal's width (argparse's own help does). No YADE import.
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import sys
 
 from .cli import build_parser
@@ -50,10 +51,20 @@ def _flag(action: argparse.Action) -> str:
     return f"{names} {_cell(arg)}".rstrip() if arg else names
 
 
+#: The checkout's root: defaults below it are written relative to it.
+_ROOT = Path(__file__).resolve().parents[1]
+
+
 def _default(action: argparse.Action) -> str:
     if action.nargs == 0 or action.default in (None, argparse.SUPPRESS) or action.default == []:
         return ""
-    return _cell(repr(action.default) if isinstance(action.default, str) else action.default)
+    default = action.default
+    if isinstance(default, (str, Path)) and Path(default).is_absolute():
+        try:   # paths inside the checkout, as the checkout's own relative path: the page is the same in any clone
+            default = str(Path(default).resolve().relative_to(_ROOT))
+        except ValueError:
+            pass
+    return _cell(repr(str(default)) if isinstance(default, (str, Path)) else default)
 
 
 def _help(parser: argparse.ArgumentParser, action: argparse.Action) -> str:
