@@ -31,7 +31,7 @@ SUMMARY = "summary.json"
 PROVENANCE_KEYS = ("sources",)
 #: Parameters that do not change what a run computes (how often it is checkpointed): never compared
 #: between runs, and not part of :func:`run_digest`.
-RESULT_NEUTRAL_KEYS = ("creep.checkpoint_interval",)
+RESULT_NEUTRAL_KEYS = ("numerics.checkpoint_interval",)
 #: Checkpoint of an unfinished run (creep ``--resume``): ``<run>/checkpoint/`` holds the DEM scene and
 #: :data:`CHECKPOINT_STATE`, the driver's state, written last.  A new checkpoint is written into
 #: ``checkpoint.tmp/`` and renamed; the previous one is moved aside to ``checkpoint.old/`` for the

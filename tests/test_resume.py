@@ -22,7 +22,7 @@ SMALL = {"width": 4e-3, "height": 8e-3, "ratio": 0.5, "ucs": 300e6, "seed": 1}
 #: 3 x 6 mm, 0.8 x 300 MPa: one event (tests/test_batch.py); about 3 s.
 TINY = {"width": 3e-3, "height": 6e-3, "ratio": 0.8, "ucs": 300e6, "seed": 1}
 #: Checkpoint at every safe point (test only): a kill always finds a recent one.
-EVERY_SAFE_POINT = "creep.checkpoint_interval=1e-6"
+EVERY_SAFE_POINT = "numerics.checkpoint_interval=1e-6"
 #: Columns that differ between two identical runs (wall time).
 WALL = ["wall_s"]
 
@@ -154,7 +154,7 @@ def test_a_batch_row_skips_resumes_or_starts_by_its_folder(tmp_path):
     stop = {"on_change": "stop"}
     out = _unfinished(tmp_path / "a", params)
     assert row_plan(out, params, stop, VALUES) == (out, "resume", "")
-    slower = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3", "creep.checkpoint_interval=60"])
+    slower = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3", "numerics.checkpoint_interval=60"])
     assert row_plan(out, slower, stop, VALUES) == (out, "resume", "")   # the interval changes no result
     edited = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3", "stress_corrosion.beta1=2e-3"])
     folder, action, note = row_plan(out, edited, stop, VALUES)
@@ -186,10 +186,10 @@ def test_checkpoint_interval_is_a_checked_parameter_that_no_run_comparison_sees(
     from grainfrac_yade.errors import ParameterError
     from grainfrac_yade.runio import run_digest
     p = load_parameters()
-    assert p.creep.checkpoint_interval == 600.0
-    assert run_digest(load_parameters(overrides=["creep.checkpoint_interval=0"]), VALUES) == run_digest(p, VALUES)
-    with pytest.raises(ParameterError, match="creep.checkpoint_interval: must be >= 0"):
-        load_parameters(overrides=["creep.checkpoint_interval=-1"])
+    assert p.numerics.checkpoint_interval == 600.0
+    assert run_digest(load_parameters(overrides=["numerics.checkpoint_interval=0"]), VALUES) == run_digest(p, VALUES)
+    with pytest.raises(ParameterError, match="numerics.checkpoint_interval: must be >= 0"):
+        load_parameters(overrides=["numerics.checkpoint_interval=-1"])
 
 
 @pytest.mark.parametrize("case", ["no folder", "no checkpoint", "finished", "conflict", "ucs run"])
