@@ -117,6 +117,10 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
     if out.exists() and not out.is_dir():
         raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
     if not overwrite and any((out / m).exists() for m in RUN_MARKERS):
+        if not (out / SUMMARY).exists() and checkpoint_folder(out) is not None:
+            raise GrainfracError(f"{out}: holds an unfinished run with a checkpoint; fix: go on with it by "
+                                 f"`{command} --resume {out}`, choose another --out, or pass --overwrite to start "
+                                 "it again")
         raise GrainfracError(f"{out}: already holds a run (run.json); fix: choose another --out "
                              "or pass --overwrite to replace it")
     out.mkdir(parents=True, exist_ok=True)
