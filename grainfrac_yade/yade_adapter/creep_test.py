@@ -553,11 +553,13 @@ def resume_creep(specimen, params, target_stress, run_folder, progress=None, **o
     driver's state is restored (:func:`.checkpoint.restore`).  GrainfracError if the folder holds
     no usable checkpoint.
     """
-    from .checkpoint import read, restore
+    from .checkpoint import inexact_note, read, restore
     where, state, arrays = read(run_folder)
     outputs.setdefault("run_values", state.get("run_values"))
     run = CreepRun(specimen, params, target_stress, progress, checkpoint_folder=run_folder, **outputs)
     run.resumed = restore(run, where, state, arrays)
     run.progress(f"resumed from the checkpoint at DEM step {state['dem_steps']}, creep time "
                  f"{state['creep_time_s']:.6g} s ({state['phase']} phase)")
+    if inexact_note(params):
+        run.progress(f"note: not bit-identical: {inexact_note(params)}")
     return run.run()

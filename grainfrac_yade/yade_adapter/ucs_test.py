@@ -167,7 +167,7 @@ def resume_ucs(specimen, params, run_folder, progress=None, run_values=None):
     """Go on with the UCS test whose checkpoint is in ``run_folder`` (same specimen and parameters as the
     test that wrote it); returns what :func:`run_ucs` returns.  GrainfracError if there is no usable
     checkpoint."""
-    from .checkpoint import read
+    from .checkpoint import inexact_note, read
     where, state, arrays = read(run_folder, "ucs")
     run = UcsRun(specimen, params, progress, checkpoint_folder=run_folder,
                  run_values=run_values if run_values is not None else state.get("run_values"))
@@ -175,4 +175,6 @@ def resume_ucs(specimen, params, run_folder, progress=None, run_values=None):
     if progress:
         progress(f"resumed from the checkpoint at DEM step {state['dem_steps']} ({len(run.cols['dem_step'])} "
                  "history rows)")
+        if inexact_note(params):
+            progress(f"note: not bit-identical: {inexact_note(params)}")
     return run.run()
