@@ -450,3 +450,10 @@ def test_a_brazilian_test_killed_mid_loading_resumes_to_the_uninterrupted_result
                          capture_output=True, text=True, cwd=ROOT, env=dict(os.environ, OMP_NUM_THREADS="1"))
     assert res.returncode == 0, res.stderr
     _assert_same_loading_test(ref, killed)
+
+
+def test_only_finite_element_cells_are_flagged_as_resuming_inexactly():
+    from grainfrac_yade.yade_adapter.checkpoint import inexact_note
+    assert inexact_note(load_parameters()) == ""
+    assert inexact_note(load_parameters(overrides=["resolution.grain_model=deformable"])) == ""
+    assert "memory address" in inexact_note(load_parameters(overrides=["resolution.grain_model=fem"]))
