@@ -118,8 +118,9 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
         raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
     if not overwrite and any((out / m).exists() for m in RUN_MARKERS):
         if not (out / SUMMARY).exists() and checkpoint_folder(out) is not None:
-            raise GrainfracError(f"{out}: holds an unfinished run with a checkpoint; fix: go on with it by "
-                                 f"`{command} --resume {out}`, choose another --out, or pass --overwrite to start "
+            held = _run_command(out) or command
+            raise GrainfracError(f"{out}: holds an unfinished {held} run with a checkpoint; fix: go on with it by "
+                                 f"`{held} --resume {out}`, choose another --out, or pass --overwrite to start "
                                  "it again")
         raise GrainfracError(f"{out}: already holds a run (run.json); fix: choose another --out "
                              "or pass --overwrite to replace it")
@@ -133,6 +134,15 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
         "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     })
     return out
+
+
+def _run_command(folder) -> str | None:
+    """The command of the run in ``folder`` (run.json), None if unreadable."""
+    try:
+        command = json.loads((Path(folder) / "run.json").read_text()).get("command")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return command if isinstance(command, str) else None
 
 
 def remove_checkpoints(folder) -> None:
