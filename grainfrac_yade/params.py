@@ -125,6 +125,10 @@ class NumericsParams:
                                    "has moved farther (YADE's default: 0.5)")
     verlet_radius_quantile: float = _spec("1", "fraction", "quantile of the sphere radii the Verlet distance refers "
                                           "to: 0 = the smallest sphere (YADE's own rule), 0.5 = the median sphere")
+    checkpoint_interval: float = _spec("s", "nonnegative",
+                                       "wall time between checkpoints of a long run (UCS, Brazilian and creep "
+                                       "tests, for --resume DIR); 0 = none, but a creep run's at the end of its "
+                                       "ramp; does not change results")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -207,9 +211,6 @@ class CreepParams:
     relaxation_damping: float = _spec("1", "fraction_below_one", "Cundall damping of the creep phase (after the "
                                       "ramp: every relaxation); 0 = numerics.damping, as in the ramp")
     record_period: int = _spec("1", "positive_int", "paper clock: law applications between history rows")
-    checkpoint_interval: float = _spec("s", "nonnegative",
-                                       "wall time between checkpoints of a creep run (for creep --resume); "
-                                       "0 = only at the end of the ramp; does not change results")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -380,7 +381,9 @@ def nearest_key(word: str, keys) -> str | None:
 #: Keys renamed in the schema: old dotted key -> (new dotted key, {old value: new value}).  Parameter
 #: files and --set refuse the old key in one line; params.json of older runs are migrated on reading
 #: (:func:`migrate_tree`).
-RENAMED_KEYS = {"stress_corrosion.mode": ("stress_corrosion.law", {"strength": "hillig_charles", "area": "area"})}
+RENAMED_KEYS = {"stress_corrosion.mode": ("stress_corrosion.law", {"strength": "hillig_charles", "area": "area"}),
+                # one interval for every test since the UCS and Brazilian tests checkpoint too; same value
+                "creep.checkpoint_interval": ("numerics.checkpoint_interval", {})}
 
 
 def renamed_key_fix(dotted: str) -> str | None:
@@ -388,6 +391,9 @@ def renamed_key_fix(dotted: str) -> str | None:
     if dotted not in RENAMED_KEYS:
         return None
     new, values = RENAMED_KEYS[dotted]
+    if not values:
+        section, key = new.split(".")
+        return f"{dotted} was moved to {new}; write {key} = ... under [{section}] (same value), or --set {new}=..."
     mapping = ", ".join(f'{old!r} -> {v!r}' for old, v in values.items())
     return f"{dotted} was replaced by {new}; write {new.rsplit('.', 1)[-1]} = ... ({mapping})"
 
@@ -401,10 +407,13 @@ def migrate_tree(tree: dict) -> list:
         if not isinstance(table, dict) or key not in table:
             continue
         value = table.pop(key)
-        new_key = new.split(".")[1]
-        if new_key not in table:
-            table[new_key] = values.get(value, value)
-        notes.append(f"{old} = {value!r} read as {new} = {table[new_key]!r}")
+        new_section, new_key = new.split(".")
+        target = tree.setdefault(new_section, {}) if new_section != section else table
+        if not isinstance(target, dict):
+            continue
+        if new_key not in target:
+            target[new_key] = values.get(value, value)
+        notes.append(f"{old} = {value!r} read as {new} = {target[new_key]!r}")
     return notes
 
 

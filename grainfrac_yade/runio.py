@@ -31,7 +31,7 @@ SUMMARY = "summary.json"
 PROVENANCE_KEYS = ("sources",)
 #: Parameters that do not change what a run computes (how often it is checkpointed): never compared
 #: between runs, and not part of :func:`run_digest`.
-RESULT_NEUTRAL_KEYS = ("creep.checkpoint_interval",)
+RESULT_NEUTRAL_KEYS = ("numerics.checkpoint_interval",)
 #: Checkpoint of an unfinished run (creep ``--resume``): ``<run>/checkpoint/`` holds the DEM scene and
 #: :data:`CHECKPOINT_STATE`, the driver's state, written last.  A new checkpoint is written into
 #: ``checkpoint.tmp/`` and renamed; the previous one is moved aside to ``checkpoint.old/`` for the
@@ -117,6 +117,11 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
     if out.exists() and not out.is_dir():
         raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
     if not overwrite and any((out / m).exists() for m in RUN_MARKERS):
+        if not (out / SUMMARY).exists() and checkpoint_folder(out) is not None:
+            held = _run_command(out) or command
+            raise GrainfracError(f"{out}: holds an unfinished {held} run with a checkpoint; fix: go on with it by "
+                                 f"`{held} --resume {out}`, choose another --out, or pass --overwrite to start "
+                                 "it again")
         raise GrainfracError(f"{out}: already holds a run (run.json); fix: choose another --out "
                              "or pass --overwrite to replace it")
     out.mkdir(parents=True, exist_ok=True)
@@ -129,6 +134,15 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
         "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     })
     return out
+
+
+def _run_command(folder) -> str | None:
+    """The command of the run in ``folder`` (run.json), None if unreadable."""
+    try:
+        command = json.loads((Path(folder) / "run.json").read_text()).get("command")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return command if isinstance(command, str) else None
 
 
 def remove_checkpoints(folder) -> None:

@@ -51,7 +51,7 @@ def run(name, out, extra=WITHOUT_COLLAPSE):
     from grainfrac_yade.params import load_parameters
     seed, width, height, ratio, _ = RUNS[name]
     p = load_parameters(overrides=[("specimen.width", width), ("specimen.height", height),
-                                   "stress_corrosion.creep_time_limit=1e30", "creep.checkpoint_interval=0",
+                                   "stress_corrosion.creep_time_limit=1e30", "numerics.checkpoint_interval=0",
                                    *RUNS[name][4], *extra])
     run_creep_to_folder(p, seed, out, ratio * UCS, ratio, UCS, overwrite=True)
     out = Path(out)

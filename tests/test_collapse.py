@@ -201,7 +201,7 @@ def test_a_tiny_specimen_ends_by_collapse_early_with_the_lifetime_of_the_criteri
     from grainfrac_yade.specimen import build_specimen
     from grainfrac_yade.yade_adapter.creep_test import run_creep
     base = ["specimen.width=3e-3", "specimen.height=6e-3", "stress_corrosion.creep_time_limit=1e13",
-            "creep.checkpoint_interval=0"]
+            "numerics.checkpoint_interval=0"]
     runs = {}
     for name, extra in (("on", []), ("off", ["creep.collapse_strain_increment=0"])):
         p = load_parameters(overrides=base + extra)

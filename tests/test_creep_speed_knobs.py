@@ -11,7 +11,7 @@ from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.params import load_parameters
 
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3", "stress_corrosion.creep_time_limit=1e13",
-        "creep.checkpoint_interval=0"]
+        "numerics.checkpoint_interval=0"]
 LOAD = 0.8 * 300e6   # Pa, as test_collapse's tiny run
 
 

@@ -137,7 +137,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, def
                "broken_tensile": zeros, "broken_shear": zeros, "broken_inter": zeros, "broken_intra": zeros}
     result = {"dem_steps": 1000, "wall_s": 0.1, "dem_timestep_s": 1e-9, "n_bonds": lay.n_bonds,
               "numerical_failure": False, "peak_reached": True, "end_reason": "post-peak"}
-    monkeypatch.setattr(ucs_test, "run_ucs", lambda specimen, params, progress=None:
+    monkeypatch.setattr(ucs_test, "run_ucs", lambda specimen, params, progress=None, **outputs:
                         (history, result, scene, (scene.broken, scene.break_mode)))
     rows = [{"creep_time_s": t, "axial_strain": 2e-3 + 1e-9 * t, "lateral_strain": -4e-4, "axial_stress_pa": 200e6,
              "broken_total": 3, "macrocracks": 0, "dem_steps": 1000, "wall_s": 0.1} for t in (0.0, 10.0, 20.0)]

@@ -34,11 +34,25 @@ def register(sub, common):
     lv.add_argument("--strength-cv", type=float, default=0.0, metavar="C",
                     help="coefficient of variation of a lognormal factor (mean 1) on each bond's J^T and J^C")
     lv.add_argument("--block-rotation", action="store_true", help="cells do not rotate (rigid cells)")
+    from .resume import add_resume_option
+    add_resume_option(p, "Brazilian test")
     p.set_defaults(func=cmd_brazilian)
 
 
 def cmd_brazilian(args) -> int:
     from ..cli import load_params_from_args
+    if args.resume:
+        from .resume import refuse_resume_conflicts, resumable_run
+        refuse_resume_conflicts(args)
+        found = resumable_run(args.resume, "brazilian")
+        if found is None:
+            print(f"Brazilian test already finished (summary.json): {args.resume}; nothing to resume")
+            return 0
+        params, state = found
+        summary = run_brazilian_to_folder(params, int(state["run_values"]["seed"]), args.resume, progress=print,
+                                          resume=True)
+        print(format_result(summary, args.resume))
+        return 0
     params = load_params_from_args(args)
     if args.diameter is not None or args.tensile_scale is not None:
         extra = [] if args.diameter is None else [("brazilian.diameter", args.diameter)]
@@ -116,22 +130,31 @@ def require_disc_model(params):
                              "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
 
 
-def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None) -> dict:
+def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None, resume=False) -> dict:
     """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished).
 
-    ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none)."""
+    ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none).  Checkpoints go to
+    ``out/checkpoint/`` every ``numerics.checkpoint_interval`` s of wall time and are removed once
+    summary.json is written; ``resume``: go on from the checkpoint in ``out`` (its levers with it)."""
+    from pathlib import Path
     from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
     from ..disc import build_disc_specimen
-    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
-    from ..yade_adapter.brazilian_test import run_brazilian
-    from ..yade_adapter.levers import new_breaks
+    from ..runio import prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
+    from ..yade_adapter.brazilian_test import resume_brazilian, run_brazilian
+    from ..yade_adapter.levers import Levers, new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
-    out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
-    history, result, scene, (broken_peak, mode_peak) = run_brazilian(specimen, params, progress=progress,
-                                                                     levers=levers)
+    if resume:
+        out = Path(out)
+        history, result, scene, (broken_peak, mode_peak) = resume_brazilian(specimen, params, out, progress=progress)
+    else:
+        out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
+        levers = levers or Levers()
+        history, result, scene, (broken_peak, mode_peak) = run_brazilian(
+            specimen, params, progress=progress, levers=levers, checkpoint_folder=out,
+            run_values={"seed": seed, "levers": levers.to_dict()})
     t = specimen.tessellation
     diameter = t.diameter
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else \
@@ -157,6 +180,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     run_brazilian_load_figure(history, summary, out / "load_strain.png")
     draw_crack_maps(scene, summary, broken_peak, mode_peak, out)
     write_json(out / "summary.json", summary)   # last: marks the run finished
+    remove_checkpoints(out)                     # a finished run has nothing to resume
     return summary
 
 
@@ -213,19 +237,30 @@ def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
 
 def run_brazilian_in_yade():
     """Entry of ``yade_scripts/brazilian.py``: parameters from the batch row (or defaults); a finished row
-    is skipped or stops as a UCS row does (:mod:`grainfrac_yade.yade_adapter.batch`)."""
+    is skipped or stops as a UCS row does, an unfinished one with a checkpoint of this row (no levers)
+    goes on from it (:mod:`grainfrac_yade.yade_adapter.batch`)."""
     from ..params import load_parameters
-    from ..yade_adapter.batch import read_table, row_errors, row_folder, run_folder_name
+    from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
+    from ..runio import read_checkpoint_state
+    from ..yade_adapter.levers import Levers
     with row_errors():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)
         require_disc_model(params)
-        out, done = row_folder(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}",
-                               params, controls, {"seed": int(controls["seed"])})
-    if done:
+        out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/"
+                                     f"{run_folder_name(controls, overrides)}",
+                                     params, controls, {"seed": int(controls["seed"])})
+    if action == "resume" and (read_checkpoint_state(out) or {}).get("run_values", {}).get("levers") != \
+            Levers().to_dict():   # a CLI test with levers in this folder: not this row's (rows have none)
+        action, note = "run", f"{out}: its checkpoint is of a test with levers (brazilian --slit-fraction ...): started again"
+    if action == "skip":
         print(f"Brazilian row already finished, skipped: {out}")
         return
+    if note:
+        print(note)
+    if action == "resume":
+        print(f"Brazilian row unfinished, resumed from its checkpoint: {out}")
     with row_errors():
         summary = run_brazilian_to_folder(params, int(controls["seed"]), out,
-                                          overwrite=(out / "run.json").exists())
+                                          overwrite=(out / "run.json").exists(), resume=action == "resume")
     print(format_result(summary, out))

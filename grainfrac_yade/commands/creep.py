@@ -24,7 +24,7 @@ def register(sub, common):
                         "creep times [s] and at the end, into DIR/vtk/ (e.g. --vtk-times 0,1e7)")
     p.add_argument("--resume", metavar="DIR",
                    help="go on with the interrupted creep run in DIR from its last checkpoint (DIR/checkpoint/, "
-                        "written at the end of the ramp and every creep.checkpoint_interval s); load, seed and "
+                        "written at the end of the ramp and every numerics.checkpoint_interval s); load, seed and "
                         "parameters come from DIR")
     p.set_defaults(func=cmd_creep, with_params=True, param_overrides=_clock_override)
 
@@ -174,7 +174,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     """Run a creep test into ``out``; summary.json is written last (it marks the run finished).
 
     Checkpoints go to ``out/checkpoint/`` during the run (end of the ramp, then every
-    ``creep.checkpoint_interval`` s) and are removed once summary.json is written.  ``resume``: go on
+    ``numerics.checkpoint_interval`` s) and are removed once summary.json is written.  ``resume``: go on
     from the checkpoint in ``out`` instead of starting (``out`` keeps its run.json and params.json).
 
     A numerical failure (NaN/inf, a stalled clock) gives ``numerical_failure: true``, ``failed:

@@ -4,20 +4,32 @@ from __future__ import annotations
 import numpy as np
 
 from .creep import add_confinement_option, confinement_override
+from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
 def register(sub, common):
     p = sub.add_parser("ucs", help="strain-controlled uniaxial compression test")
     common(p)
     add_confinement_option(p)
+    add_resume_option(p, "UCS test")
     p.set_defaults(func=cmd_ucs, with_params=True, param_overrides=confinement_override)
 
 
 def cmd_ucs(args, params) -> int:
     from ..params import require_plane
-    require_plane(params, "ucs")
-    out = args.out or f"results/ucs_seed{args.seed}"
-    summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
+    if args.resume:
+        refuse_resume_conflicts(args)
+        found = resumable_run(args.resume, "ucs")
+        if found is None:
+            print(f"UCS test already finished (summary.json): {args.resume}; nothing to resume")
+            return 0
+        params, state = found
+        out = args.resume
+        summary = run_ucs_to_folder(params, int(state["run_values"]["seed"]), out, progress=print, resume=True)
+    else:
+        require_plane(params, "ucs")
+        out = args.out or f"results/ucs_seed{args.seed}"
+        summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
     if summary["numerical_failure"]:
         print(f"UCS: no result ({summary['end_reason']}) -> {out}")
         return 0
@@ -40,20 +52,31 @@ MEASURES = ("ucs_pa", "peak_axial_strain", "young_pa", "young_method", "poisson"
             "crack_damage_pa")
 
 
-def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
-    """Run a UCS test into ``out``; summary.json is written last (it marks the run finished)."""
+def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=False) -> dict:
+    """Run a UCS test into ``out``; summary.json is written last (it marks the run finished).
+
+    Checkpoints go to ``out/checkpoint/`` every ``numerics.checkpoint_interval`` s of wall time and are
+    removed once summary.json is written.  ``resume``: go on from the checkpoint in ``out`` instead of
+    starting (``out`` keeps its run.json and params.json)."""
+    from pathlib import Path
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
+    from ..runio import prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
-    from ..yade_adapter.ucs_test import run_ucs
+    from ..yade_adapter import ucs_test
     require_plane(params, "ucs")
-    out = prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
+    out = Path(out) if resume else prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
-    history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)
+    outputs = {"checkpoint_folder": out, "run_values": {"seed": seed}}
+    if resume:
+        history, result, scene, (broken_peak, mode_peak) = ucs_test.resume_ucs(specimen, params, out,
+                                                                              progress=progress)
+    else:
+        history, result, scene, (broken_peak, mode_peak) = ucs_test.run_ucs(specimen, params, progress=progress,
+                                                                           **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else ucs_summary(history)
     summary.update(result)
@@ -67,6 +90,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}")
     write_json(out / "summary.json", summary)   # last: marks the run finished
+    remove_checkpoints(out)                     # a finished run has nothing to resume
     return summary
 
 
@@ -88,18 +112,25 @@ def write_cracks(path, scene):
 
 def run_ucs_in_yade():
     """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults); a finished row
-    is skipped or stops as a creep row does (:mod:`grainfrac_yade.yade_adapter.batch`)."""
+    is skipped or stops as a creep row does, an unfinished one with a checkpoint of this row goes on
+    from it (:mod:`grainfrac_yade.yade_adapter.batch`)."""
     from ..params import load_parameters, require_plane
-    from ..yade_adapter.batch import read_table, row_errors, row_folder, run_folder_name
+    from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
     with row_errors():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)
         require_plane(params, "ucs")
-        out, done = row_folder(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}",
-                               params, controls, {"seed": int(controls["seed"])})
-    if done:
+        out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/"
+                                     f"{run_folder_name(controls, overrides)}",
+                                     params, controls, {"seed": int(controls["seed"])})
+    if action == "skip":
         print(f"UCS row already finished, skipped: {out}")
         return
-    s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists())
+    if note:
+        print(note)
+    if action == "resume":
+        print(f"UCS row unfinished, resumed from its checkpoint: {out}")
+    s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists(),
+                          resume=action == "resume")
     print(f"UCS: no result ({s['end_reason']}) -> {out}" if s["numerical_failure"] else
           f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(s['young_pa'], 1e9)} GPa -> {out}")

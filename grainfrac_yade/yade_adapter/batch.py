@@ -10,8 +10,8 @@ that run's stored parameters (params.json) and run values (seed, load) equal the
 row's; otherwise the row stops with one line naming the folder and the keys that
 differ, or, with ``on_change`` = ``'new_folder'``, runs into ``<folder>_<digest>``
 (:func:`grainfrac_yade.runio.run_digest` of its parameters), skipped in turn once
-finished there.  An unfinished creep row whose folder holds a checkpoint of the same
-parameters and run values goes on from it (:func:`row_plan`); otherwise it starts again.
+finished there.  An unfinished creep, UCS or Brazilian row whose folder holds a checkpoint of the
+same parameters and run values goes on from it (:func:`row_plan`); otherwise it starts again.
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..errors import GrainfracError
-from ..params import nearest_key, shipped_values
+from ..params import nearest_key, renamed_key_fix, shipped_values
 from ..runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
 from . import load_yade
 
@@ -38,6 +38,9 @@ def check_columns(columns, valid, where: str) -> None:
     for col in columns:
         if col == "description" or col.startswith("!") or col in valid:
             continue
+        renamed = renamed_key_fix(col)
+        if renamed:
+            raise GrainfracError(f"batch table {where}: column {col!r} is a renamed key; fix: {renamed}")
         close = nearest_key(col, valid)
         hint = f"did you mean {close}?" if close else ("columns are parameter paths (section.key, as in "
                                                        "params/*.toml) or " + ", ".join(RUN_COLUMNS))
@@ -141,7 +144,7 @@ def row_folder(out, params, controls: dict, run_values: dict) -> tuple:
 
 
 def row_plan(out, params, controls: dict, run_values: dict) -> tuple:
-    """(folder, action, note): what a batch row of a resumable run (creep) does with its folder.
+    """(folder, action, note): what a batch row of a resumable run (creep, UCS, Brazilian) does with its folder.
 
     ``action``: "skip" (the folder holds this row's finished run, :func:`row_folder`), "resume" (an
     unfinished run of this row with a checkpoint: same parameters, apart from those that do not change

@@ -1,22 +1,24 @@
-"""Checkpoints of a creep run and resuming from them (``creep --resume DIR``).
+"""Checkpoints of long runs (creep, UCS and Brazilian tests) and resuming from them (``--resume DIR``).
 
 A checkpoint is the folder ``DIR/checkpoint/`` (:data:`grainfrac_yade.runio.CHECKPOINT`):
 
 * ``scene.yade.gz``: the YADE scene (``O.save``, YADE's binary archive, gzip'd: exact doubles);
-* ``arrays.npz``: the driver's per-bond arrays (bookkeeping of breaks, the degradation law's state:
-  strengths J^T, J^C of paper Eq. 7 or area fractions, break and macrocrack times, the bond
-  stresses at the start of creep);
-* ``state.json``: everything else (phase, clock state, servo and platen state, history rows so
+* ``arrays.npz``: the driver's per-bond arrays (bookkeeping of breaks; creep: the degradation law's
+  state: strengths J^T, J^C of paper Eq. 7 or area fractions, break and macrocrack times, the bond
+  stresses at the start of creep; UCS and Brazilian: the history so far and the snapshot at the peak);
+* ``state.json``: everything else (test, phase, clock state, servo and platen state, history rows so
   far, run values), written last.
 
 It is written into ``checkpoint.tmp/``, each file flushed to disk, then renamed into place
 (:meth:`Checkpointer.write`), so a kill at any moment leaves the previous checkpoint or the new
 one, never a half-written one.
 
-A checkpoint is taken only at a *safe point* of the creep driver: between DEM steps, at the end
-of the ramp and at the top of each pass of the creep clock loops, where what the driver does next
-depends on the saved state alone.  Checking the wall clock and ``O.save`` change nothing in the
-scene, so a checkpointed run computes what an unchecked one does (tested bit for bit).
+A checkpoint is taken only at a *safe point* of a driver, between DEM steps, where what the driver
+does next depends on the saved state alone: creep: in the loading ramp (phase ``loading``, every
+``numerics.checkpoint_interval`` s of wall time), at its end (``ramp``, always) and at the top of
+each pass of the creep clock loops (``event``, ``paper``); UCS and Brazilian tests: before each
+history row's DEM steps (``loading``).  Checking the wall clock and ``O.save`` change nothing in
+the scene, so a checkpointed run computes what an unchecked one does (tested bit for bit).
 
 What ``O.save`` / ``O.load`` keep, measured on YADE 2023.02a with one thread:
 
@@ -26,15 +28,15 @@ What ``O.save`` / ``O.load`` keep, measured on YADE 2023.02a with one thread:
   ``O.load`` equal 5000 steps without it to the last bit;
 * not kept: the force container (it reads zero after ``O.load`` until a step has run; forces
   put back with ``O.forces.addF`` act in the next step and change it: 1 step later the forces
-  were about twice the uninterrupted run's), the collider's potential (not real) interactions
-  (6 x 12 mm after the ramp: 242 interactions before ``O.save``, 241 real ones after ``O.load``;
-  they carry no force), and every Python handle: bodies, interactions and engines are new
-  objects after ``O.load``.
+  were about twice the uninterrupted run's), permanent forces (``setPermF``: the confinement's,
+  set again), the collider's potential (not real) interactions (6 x 12 mm after the ramp: 242
+  interactions before ``O.save``, 241 real ones after ``O.load``; they carry no force), and every
+  Python handle: bodies, interactions and engines are new objects after ``O.load``.
 
-So after ``O.load`` (:func:`restore`) the bond, link and engine handles of the
-:class:`~.scene.GrainScene` and the platens' body handles are fetched anew, and the one force
-the driver reads before the next step, the platens' reaction (the servo's input), is restored
-from the state (:meth:`~.platens.Platens.rebind`); the Python-side state (servo, stress
+So after ``O.load`` (:func:`restore_scene`) the bond, link and engine handles of the
+:class:`~.scene.GrainScene` and the platens' (jaws') body handles are fetched anew, and the one
+force the creep driver reads before the next step, the platens' reaction (the servo's input), is
+restored from the state (:meth:`~.platens.Platens.rebind`); the Python-side state (servo, stress
 corrosion, clock, history, loop counters) comes from ``state.json`` and ``arrays.npz``.
 """
 from __future__ import annotations
@@ -57,8 +59,9 @@ SCENE_FILE = "scene.yade.gz"
 ARRAYS_FILE = "arrays.npz"
 #: Layout of state.json and arrays.npz; a checkpoint of another layout is refused.
 FORMAT = 1
-#: Safe points of the creep driver at which a checkpoint can be taken (the phase it resumes in).
-PHASES = ("ramp", "event", "paper")
+#: Safe points of each test's driver at which a checkpoint can be taken (the phase it resumes in);
+#: a checkpoint without a ``test`` key is a creep run's (written before the other tests had any).
+PHASES = {"creep": ("loading", "ramp", "event", "paper"), "ucs": ("loading",), "brazilian": ("loading",)}
 #: Prefix of the initial bond-stress table's columns in arrays.npz.
 START_TABLE = "start_"
 
@@ -79,14 +82,17 @@ def _fsync(path):
 
 
 class Checkpointer:
-    """Writes the checkpoints of one creep run into ``run_folder/checkpoint/``.
+    """Writes the checkpoints of one run into ``run_folder/checkpoint/``.
 
-    ``interval``: wall time between checkpoints [s] (``creep.checkpoint_interval``); 0: only the one
-    at the end of the ramp.  ``run_values``: what besides the parameters makes the run (seed, load),
-    stored so that a batch rerun can tell whether the checkpoint continues its row.
+    ``interval``: wall time between checkpoints [s] (``numerics.checkpoint_interval``); 0: none but
+    those the driver forces (a creep run's at the end of its ramp).  ``run_values``: what besides the
+    parameters makes the run (seed, load), stored so that a batch rerun can tell whether the
+    checkpoint continues its row.  ``capture(run, phase, loop, run_values, code_version)`` gives
+    (state, arrays) of the run (default: a creep run's, :func:`capture`).
     """
 
-    def __init__(self, run_folder, interval: float, run_values: dict, progress=None):
+    def __init__(self, run_folder, interval: float, run_values: dict, progress=None, capture=None):
+        self.capture = capture or globals()["capture"]
         self.folder = Path(run_folder)
         self.interval = float(interval)
         self.run_values = dict(run_values)
@@ -106,7 +112,7 @@ class Checkpointer:
         try:
             shutil.rmtree(tmp, ignore_errors=True)
             tmp.mkdir(parents=True)
-            state, arrays = capture(run, phase, loop, self.run_values, self.code_version)
+            state, arrays = self.capture(run, phase, loop, self.run_values, self.code_version)
             run.scene.O.save(str(tmp / SCENE_FILE))
             with open(tmp / ARRAYS_FILE, "wb") as fh:
                 np.savez(fh, **arrays)
@@ -131,28 +137,42 @@ class Checkpointer:
         self.sizes.append(sum(p.stat().st_size for p in final.iterdir()))
 
 
+def base_state(test: str, run, phase: str, loop: dict, run_values: dict, version: str) -> dict:
+    """The keys of state.json every test writes (``run``: has ``scene``, ``t0`` and ``c0``)."""
+    sc = run.scene
+    return {"format": FORMAT, "test": test, "phase": phase, "loop": dict(loop), "run_values": run_values,
+            "code_version": version, "written": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+            "dem_steps": int(sc.O.iter), "wall_s": time.time() - run.t0, "cpu_s": time.process_time() - run.c0,
+            "scene": {"n_bodies": len(sc.O.bodies), "n_bonds": sc.n_bonds, "cracks_seen": sc._cracks_seen,
+                      "tens_seen": getattr(sc, "_tens_seen", 0)}}
+
+
+def scene_arrays(scene) -> dict:
+    """The scene's bond bookkeeping for arrays.npz."""
+    return {"broken": scene.broken, "break_mode": scene.break_mode, "break_step": scene.break_step}
+
+
+def platen_state(platens) -> dict:
+    return {"velocity": platens.velocity, "y0_top": float(platens.y0_top), "y0_bottom": float(platens.y0_bottom),
+            "x0_gap": float(platens.x0_gap), "reaction_pa": float(platens.axial_stress())}
+
+
 def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") -> tuple:
-    """(state dict for state.json, arrays for arrays.npz) of ``run`` at a safe point."""
+    """(state dict for state.json, arrays for arrays.npz) of creep run ``run`` at a safe point."""
     sc, pl = run.scene, run.platens
-    O = sc.O
     state = {
-        "format": FORMAT, "phase": phase, "loop": dict(loop), "run_values": run_values,
-        "code_version": version, "written": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "dem_steps": int(O.iter), "wall_s": time.time() - run.t0, "cpu_s": time.process_time() - run.c0,
+        **base_state("creep", run, phase, loop, run_values, version),
         "creep_time_s": run.rows[-1]["creep_time_s"] if run.rows else 0.0,
         "run": {"rows": run.rows, "ramp_broken": run.ramp_broken, "failed": run.failed,
                 "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
                 "n_events": run.n_events, "vtk_times": run.vtk_times, "vtk_written": run.vtk_written,
                 "vtk_rows": run._vtk_rows, "vtk": run.vtk_folder is not None,
-                "last_relaxation_steps": getattr(run, "last_relaxation_steps", 0), "resumes": run.resumes},
-        "scene": {"n_bodies": len(O.bodies), "n_bonds": sc.n_bonds, "cracks_seen": sc._cracks_seen,
-                  "tens_seen": getattr(sc, "_tens_seen", 0)},
-        "platens": {"velocity": pl.velocity, "y0_top": float(pl.y0_top), "y0_bottom": float(pl.y0_bottom),
-                    "x0_gap": float(pl.x0_gap), "reaction_pa": float(pl.axial_stress())},
+                "last_relaxation_steps": getattr(run, "last_relaxation_steps", 0), "resumes": run.resumes,
+                "consolidation": getattr(run, "consolidation", {})},
+        "platens": platen_state(pl),
         "servo": None, "clock": None, "corrosion": None, "start_table_columns": None,
     }
-    arrays = {"broken": sc.broken, "break_mode": sc.break_mode, "break_step": sc.break_step,
-              "break_time": run.break_time, "macro_time": run.macro_time}
+    arrays = {**scene_arrays(sc), "break_time": run.break_time, "macro_time": run.macro_time}
     servo = getattr(run, "servo", None)
     if servo is not None:
         state["servo"] = {"target": servo.target, "gain": servo.gain, "max_speed": servo.max_speed,
@@ -171,12 +191,13 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
     return state, arrays
 
 
-def read(run_folder) -> tuple:
-    """(checkpoint folder, state, arrays) of run ``run_folder``; GrainfracError if it has none or it is bad."""
+def read(run_folder, test: str = "creep") -> tuple:
+    """(checkpoint folder, state, arrays) of the ``test`` run in ``run_folder``; GrainfracError if it has
+    none or it is bad."""
     where = checkpoint_folder(run_folder)
     if where is None:
         raise GrainfracError(f"{run_folder}: no checkpoint to resume from ({CHECKPOINT}/ missing: the run stopped "
-                             "before the end of its ramp, or was started by code without checkpoints); fix: start "
+                             "before its first checkpoint, or was started by code without checkpoints); fix: start "
                              "it again with --overwrite")
     try:
         state = json.loads((where / CHECKPOINT_STATE).read_text())
@@ -185,10 +206,13 @@ def read(run_folder) -> tuple:
     except (OSError, ValueError) as exc:
         raise GrainfracError(f"{where}: checkpoint unreadable ({type(exc).__name__}: {exc}); fix: start the run "
                              "again with --overwrite") from None
-    if state.get("format") != FORMAT or state.get("phase") not in PHASES:
+    if state.get("format") != FORMAT or state.get("phase") not in PHASES.get(state.get("test", "creep"), ()):
         raise GrainfracError(f"{where}: checkpoint of another layout (format {state.get('format')!r}, this code "
                              f"reads {FORMAT}); fix: resume it with the code that wrote it, or start the run again "
                              "with --overwrite")
+    if state.get("test", "creep") != test:
+        raise GrainfracError(f"{where}: checkpoint of a {state.get('test', 'creep')} run, not of a {test} run; fix: "
+                             f"resume it with the {state.get('test', 'creep')} command")
     return where, state, arrays
 
 
@@ -217,16 +241,10 @@ def rebind_scene(scene):
     scene.newton = next(e for e in O.engines if isinstance(e, w.NewtonIntegrator))
 
 
-def restore(run, where, state: dict, arrays: dict):
-    """Load the checkpoint ``where`` into ``run``, freshly built from the same specimen and parameters.
-
-    Returns (phase, loop counters) for the driver to go on from.
-    """
-    from ..clocks import EventClock, PaperClock
-    from .corrosion_engine import StressCorrosion
-    from .creep_test import add_stiffness_restorer
-    from .platens import StressServo
-    sc, pl = run.scene, run.platens
+def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):
+    """Replace scene ``sc`` (freshly built from the same specimen and parameters) by the checkpoint's
+    (``O.load``), fetch its handles anew and restore its bond bookkeeping; ``confinement``: the
+    :class:`.confinement.Confinement` whose permanent forces are set again (None: unconfined)."""
     O = sc.O
     n_bodies = len(O.bodies)
     if state["scene"]["n_bodies"] != n_bodies or state["scene"]["n_bonds"] != sc.n_bonds:
@@ -235,22 +253,62 @@ def restore(run, where, state: dict, arrays: dict):
                              "run again with --overwrite")
     O.load(str(where / SCENE_FILE))
     rebind_scene(sc)
-    if run.confinement is not None:
-        run.confinement.apply()   # permanent forces are not saved with the scene
-    p = state["platens"]
-    pl.rebind(p["reaction_pa"])
-    pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]
+    if confinement is not None:
+        confinement.apply()   # permanent forces are not saved with the scene
     sc.broken, sc.break_mode, sc.break_step = (np.array(arrays[k]) for k in ("broken", "break_mode", "break_step"))
     sc._cracks_seen, sc._tens_seen = state["scene"]["cracks_seen"], state["scene"]["tens_seen"]
     if sc.law.nbTensCracks + sc.law.nbShearCracks != sc._cracks_seen:
         raise GrainfracError(f"{where}: the loaded scene's crack count ({sc.law.nbTensCracks + sc.law.nbShearCracks}) "
                              f"is not the checkpoint's ({sc._cracks_seen}); fix: start the run again with --overwrite")
+
+
+def restore_platens(pl, p: dict):
+    """After :func:`restore_scene`: the platens' body handles anew, their reference positions and speed."""
+    pl.rebind(p["reaction_pa"])
+    pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]
+
+
+#: Why a resumed run of finite-element cells is not bit-identical (measured: 3 x 6 mm fem UCS resumed at
+#: DEM step 20,179: E -6e-5, crack initiation -4e-5, peak +5e-7 relative, the same 26 bonds broken in the
+#: same modes, up to 17 DEM steps apart; docs/resuming.md).
+FEM_INEXACT = ("finite-element cells: YADE keys an element's nodes by their memory address, which O.load changes, "
+               "so the element sums its nodes in another order: the resumed run differs from an uninterrupted one "
+               "by rounding that grows (measured: E within 1e-4 relative)")
+
+
+def inexact_note(params) -> str:
+    """"" if a resume of a run with ``params`` is bit-identical to the uninterrupted run (one thread), else why not."""
+    return FEM_INEXACT if params.resolution.grain_model == "fem" else ""
+
+
+def resume_record(state: dict) -> dict:
+    """What a summary's ``resumed_from`` lists for the checkpoint ``state``."""
+    out = {"dem_steps": state["dem_steps"], "phase": state["phase"], "checkpoint_written": state["written"]}
+    if "creep_time_s" in state:
+        out["creep_time_s"] = state["creep_time_s"]
+    return out
+
+
+def restore(run, where, state: dict, arrays: dict):
+    """Load the checkpoint ``where`` into creep run ``run``, freshly built from the same specimen and
+    parameters.
+
+    Returns (phase, loop counters) for the driver to go on from.
+    """
+    from ..clocks import EventClock, PaperClock
+    from .corrosion_engine import StressCorrosion
+    from .creep_test import add_stiffness_restorer
+    from .platens import StressServo
+    sc, pl = run.scene, run.platens
+    restore_scene(sc, where, state, arrays, run.confinement)
+    restore_platens(pl, state["platens"])
     r = state["run"]
     run.rows = r["rows"]
     run.ramp_broken, run.failed, run.failure_reason = r["ramp_broken"], r["failed"], r["failure_reason"]
     run.failed_on_loading, run.n_events = r["failed_on_loading"], r["n_events"]
     run.vtk_times, run.vtk_written, run._vtk_rows = r["vtk_times"], r["vtk_written"], r["vtk_rows"]
     run.last_relaxation_steps = r["last_relaxation_steps"]
+    run.consolidation = r.get("consolidation", {})
     run.resumes = r["resumes"] + [{"dem_steps": state["dem_steps"], "creep_time_s": state["creep_time_s"],
                                    "phase": state["phase"], "checkpoint_written": state["written"]}]
     run.break_time, run.macro_time = np.array(arrays["break_time"]), np.array(arrays["macro_time"])

@@ -25,8 +25,8 @@ up), or ``MAX_STALLED_INTERVALS`` creep intervals of length 0 in a row that
 break no bond, end the run with ``numerical_failure`` set and the reason in
 ``failure_reason``: neither a lifetime nor a survival.
 
-Checkpoints (given a run folder): at the end of the ramp and then every
-``creep.checkpoint_interval`` s of wall time, at a safe point of the clock loops
+Checkpoints (given a run folder): every ``numerics.checkpoint_interval`` s of wall time
+in the ramp, always at its end, then every interval again at a safe point of the clock loops
 (:meth:`CreepRun.safe_point`); :func:`resume_creep` goes on from the last one and
 computes what the uninterrupted run would have (:mod:`.checkpoint`).
 """
@@ -169,7 +169,7 @@ class CreepRun:
         self.checkpointer = None
         if checkpoint_folder is not None:
             from .checkpoint import Checkpointer
-            self.checkpointer = Checkpointer(checkpoint_folder, params.creep.checkpoint_interval, run_values or {},
+            self.checkpointer = Checkpointer(checkpoint_folder, params.numerics.checkpoint_interval, run_values or {},
                                              self.progress)
         #: (phase, loop counters) to go on from after :func:`resume_creep`; None: a run from the start
         self.resumed = None
@@ -224,12 +224,17 @@ class CreepRun:
         self.break_time[new] = creep_time
 
     # ------------------------------------------------------------------ phases
-    def ramp(self):
+    def ramp(self, resume=None):
+        """Strain-controlled loading to the target stress; ``resume``: the counters of a checkpoint taken
+        in it (phase ``loading``: the scene, platens and their speed came back with it)."""
         cp = self.params.creep
-        self.platens.set_axial_velocity(cp.ramp_strain_rate * self.platens.height)
+        if resume is None:
+            self.platens.set_axial_velocity(cp.ramp_strain_rate * self.platens.height)
         steps = max(1, int(round(1e-5 / (cp.ramp_strain_rate * self.scene.O.dt))))
-        peak = 0.0
+        peak = 0.0 if resume is None else float(resume["peak"])
         while True:
+            if self.scene.O.iter > 0:   # not before the first step: the bonds' reference state is set by it
+                self.safe_point("loading", {"peak": peak})
             self.scene.run(steps)
             s = self.platens.axial_stress()
             check_value("axial stress during the ramp", s, self.scene.O.iter)
@@ -309,9 +314,10 @@ class CreepRun:
         self.n_events = int(np.sum(self.break_time > 0))
 
     def safe_point(self, phase, loop):
-        """A point between DEM steps where the driver's state is complete (``phase``: "ramp", "event",
-        "paper"; ``loop``: the clock loop's counters): write a checkpoint if one is due, always at the
-        end of the ramp, then every ``creep.checkpoint_interval`` s of wall time."""
+        """A point between DEM steps where the driver's state is complete (``phase``: "loading" (in the
+        ramp), "ramp" (its end), "event", "paper"; ``loop``: the ramp's or the clock loop's counters):
+        write a checkpoint if one is due, always at the end of the ramp, else every
+        ``numerics.checkpoint_interval`` s of wall time."""
         ck = self.checkpointer
         if ck is not None and (phase == "ramp" or ck.due()):
             ck.write(self, phase, loop)
@@ -351,17 +357,17 @@ class CreepRun:
 
     def _run(self):
         phase, loop = self.resumed or (None, None)
-        if phase is None:
-            if self.confinement is not None:
+        if phase in (None, "loading"):
+            if phase is None and self.confinement is not None:
                 self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params.creep,
                                                  young_estimate(self.params))
-            self.ramp()
+            self.ramp(loop if phase == "loading" else None)
             self.record(0.0)
             self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp
             if self.failed:
                 return self
             self.safe_point("ramp", {})
-        if phase in (None, "ramp"):
+        if phase in (None, "loading", "ramp"):
             self.hold_servo()
             if not self.params.stress_corrosion.enabled:
                 # control run: the load is held, nothing corrodes; equilibrium must come and stay
@@ -547,11 +553,13 @@ def resume_creep(specimen, params, target_stress, run_folder, progress=None, **o
     driver's state is restored (:func:`.checkpoint.restore`).  GrainfracError if the folder holds
     no usable checkpoint.
     """
-    from .checkpoint import read, restore
+    from .checkpoint import inexact_note, read, restore
     where, state, arrays = read(run_folder)
     outputs.setdefault("run_values", state.get("run_values"))
     run = CreepRun(specimen, params, target_stress, progress, checkpoint_folder=run_folder, **outputs)
     run.resumed = restore(run, where, state, arrays)
     run.progress(f"resumed from the checkpoint at DEM step {state['dem_steps']}, creep time "
                  f"{state['creep_time_s']:.6g} s ({state['phase']} phase)")
+    if inexact_note(params):
+        run.progress(f"note: not bit-identical: {inexact_note(params)}")
     return run.run()
