@@ -65,7 +65,8 @@ class Specimen:
             "n_faces": t.n_faces,
             "n_faces_inter": int(self.face_is_inter.sum()),
             "n_faces_intra": int((~self.face_is_inter).sum()),
-            "shortest_face_m": float(t.face_measure.min()) if t.n_faces else None,
+            ("shortest_face_m" if t.dim == 2 else "smallest_face_m2"):
+                float(t.face_measure.min()) if t.n_faces else None,
             "edges_collapsed": self.edges_collapsed,
             "edges_kept_short": self.edges_kept_short,
             "mean_equivalent_diameter_m": float(eq.mean()),
