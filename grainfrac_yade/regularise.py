@@ -7,8 +7,9 @@ is to remove such edges: 3DEC's block edge tolerance, UDEC's minimum edge length
 length) and Neper's regularisation of Voronoi tessellations (Quey, Dawson & Barbe 2011, Comput.
 Methods Appl. Mech. Eng. 200: small edges removed so that the cells mesh into good elements).
 
-The collapse of an interior edge (a face shared by two cells) merges its two vertices into one, at the
-edge's midpoint, with the constraints of the two vertices kept: a vertex on a box wall slides only
+The collapse of an edge (a face shared by two cells, a cell's side on a box wall or a rim arc: a short
+wall side or arc makes the same sliver fan triangle at the boundary) merges its two vertices into one, at
+the edge's midpoint (an arc: its chord's), with the constraints of the two vertices kept: a vertex on a box wall slides only
 along that wall, a box corner stays at the corner, a vertex on a disc's rim is put back on the circle
 (radially).  Edges are taken shortest first (ties by vertex index, so the result is deterministic),
 and after every collapse the edges at the merged vertex are looked at again (they moved).
@@ -16,7 +17,7 @@ and after every collapse the edges at the merged vertex are looked at again (the
 A collapse is skipped, and counted in ``edges_kept_short``, where it would spoil a cell: every cell
 touching the merged vertex must keep at least three corners (two if one of its sides is a rim arc),
 stay strictly convex (each corner's turn above :data:`CONVEX_TOLERANCE` of its two edges' lengths) and
-keep a positive area; two rim vertices are never merged (the arc between them would vanish).  So no
+keep a positive area.  So no
 cell is ever deleted, every interior face keeps its two cells, and the cells still tile the domain
 exactly (their corners are shared), so their areas sum to the box's or disc's area to rounding.
 
@@ -46,7 +47,8 @@ FREE, WALL_X, WALL_Y, CORNER, RIM = 0, 1, 2, 3, 4
 
 @dataclass(frozen=True)
 class Regularisation:
-    """What :func:`regularise` did: edges collapsed and short interior edges kept (collapse refused)."""
+    """What :func:`regularise` did: edges collapsed and edges (faces, wall sides, arcs) still shorter than the
+    threshold (their collapse refused)."""
     min_edge: float            # m, the threshold (min_edge_fraction x grain size)
     edges_collapsed: int
     edges_kept_short: int
@@ -61,7 +63,7 @@ def check_min_edge_fraction(fraction: float, dimension: int):
 
 
 def regularise(tess: Tessellation, min_edge_fraction: float, grain_size: float) -> tuple:
-    """(tessellation, :class:`Regularisation`): interior edges shorter than ``min_edge_fraction`` x
+    """(tessellation, :class:`Regularisation`): edges shorter than ``min_edge_fraction`` x
     ``grain_size`` collapsed (module doc).  Fraction 0: ``tess`` itself, untouched."""
     min_edge = min_edge_fraction * grain_size
     if min_edge_fraction == 0:
@@ -70,7 +72,7 @@ def regularise(tess: Tessellation, min_edge_fraction: float, grain_size: float) 
     disc = hasattr(tess, "radius") and tess.radius > 0
     mesh = _disc_mesh(tess, grain_size) if disc else _box_mesh(tess)
     collapsed = mesh.collapse_short(min_edge)
-    kept = sum(1 for (u, v) in mesh.interior_edges() if mesh.length(u, v) < min_edge)
+    kept = sum(1 for (u, v) in mesh.edges() if mesh.length(u, v) < min_edge)
     report = Regularisation(min_edge, collapsed, kept)
     if collapsed == 0:
         return tess, report
@@ -104,29 +106,20 @@ class _PlaneMesh:
         n = len(cyc)
         return [(cyc[k], cyc[(k + 1) % n]) for k in range(n) if not arc[k]]
 
-    def interior_edges(self) -> list:
-        """Sorted (u, v), u < v, of the straight sides shared by two cells."""
-        count = {}
-        for c in range(len(self.cells)):
-            for u, v in self._straight_sides(c):
-                key = (min(u, v), max(u, v))
-                count[key] = count.get(key, 0) + 1
-        return sorted(k for k, n in count.items() if n == 2)
+    def _sides(self, c):
+        cyc = self.cells[c]
+        return [(cyc[k], cyc[(k + 1) % len(cyc)]) for k in range(len(cyc))]
 
-    def _is_interior(self, u, v) -> bool:
-        shared = self.vcells[u] & self.vcells[v]
-        if len(shared) != 2:
-            return False
-        for c in shared:
-            if (u, v) not in self._straight_sides(c) and (v, u) not in self._straight_sides(c):
-                return False
-        return True
+    def edges(self) -> list:
+        """Sorted (u, v), u < v, of every side of every cell: interior faces, wall sides, rim arcs."""
+        return sorted({(min(u, v), max(u, v)) for c in range(len(self.cells)) for u, v in self._sides(c)})
+
+    def _is_edge(self, u, v) -> bool:
+        return any((u, v) in self._sides(c) or (v, u) in self._sides(c) for c in self.vcells[u] & self.vcells[v])
 
     def _merged(self, u, v):
         """(position, kind) of the vertex merging u and v, or None if they must not merge."""
         pu, pv, ku, kv = self.pos[u], self.pos[v], self.kind[u], self.kind[v]
-        if ku == RIM and kv == RIM:
-            return None
         if ku == CORNER or kv == CORNER:
             return (pu if ku == CORNER else pv).copy(), CORNER
         w = 0.5 * (pu + pv)
@@ -158,13 +151,9 @@ class _PlaneMesh:
             if u in cyc and v in cyc:
                 i, j = cyc.index(u), cyc.index(v)
                 if (i + 1) % n == j:        # side u -> v goes; u takes v's outgoing side
-                    if arc[i]:
-                        return False
                     new_arc = list(arc)
                     new_arc[i] = arc[j]
                 elif (j + 1) % n == i:      # side v -> u goes; the side into v now ends at u
-                    if arc[j]:
-                        return False
                     new_arc = list(arc)
                 else:
                     return False
@@ -190,24 +179,24 @@ class _PlaneMesh:
 
     def collapse_short(self, min_edge: float) -> int:
         """Collapse interior edges shorter than ``min_edge``, shortest first; return how many."""
-        heap = [(self.length(u, v), u, v) for u, v in self.interior_edges() if self.length(u, v) < min_edge]
+        heap = [(self.length(u, v), u, v) for u, v in self.edges() if self.length(u, v) < min_edge]
         heapq.heapify(heap)
         refused = set()
         done = 0
         while heap:
             length, u, v = heapq.heappop(heap)
             if not (self.alive[u] and self.alive[v]) or (u, v) in refused or length != self.length(u, v) \
-                    or not self._is_interior(u, v):
+                    or not self._is_edge(u, v):
                 continue
             if not self._try_collapse(u, v):
                 refused.add((u, v))
                 continue
             done += 1
             for c in self.vcells[u]:       # sides around the merged vertex moved: look at them again
-                for a, b in self._straight_sides(c):
+                for a, b in self._sides(c):
                     key = (min(a, b), max(a, b))
                     ell = self.length(*key)
-                    if ell < min_edge and self._is_interior(*key):
+                    if ell < min_edge:
                         refused.discard(key)
                         heapq.heappush(heap, (ell, *key))
         return done
