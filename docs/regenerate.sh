@@ -32,6 +32,7 @@ declare -A WHAT=(
   [accuracy_cost_paper_size]="docs/studies/accuracy_cost.md paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
   [threshold]="docs/studies/creep.md long-term strength table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
+  [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired fem UCS/E at 0, 2, 5 % (docs/regularisation_ucs.csv, 9 UCS runs: about 20 min on one core)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -79,6 +80,8 @@ run_target() {
                    cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
     step_floor) $PY docs/step_floor_steps.py ;;
+    regularisation) $PY docs/regularisation_steps.py
+                    $PY docs/regularisation_ucs.py ;;
     threshold) for s in 1 2; do $PY -m grainfrac_yade ucs --width 4e-3 --height 8e-3 --seed $s \
                    --out results/threshold_tiny/ucs_seed$s --overwrite; done
                batch params/threshold_study_tiny.table creep.py threshold_tiny
@@ -96,7 +99,8 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
 fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lattice lifetime_small
-                           lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold)
+                           lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
+                           regularisation)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)

@@ -11,6 +11,7 @@ import numpy as np
 
 from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
 from .params import Parameters
+from .regularise import regularise
 from .tessellation import Tessellation, voronoi_box
 
 
@@ -23,6 +24,8 @@ class Specimen:
     clump_label: np.ndarray      # (n_cells,) mineral clump of each cell
     thickness: float             # m, layer thickness (2D) or box depth (3D)
     seed: int
+    edges_collapsed: int = 0     # short Voronoi edges collapsed (specimen.min_edge_fraction)
+    edges_kept_short: int = 0    # interior edges below the threshold whose collapse would spoil a cell
 
     @property
     def n_cells(self) -> int:
@@ -62,6 +65,10 @@ class Specimen:
             "n_faces": t.n_faces,
             "n_faces_inter": int(self.face_is_inter.sum()),
             "n_faces_intra": int((~self.face_is_inter).sum()),
+            ("shortest_face_m" if t.dim == 2 else "smallest_face_m2"):
+                float(t.face_measure.min()) if t.n_faces else None,
+            "edges_collapsed": self.edges_collapsed,
+            "edges_kept_short": self.edges_kept_short,
             "mean_equivalent_diameter_m": float(eq.mean()),
             "std_equivalent_diameter_m": float(eq.std()),
             "mineral_area_fractions": self.area_fractions(),
@@ -78,13 +85,16 @@ def specimen_from_tessellation(tess: Tessellation, mineral, names, thickness: fl
 
 
 def build_specimen(params: Parameters, seed: int) -> Specimen:
-    """Tessellate the specimen of ``params.specimen`` and allocate minerals (seeded)."""
+    """Tessellate the specimen of ``params.specimen``, collapse its short edges
+    (``specimen.min_edge_fraction``, :mod:`grainfrac_yade.regularise`) and allocate minerals (seeded)."""
     sp = params.specimen
     box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
     rng = np.random.default_rng(seed)
-    tess = voronoi_box(box, sp.grain_size, rng, sp.lloyd_iterations)
+    tess, reg = regularise(voronoi_box(box, sp.grain_size, rng, sp.lloyd_iterations), sp.min_edge_fraction,
+                           sp.grain_size)
     names = params.minerals
     fractions = [params.composition[m] for m in names]
     mineral = allocate_minerals(tess.cell_measure, fractions, rng)
     return Specimen(tessellation=tess, mineral=mineral, mineral_names=names,
-                    clump_label=mineral_clumps(tess.face_cells, mineral), thickness=sp.thickness, seed=seed)
+                    clump_label=mineral_clumps(tess.face_cells, mineral), thickness=sp.thickness, seed=seed,
+                    edges_collapsed=reg.edges_collapsed, edges_kept_short=reg.edges_kept_short)

@@ -5,14 +5,17 @@ from pathlib import Path
 
 import numpy as np
 
+from ..dem_step import critical_dem_step
 from ..layout import layout_for
 from ..plotting import specimen_figure
 from ..runio import prepare_run_dir, write_json
 from ..specimen import build_specimen
 
 
-def specimen_record(specimen, layout) -> dict:
-    """``specimen.json`` content: specimen summary plus bond counts of the layout."""
+def specimen_record(specimen, layout, params=None) -> dict:
+    """``specimen.json`` content: specimen summary plus bond counts of the layout and, given ``params``, the
+    critical DEM step of its scene (:func:`grainfrac_yade.dem_step.critical_dem_step`, computed without YADE:
+    what a run of this specimen will cost before it starts)."""
     is_inter = specimen.face_is_inter[layout.bond_face]
     face_sum = np.bincount(layout.bond_face, weights=layout.bond_area, minlength=specimen.tessellation.n_faces)
     summary = specimen.summary()
@@ -25,6 +28,11 @@ def specimen_record(specimen, layout) -> dict:
         "n_bonds_intra": int((~is_inter).sum()),
         "max_face_area_mismatch_rel": float(np.max(np.abs(face_sum / specimen.face_area - 1.0))),
     })
+    if params is not None:
+        summary["grain_model"] = params.resolution.grain_model
+        summary["min_edge_fraction"] = params.specimen.min_edge_fraction
+        summary["critical_dem_step_s"] = critical_dem_step(specimen, params, layout)
+        summary["dem_step_s"] = params.numerics.timestep_safety * summary["critical_dem_step_s"]
     return summary
 
 
@@ -40,7 +48,7 @@ def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bo
     out = prepare_run_dir(out, "specimen", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     layout = layout_for(specimen, params)
-    record = specimen_record(specimen, layout)
+    record = specimen_record(specimen, layout, params)
     record["spheres_per_cell_parameter"] = params.resolution.spheres_per_cell
     write_json(Path(out) / "specimen.json", record)
     specimen_figure(specimen, Path(out) / "specimen.png",
@@ -63,5 +71,6 @@ def run_specimen_in_yade():
     record["n_bonds_yade"] = scene.O.interactions.countReal() - len(scene.links)   # breakable bonds
     record["n_links_yade"] = len(scene.links)   # unbreakable intra-cell links (deformable cells)
     record["engines"] = scene.engine_names()
+    record["dt_critical_yade"] = scene.dt_critical   # equals critical_dem_step_s (the same arithmetic)
     write_json(Path(out) / "specimen.json", {k: v for k, v in record.items() if k != "out"})
     print(f"specimen: {record['n_cells']} cells, {record['n_bonds_yade']} bonds in YADE -> {out}")

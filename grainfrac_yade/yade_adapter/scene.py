@@ -36,8 +36,10 @@ import numpy as np
 
 from ..errors import GrainfracError, NumericalFailure
 from ..law import check_finite
-from ..layout import (BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for,
-                      step_floor_factors)
+from ..dem_step import (DEFORMABLE_BLOCKED_DOFS, DEFORMABLE_RATCHETING_GUARD, _links,  # noqa: F401 (re-exported)
+                        body_steps, cell_steps, critical_timestep, fem_node_stiffness, inertia_about_bodies,
+                        lift_short_steps, rigid_masses_and_step, sphere_mass_inertia, sphere_masses_and_step)
+from ..layout import BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for
 from ..params import Parameters
 from ..specimen import Specimen
 from . import load_yade
@@ -49,25 +51,6 @@ COHESIVE_TYPE = 1
 #: FnMax and FsMax [N] of the intra-cell links of deformable cells: never reached, so a link never
 #: breaks (not 0: FnMax = 0 only switches the tension check off, a shear break would still happen).
 LINK_STRENGTH = 1e30
-#: Blocked DOFs of the spheres of deformable cells: in-plane translation only, the springs that
-#: :mod:`grainfrac_yade.deformable` fits and the static lattice solve assumes.  Measured (layout of
-#: commit fa5f3f4) on 4 x 8 mm, seed 1, 2 nodes per face, axial strain 3e-4 (5x the UCS rate;
-#: static lattice solve: E 89.6 GPa, nu 0.209, bond shear p99 1.05 x the applied stress):
-#:   "zXYZ", plain kinematics (below): E 89.8 GPa, nu 0.208, p99 1.05, DEM step 3.7e-8 s;
-#:   "zXY" (free spin, as rigid cells), YADE's default kinematics: E 80.5 GPa, nu 0.255, p99 0.80
-#:   (max 1.56), DEM step 8.1e-9 s (the rotation of the smallest spheres sets it: 4.6x more steps).
-#: Blocking has a price only where links carry shear springs: a translation-only link with one
-#: resists the rigid rotation of its cell (its shear spring sees the chord).  With such links a
-#: 4 x 8 mm specimen with the rigid-cell calibration reached a UCS of 1414 MPa (677 MPa free spin,
-#: 252 MPa rigid cells); the links of :mod:`grainfrac_yade.deformable` are normal springs only.
-DEFORMABLE_BLOCKED_DOFS = "zXYZ"
-#: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in deformable scenes.  YADE's default (True)
-#: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
-#: a link between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
-#: False: the plain relative displacement, k_s as given (bonds join touching spheres: no change for
-#: them); the DEM then gives the static lattice solve's E and Poisson's ratio (tested; 85.5 GPa,
-#: nu 0.227 with the default).  Rigid cells keep YADE's default.
-DEFORMABLE_RATCHETING_GUARD = False
 #: Collision mask bit shared by every sphere of a scene with per-cell masks (and the collider's
 #: ``avoidSelfInteractionMask``): YADE makes no contact between two bodies of equal masks that
 #: carry this bit, and lets bodies of different masks that share it meet.
@@ -340,96 +323,6 @@ def _blocked_dofs(dim: int) -> str:
     return "zXY" if dim == 2 else ""
 
 
-def _oscillation_steps(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq: np.ndarray,
-                       mass: np.ndarray, inertia: np.ndarray | None) -> np.ndarray:
-    """(n_bodies,) the smaller of sqrt(m/K) and sqrt(I/K_rot) of each body, for springs of stiffness ``k``
-    joining ``ends`` (c, 2).
-
-    K sums k over a body's springs, K_rot sums k x ``lever_sq`` ((2c,): the first ends' squared
-    lever arms, then the second ends').  ``inertia`` None: bodies that do not rotate, sqrt(m/K) only.
-    """
-    k_body = np.bincount(ends.ravel(), weights=np.repeat(k, 2), minlength=n_bodies)
-    with np.errstate(divide="ignore"):
-        t_trans = np.sqrt(mass / k_body)
-        if inertia is None:
-            return t_trans
-        k_rot = np.bincount(np.concatenate([ends[:, 0], ends[:, 1]]), weights=np.tile(k, 2) * lever_sq,
-                            minlength=n_bodies)
-        t_rot = np.sqrt(inertia / k_rot)
-    return np.minimum(t_trans, t_rot)
-
-
-def _links(layout: ClumpLayout):
-    """(m, 2) sphere pairs, k_n and k_s [N/m] of the layout's intra-cell links (empty without links)."""
-    if not layout.n_links:
-        return np.empty((0, 2), dtype=np.int64), np.empty(0), np.empty(0)
-    return layout.link_spheres, layout.link_normal_stiffness, layout.link_shear_stiffness
-
-
-def body_steps(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
-               mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
-               rotating: bool = True, ratcheting_guard: bool = True) -> np.ndarray:
-    """Each body's own critical DEM step [s]: sqrt(m/K), and sqrt(I/K_rot) where it rotates.
-
-    Rigid cells: the bodies are the cells (``mass``, ``inertia`` per cell; ``body_pos`` (n, 3)
-    the cell bodies' positions).  K sums k_n + k_s of a cell's bonds; K_rot sums
-    (k_n + k_s) |r|^2 with r the lever arm from the cell body to the bond point.
-
-    Deformable cells: the bodies are the spheres (``mass``, ``inertia`` per sphere).  K sums
-    k_n + k_s of a sphere's bonds and links.  ``rotating=False`` (rotation blocked,
-    ``DEFORMABLE_BLOCKED_DOFS``, the default): sqrt(m/K) only.  Otherwise K_rot sums
-    (k_n + k_s) a l: l = max(r, (d + r - r_other)/2) the lever of the JCFpm torque (r for touching
-    spheres; for spheres d apart the force acts half-way across the gap), a the lever of rotation
-    in YADE's shear increment: the radius r with ``ratcheting_guard``
-    (``avoidGranularRatcheting``, YADE's default), l without.
-    """
-    if layout.rigid_cells:
-        cells = specimen.tessellation.face_cells[layout.bond_face]
-        lever = np.concatenate([layout.bond_point - body_pos[cells[:, 0]],
-                                layout.bond_point - body_pos[cells[:, 1]]])
-        return _oscillation_steps(specimen.n_cells, cells, props.normal_stiffness + props.shear_stiffness,
-                                  (lever**2).sum(1), mass, inertia)
-    link_spheres, link_kn, link_ks = _links(layout)
-    ends = np.concatenate([layout.bond_spheres, link_spheres]).astype(np.int64)
-    k = np.concatenate([props.normal_stiffness + props.shear_stiffness, link_kn + link_ks])
-    r = layout.sphere_radius[ends]
-    d = np.linalg.norm(layout.sphere_center[ends[:, 0]] - layout.sphere_center[ends[:, 1]], axis=1)
-    torque_lever = np.maximum(r, 0.5 * (d[:, None] + r - r[:, ::-1]))
-    lever_sq = ((r if ratcheting_guard else torque_lever) * torque_lever).T.ravel()
-    return _oscillation_steps(layout.n_spheres, ends, k, lever_sq, mass, inertia if rotating else None)
-
-
-def critical_timestep(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
-                      mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
-                      rotating: bool = True, ratcheting_guard: bool = True) -> float:
-    """Conservative critical DEM time step [s]: the smallest of the bodies' own steps (:func:`body_steps`)."""
-    return float(body_steps(layout, props, specimen, mass, inertia, body_pos, rotating, ratcheting_guard).min())
-
-
-def fem_node_stiffness(specimen: Specimen, params: Parameters, layout: ClumpLayout) -> np.ndarray:
-    """(s,) Gershgorin bound of each sphere's stiffness row in finite-element cells [N/m] (elements and
-    bonds, :func:`grainfrac_yade.elastic.node_stiffness`): a sphere's own step is sqrt(m / K)."""
-    from ..elastic import cluster_network, node_stiffness
-    return node_stiffness(cluster_network(specimen, params, layout))
-
-
-def cell_steps(body_step: np.ndarray, body_cell: np.ndarray, n_cells: int) -> np.ndarray:
-    """(n_cells,) the smallest own step of each cell's bodies [s]."""
-    steps = np.full(n_cells, np.inf)
-    np.minimum.at(steps, body_cell, body_step)
-    return steps
-
-
-def lift_short_steps(quantile: float, body_step: np.ndarray, body_cell: np.ndarray, mass: np.ndarray,
-                     inertia: np.ndarray) -> tuple:
-    """Per-body ``mass`` and ``inertia`` with ``numerics.step_floor_quantile`` applied: every body of a cell
-    whose smallest own step (``body_step``, bodies of cell ``body_cell``) lies below the quantile of the
-    cells' steps is made heavier by the cell's :func:`grainfrac_yade.layout.step_floor_factors`."""
-    n_cells = int(body_cell.max()) + 1
-    f = step_floor_factors(cell_steps(body_step, body_cell, n_cells), quantile)[body_cell]
-    return mass * f, inertia * f
-
-
 def _cell_spheres(layout: ClumpLayout, n_cells: int) -> list:
     """Sphere indices of each cell, ascending."""
     order = np.argsort(layout.sphere_cell, kind="stable")
@@ -442,7 +335,6 @@ def _append_rigid_cells(O, utils, Vector3, specimen, layout, mats, mass, inertia
 
     Returns (sphere_body, cell_body, body positions (n, 3), inertia about the bodies).
     """
-    dim = specimen.tessellation.dim
     sphere_body = np.empty(layout.n_spheres, dtype=np.int64)
     cell_body = np.empty(specimen.n_cells, dtype=np.int64)
     for cell, members in enumerate(_cell_spheres(layout, specimen.n_cells)):
@@ -457,10 +349,7 @@ def _append_rigid_cells(O, utils, Vector3, specimen, layout, mats, mass, inertia
             sphere_body[members] = ids
         cell_body[cell] = body
     body_pos3 = np.array([tuple(O.bodies[int(b)].state.pos) for b in cell_body])
-    body_pos = body_pos3[:, :dim]
-    centroid = specimen.tessellation.cell_centroid
-    # polygon inertia about the body's reference point (parallel-axis theorem)
-    inertia = inertia + mass * ((body_pos - centroid) ** 2).sum(1)
+    inertia = inertia_about_bodies(specimen, mass, inertia, body_pos3)
     _set_mass_inertia(O, Vector3, cell_body, mass, inertia, blocked)
     return sphere_body, cell_body, body_pos3, inertia
 
@@ -473,18 +362,6 @@ def _set_mass_inertia(O, Vector3, bodies, mass, inertia, blocked=None):
         st.inertia = Vector3(*([float(inertia[i])] * 3))
         if blocked is not None:
             st.blockedDOFs = blocked
-
-
-def sphere_mass_inertia(specimen: Specimen, layout: ClumpLayout, cell_mass: np.ndarray):
-    """Mass [kg] and inertia [kg m^2] of each sphere of deformable cells.
-
-    Mass: the cell's areal mass (cell mass / cell area, i.e. density x density scale x thickness)
-    times the area lumped on the sphere (``layout.sphere_area``), so a cell's spheres carry its
-    mass.  Inertia: a disc's 0.5 m r^2 on all three axes (pseudo-2D).
-    """
-    areal = cell_mass / specimen.tessellation.cell_measure
-    mass = areal[layout.sphere_cell] * layout.sphere_area
-    return mass, 0.5 * mass * layout.sphere_radius**2
 
 
 def _append_deformable_cells(O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked):
@@ -661,23 +538,20 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
     blocked = _blocked_dofs(dim) if layout.rigid_cells else DEFORMABLE_BLOCKED_DOFS
     rotating = "Z" not in blocked
     floor = params.numerics.step_floor_quantile
-    fem_k = fem_node_stiffness(specimen, params, layout) if layout.n_elements else None
+    guard = geometry.avoidGranularRatcheting
+    # masses, inertias and the critical step: the core's arithmetic (grainfrac_yade.dem_step), which
+    # specimen.json's critical_dem_step_s repeats without YADE
     if layout.rigid_cells:
         sphere_body, cell_body, body_pos3, inertia = _append_rigid_cells(
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
         cell_bodies = [cell_body[c:c + 1] for c in range(specimen.n_cells)]
+        mass, inertia, dt_crit = rigid_masses_and_step(specimen, layout, props, mass, inertia, body_pos3, floor,
+                                                       rotating, guard)
         if floor > 0:
-            own = body_steps(layout, props, specimen, mass, inertia, body_pos3, rotating,
-                             geometry.avoidGranularRatcheting)
-            mass, inertia = lift_short_steps(floor, own, np.arange(specimen.n_cells), mass, inertia)
             _set_mass_inertia(O, Vector3, cell_body, mass, inertia)
     else:
-        mass, inertia = sphere_mass_inertia(specimen, layout, mass)
-        if floor > 0:
-            own = (np.sqrt(mass / fem_k) if fem_k is not None else
-                   body_steps(layout, props, specimen, mass, inertia, None, rotating, geometry.avoidGranularRatcheting))
-            mass, inertia = lift_short_steps(floor, own, layout.sphere_cell, mass, inertia)
-        body_pos3 = None
+        mass, inertia, dt_crit, _ = sphere_masses_and_step(specimen, params, layout, props, mass, floor,
+                                                           rotating, guard)
         sphere_body, cell_body, cell_bodies = _append_deformable_cells(
             O, utils, Vector3, specimen, layout, mats, mass, inertia, blocked)
     interactions = []
@@ -708,11 +582,6 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             moving[s] = clump_id
         cell_body = np.array([moving[np.flatnonzero(sphere_body == b)[0]] for b in cell_body], dtype=np.int64)
         cell_bodies = [moving[m] for m in _cell_spheres(layout, specimen.n_cells)]
-        with np.errstate(divide="ignore"):
-            dt_crit = float(np.sqrt(mass / fem_k).min())
-    else:
-        dt_crit = critical_timestep(layout, props, specimen, mass, inertia, body_pos3, rotating=rotating,
-                                    ratcheting_guard=geometry.avoidGranularRatcheting)
     if not 0 < dt_crit < math.inf:
         raise GrainfracError(f"the scene's critical DEM step is {dt_crit:g} s (a cell without mass, or no bond "
                              "at all); fix: check the specimen's cells and faces")
