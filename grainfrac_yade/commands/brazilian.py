@@ -34,6 +34,8 @@ def register(sub, common):
     lv.add_argument("--strength-cv", type=float, default=0.0, metavar="C",
                     help="coefficient of variation of a lognormal factor (mean 1) on each bond's J^T and J^C")
     lv.add_argument("--block-rotation", action="store_true", help="cells do not rotate (rigid cells)")
+    from .ucs import add_vtk_every_option
+    add_vtk_every_option(p, "diametral")
     p.set_defaults(func=cmd_brazilian)
 
 
@@ -48,7 +50,8 @@ def cmd_brazilian(args) -> int:
     from ..yade_adapter.levers import Levers
     levers = Levers(slit_fraction=args.slit_fraction, strength_cv=args.strength_cv, block_rotation=args.block_rotation)
     out = args.out or f"results/brazilian_seed{args.seed}"
-    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers)
+    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers,
+                                      vtk_every=args.vtk_every)
     print(format_result(summary, out))
     return 0
 
@@ -116,10 +119,11 @@ def require_disc_model(params):
                              "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
 
 
-def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None) -> dict:
+def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None, vtk_every=None) -> dict:
     """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished).
 
-    ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none)."""
+    ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none); ``vtk_every``: VTK
+    series in ``out/vtk/`` at every k-th history row and the end (None: none)."""
     from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
@@ -130,8 +134,12 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
     out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
+    snapshot = None
+    if vtk_every:
+        from ..yade_adapter.vtk_output import DIAMETRAL_STRAIN, StrainSeries
+        snapshot = StrainSeries(out / "vtk", vtk_every, DIAMETRAL_STRAIN)
     history, result, scene, (broken_peak, mode_peak) = run_brazilian(specimen, params, progress=progress,
-                                                                     levers=levers)
+                                                                     levers=levers, snapshot=snapshot)
     t = specimen.tessellation
     diameter = t.diameter
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else \

@@ -6,10 +6,19 @@ import numpy as np
 from .creep import add_confinement_option, confinement_override
 
 
+def add_vtk_every_option(parser, strain: str):
+    """``--vtk-every K``: VTK series of a strain-controlled test, timestep the ``strain`` strain."""
+    from .creep import _positive_int
+    parser.add_argument("--vtk-every", type=_positive_int, default=None, metavar="K",
+                        help=f"write VTK files of cells and bonds at every K-th history row and at the end into "
+                             f"DIR/vtk/ (cells.pvd, bonds.pvd: time series whose timestep is the {strain} strain)")
+
+
 def register(sub, common):
     p = sub.add_parser("ucs", help="strain-controlled uniaxial compression test")
     common(p)
     add_confinement_option(p)
+    add_vtk_every_option(p, "axial")
     p.set_defaults(func=cmd_ucs, with_params=True, param_overrides=confinement_override)
 
 
@@ -17,7 +26,8 @@ def cmd_ucs(args, params) -> int:
     from ..params import require_plane
     require_plane(params, "ucs")
     out = args.out or f"results/ucs_seed{args.seed}"
-    summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
+    summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print,
+                                vtk_every=args.vtk_every)
     if summary["numerical_failure"]:
         print(f"UCS: no result ({summary['end_reason']}) -> {out}")
         return 0
@@ -40,8 +50,10 @@ MEASURES = ("ucs_pa", "peak_axial_strain", "young_pa", "young_method", "poisson"
             "crack_damage_pa")
 
 
-def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict:
-    """Run a UCS test into ``out``; summary.json is written last (it marks the run finished)."""
+def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, vtk_every=None) -> dict:
+    """Run a UCS test into ``out``; summary.json is written last (it marks the run finished).
+
+    ``vtk_every``: VTK series in ``out/vtk/`` at every k-th history row and the end (None: none)."""
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
     from ..plotting import crack_map
@@ -53,7 +65,12 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     require_plane(params, "ucs")
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
-    history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)
+    snapshot = None
+    if vtk_every:
+        from ..yade_adapter.vtk_output import AXIAL_STRAIN, StrainSeries
+        snapshot = StrainSeries(out / "vtk", vtk_every, AXIAL_STRAIN)
+    history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress,
+                                                               snapshot=snapshot)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else ucs_summary(history)
     summary.update(result)

@@ -119,13 +119,14 @@ def crack_counts(scene) -> dict:
     return broken_counts(scene, new_breaks(scene))
 
 
-def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
+def run_brazilian(specimen, params, progress=None, scene=None, levers=None, snapshot=None):
     """Run the test; return (history columns, result dict, scene, snapshot at the failure load).
 
     The snapshot (bonds broken, their modes) is taken at the failure load: the peak before the split
     (:func:`grainfrac_yade.brazilian_analysis.split_peak_index`, the same rows), else at the largest
     load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
-    Broken counts and the snapshot leave out slits.
+    Broken counts and the snapshot leave out slits.  ``snapshot``: a :class:`.vtk_output.StrainSeries`
+    (VTK files, timestep the diametral strain; it only reads the scene), None: no VTK output.
     """
     from ..brazilian_analysis import SPLIT_DROP_RATIO, tensile_stress
     t0 = time.time()
@@ -156,6 +157,8 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
                 check_value(k, v, scene.O.iter)
             for k, v in row.items():
                 cols[k].append(v)
+            if snapshot is not None:
+                snapshot.row(scene, len(cols["dem_step"]), strain)
             if (split_snapshot is None and load < SPLIT_DROP_RATIO * peak
                     and row["broken_total"] > broken_at_peak):   # the split: the failure load is behind us
                 split_snapshot = peak_snapshot
@@ -178,6 +181,8 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None):
         numerical, end = True, f"numerical failure: {exc}"
         if progress:
             progress(end)
+    if snapshot is not None and cols["dem_step"] and not numerical:
+        snapshot.write(scene, len(cols["dem_step"]), cols["diametral_strain"][-1])
     result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "dem_timestep_s": dt,
               "n_bonds": scene.n_bonds, **crack_counts(scene), "numerical_failure": numerical,
               "peak_reached": peak_reached, "end_reason": end,

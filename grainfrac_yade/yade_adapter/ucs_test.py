@@ -19,11 +19,12 @@ from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
 
-def run_ucs(specimen, params, progress=None, scene=None):
+def run_ucs(specimen, params, progress=None, scene=None, snapshot=None):
     """Run the test; return (history columns, result dict, scene, broken-at-peak snapshot).
 
     The history holds only finite rows (a row with a NaN or infinite value ends the run as a
-    numerical failure instead).
+    numerical failure instead).  ``snapshot``: a :class:`.vtk_output.StrainSeries` (VTK files; it
+    only reads the scene) told of each row and of the end, None: no VTK output.
     """
     t0, c0 = time.time(), time.process_time()
     scene = scene or build_scene(specimen, params)
@@ -55,6 +56,8 @@ def run_ucs(specimen, params, progress=None, scene=None):
                 check_value(k, v, scene.O.iter)
             for k, v in row.items():
                 cols[k].append(v)
+            if snapshot is not None:
+                snapshot.row(scene, len(cols["dem_step"]), strain)
             if stress > peak:
                 peak, broken_at_peak = stress, row["broken_total"]
                 peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
@@ -74,6 +77,8 @@ def run_ucs(specimen, params, progress=None, scene=None):
         numerical, end = True, f"numerical failure: {exc}"
         if progress:
             progress(end)
+    if snapshot is not None and cols["dem_step"] and not numerical:
+        snapshot.write(scene, len(cols["dem_step"]), cols["axial_strain"][-1])
     result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "cpu_s": time.process_time() - c0, "dem_timestep_s": dt,
               "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
               "peak_reached": peak_reached, "end_reason": end, "confining_stress_pa": confining, **consolidation}
