@@ -131,7 +131,7 @@ class _Renderer:
         handles = [Line2D([], [], color=CRACK_COLOURS[1], lw=1.5, label="tensile crack"),
                    Line2D([], [], color=CRACK_COLOURS[2], lw=1.5, label="shear crack"),
                    Line2D([], [], color="k", lw=MACRO_WIDTH, label="macrocrack")] + handles
-        self.fig.legend(handles=handles, loc="lower right", bbox_to_anchor=(0.98, 0.04), ncol=2, fontsize=8,
+        self.fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.57, 0.36), ncol=2, fontsize=8,
                         frameon=False)
         inset = self.fig.add_axes((0.59, 0.47, 0.37, 0.38))
         t = hist["creep_time_s"].to_numpy(float)
