@@ -213,3 +213,14 @@ def test_animate_refuses_a_folder_without_a_creep_run(tmp_path):
     res = _cli("animate", tmp_path)
     assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
     assert "run.json" in res.stderr and "fix:" in res.stderr
+
+
+def test_report_links_the_focus_runs_animation_when_it_has_one(tmp_path):
+    from grainfrac_yade.analysis.study import animation_note
+    run, report = tmp_path / "study" / "r0.7_seed1", tmp_path / "study" / "report"
+    run.mkdir(parents=True)
+    assert animation_note(run, report) is None   # no animation: no line (reports of such studies unchanged)
+    (run / "animation.gif").write_bytes(b"GIF89a")
+    assert animation_note(run, report).endswith("[animation.gif](../r0.7_seed1/animation.gif).")
+    (run / "animation.mp4").write_bytes(b"")
+    assert "[animation.mp4](../r0.7_seed1/animation.mp4)" in animation_note(run, report)
