@@ -11,8 +11,10 @@ environment (``import os; os.environ["RUN_DIR"] = "/path/to/run"``).
 Shows RUN_DIR/vtk/cells.pvd coloured by mineral (categorical, the project's mineral colours, named
 from the files' ``mineral_names`` field data), and over it the broken bonds of bonds.pvd (``state``
 > 0) coloured by state: tensile crack blue, shear crack red.  The time axis is the .pvd timestep:
-creep time [s] (UCS, Brazilian: the axial or diametral strain).  Written for ParaView 5.11 (Debian
-bookworm's paraview package); nothing in the project's tests needs ParaView.
+creep time [s] (UCS, Brazilian: the axial or diametral strain).  Written for ParaView 5.11's
+paraview.simple API and not run here (Debian bookworm's python3-paraview conflicts with the
+python3-vtk9 the project needs: use a paraview.org binary or another machine); nothing in the
+project's tests needs ParaView.
 """
 import os
 import sys
