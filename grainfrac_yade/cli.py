@@ -82,6 +82,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_specimen, with_params=True)
     from .commands import register_all
     register_all(sub, _common)
+    from .commands import animate
+    animate.register(sub, _common)
     return parser
 
 

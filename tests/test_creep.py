@@ -64,8 +64,9 @@ def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
     assert np.all(np.diff(h["creep_time_s"]) >= 0)
     c = pd.read_csv(out / "cracks.csv")
     assert set(c["mode"]) <= {"tensile", "shear"} and len(c) == s["broken_total"]
-    assert sorted(p.name for p in (out / "vtk").iterdir()) == ["bonds_0000.vtk", "bonds_0001.vtk", "cells_0000.vtk",
-                                                               "cells_0001.vtk"]   # creep time 0 and the end
+    assert sorted(p.name for p in (out / "vtk").iterdir()) == ["bonds.pvd", "bonds_0000.vtp", "bonds_0001.vtp",
+                                                               "cells.pvd", "cells_0000.vtp", "cells_0001.vtp"]
+    # creep time 0 and the end
     assert s["vtk_creep_times_s"] == [0.0, s["lifetime_s"]]
     for png in ("strain_time.png", "crack_map_t1.00.png"):
         assert (out / png).stat().st_size > 10_000

@@ -296,6 +296,21 @@ def _rescale_text(runs: pd.DataFrame, beta1: float, source: str, reference) -> l
     return text
 
 
+def animation_note(run_folder, out) -> str | None:
+    """Report line linking the focus run's crack-growth animation (``animate``; not made here, rendering
+    costs seconds per run); None when the run has none."""
+    import os
+
+    from ..animation import GIF_NAME, MP4_NAME
+    run_folder = Path(run_folder)
+    gif = run_folder / GIF_NAME
+    if not gif.is_file():
+        return None
+    links = [f"[{name}]({Path(os.path.relpath(run_folder / name, out)).as_posix()})"
+             for name in (GIF_NAME, MP4_NAME) if (run_folder / name).is_file()]
+    return f"Crack-growth animation of the run of the crack maps ({run_folder.name}): " + ", ".join(links) + "."
+
+
 def _grains(focus, cracks) -> tuple:
     """(specimen or None, report line): the focus run's specimen rebuilt and verified, else why not."""
     try:
@@ -517,6 +532,9 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
                                                                            ", specimen outline") + " (Fig. 7/8)"))
         if reason:
             content.skipped += [(f"crack_maps_{by}.png", reason) for by in ("mode", "kind")]
+        note = animation_note(focus["folder"], out)
+        if note:
+            content.notes.append(note)
 
     if len(folders) > 1:
         content.notes.append("Several studies: runs are labelled by study (column study; run = study/run) and each "

@@ -36,6 +36,8 @@ def register(sub, common):
     lv.add_argument("--block-rotation", action="store_true", help="cells do not rotate (rigid cells)")
     from .resume import add_resume_option
     add_resume_option(p, "Brazilian test")
+    from .ucs import add_vtk_every_option
+    add_vtk_every_option(p, "diametral")
     p.set_defaults(func=cmd_brazilian)
 
 
@@ -62,7 +64,8 @@ def cmd_brazilian(args) -> int:
     from ..yade_adapter.levers import Levers
     levers = Levers(slit_fraction=args.slit_fraction, strength_cv=args.strength_cv, block_rotation=args.block_rotation)
     out = args.out or f"results/brazilian_seed{args.seed}"
-    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers)
+    summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers,
+                                      vtk_every=args.vtk_every)
     print(format_result(summary, out))
     return 0
 
@@ -130,12 +133,15 @@ def require_disc_model(params):
                              "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
 
 
-def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None, resume=False) -> dict:
+def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, levers=None, resume=False,
+                            vtk_every=None) -> dict:
     """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished).
 
     ``levers``: :class:`~grainfrac_yade.yade_adapter.levers.Levers` (None: none).  Checkpoints go to
     ``out/checkpoint/`` every ``numerics.checkpoint_interval`` s of wall time and are removed once
-    summary.json is written; ``resume``: go on from the checkpoint in ``out`` (its levers with it)."""
+    summary.json is written; ``resume``: go on from the checkpoint in ``out`` (its levers with it).
+    ``vtk_every``: VTK series in ``out/vtk/`` at every k-th history row and the end (None: none; not
+    carried across a resume)."""
     from pathlib import Path
     from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
@@ -152,9 +158,13 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     else:
         out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
         levers = levers or Levers()
+        snapshot = None
+        if vtk_every:
+            from ..yade_adapter.vtk_output import DIAMETRAL_STRAIN, StrainSeries
+            snapshot = StrainSeries(out / "vtk", vtk_every, DIAMETRAL_STRAIN)
         history, result, scene, (broken_peak, mode_peak) = run_brazilian(
             specimen, params, progress=progress, levers=levers, checkpoint_folder=out,
-            run_values={"seed": seed, "levers": levers.to_dict()})
+            run_values={"seed": seed, "levers": levers.to_dict()}, snapshot=snapshot)
     t = specimen.tessellation
     diameter = t.diameter
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else \

@@ -21,7 +21,15 @@ def register(sub, common):
     add_confinement_option(p)
     p.add_argument("--vtk-times", type=_times, default=None, metavar="T1,T2,...",
                    help="write VTK files of cells and bonds (state, remaining strength) for ParaView at these "
-                        "creep times [s] and at the end, into DIR/vtk/ (e.g. --vtk-times 0,1e7)")
+                        "creep times [s] and at the end, into DIR/vtk/ (cells.pvd, bonds.pvd: time series in "
+                        "creep time; e.g. --vtk-times 0,1e7)")
+    p.add_argument("--vtk-every", type=_positive_int, default=None, metavar="K",
+                   help="also write VTK files at every K-th history row (one row per event of the event clock, "
+                        "per creep step of the paper clock) and at the end, into DIR/vtk/")
+    p.add_argument("--vtk-fractions", type=_fractions, nargs="?", const=None, default=False, metavar="F1,F2,...",
+                   help="after the run, write the bond states at these fractions of the lifetime (of the run if "
+                        "it did not fail; default the crack maps' 0.1,0.5,0.9,1) on the undeformed specimen, into "
+                        "DIR/vtk/life_cells.pvd and life_bonds.pvd")
     p.add_argument("--resume", metavar="DIR",
                    help="go on with the interrupted creep run in DIR from its last checkpoint (DIR/checkpoint/, "
                         "written at the end of the ramp and every numerics.checkpoint_interval s); load, seed and "
@@ -55,6 +63,31 @@ def outcome(summary: dict) -> str:
     if summary["failed"]:
         return f"lifetime {summary['lifetime_s']:.4g} s"
     return f"not failed by {summary['creep_time_end_s']:.4g} s"
+
+
+def _positive_int(text: str) -> int:
+    """An integer >= 1 (argparse type)."""
+    import argparse
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1 (e.g. 10)")
+    return value
+
+
+def _fractions(text: str) -> list:
+    """Comma-separated fractions in (0, 1] (argparse type)."""
+    import argparse
+    try:
+        values = [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        values = []
+    if not values or any(not (0 < v <= 1) for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: give comma-separated fractions of the lifetime in (0, 1], "
+                                         "e.g. 0.1,0.5,0.9,1")
+    return sorted(values)
 
 
 def _times(text: str) -> list:
@@ -108,13 +141,17 @@ RESUME_CONFLICTS = (("stress", "--stress"), ("ratio", "--ratio"), ("ucs", "--ucs
                     ("confinement", "--confinement"),
                     ("overrides", "--set"), ("params", "--params"), ("width", "--width"), ("height", "--height"),
                     ("grain_size", "--grain-size"), ("spheres_per_cell", "--spheres-per-cell"),
-                    ("vtk_times", "--vtk-times"), ("out", "--out"), ("overwrite", "--overwrite"))
+                    ("vtk_times", "--vtk-times"), ("vtk_every", "--vtk-every"), ("out", "--out"),
+                    ("overwrite", "--overwrite"))
 
 
 def cmd_creep(args, params) -> int:
+    from ..analysis.figures import MAP_FRACTIONS
     from ..params import require_plane
     if args.resume:
         given = [flag for attr, flag in RESUME_CONFLICTS if getattr(args, attr, None) not in (None, [], False)]
+        if args.vtk_fractions is not False:
+            given.append("--vtk-fractions")
         if given:
             raise GrainfracError(f"--resume {args.resume} takes the load, seed and parameters from the run folder; "
                                  f"fix: drop {', '.join(given)}")
@@ -130,7 +167,9 @@ def cmd_creep(args, params) -> int:
     stress, ratio, ref = resolve_stress(params, args.stress, args.ratio, args.ucs)
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
     s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
-                            vtk_times=args.vtk_times)
+                            vtk_times=args.vtk_times, vtk_every=args.vtk_every,
+                            vtk_fractions=None if args.vtk_fractions is False else
+                            (args.vtk_fractions or list(MAP_FRACTIONS)))
     confined = f", confinement {params.confinement.stress / 1e6:g} MPa" if params.confinement.stress else ""
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
@@ -170,12 +209,16 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
 
 
 def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None,
-                        vtk_times=None, resume=False) -> dict:
+                        vtk_times=None, resume=False, vtk_every=None, vtk_fractions=None) -> dict:
     """Run a creep test into ``out``; summary.json is written last (it marks the run finished).
 
     Checkpoints go to ``out/checkpoint/`` during the run (end of the ramp, then every
     ``numerics.checkpoint_interval`` s) and are removed once summary.json is written.  ``resume``: go on
     from the checkpoint in ``out`` instead of starting (``out`` keeps its run.json and params.json).
+
+    VTK series in ``out/vtk/`` (only reading the scene; with none of these options no VTK file):
+    ``vtk_times`` (creep times [s]) and ``vtk_every`` (every k-th history row) during the run, plus
+    the end; ``vtk_fractions`` (of the lifetime) after it, from the bonds' break times.
 
     A numerical failure (NaN/inf, a stalled clock) gives ``numerical_failure: true``, ``failed:
     null`` (unknown) and ``lifetime_s: null``, with the reason in ``failure_reason``.
@@ -195,18 +238,24 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     require_plane(params, "creep")
     out = Path(out) if resume else prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
+    run_values = {"seed": seed, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs}
+    if vtk_fractions:
+        run_values["vtk_fractions"] = [float(f) for f in vtk_fractions]   # a resumed run writes them too
     outputs = {"history_sink": lambda rows: write_csv(out / "history.csv", history_columns(rows)),
-               "run_values": {"seed": seed, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs}}
+               "run_values": run_values}
     if resume:
         state = read_checkpoint_state(out) or {}
         if state.get("run", {}).get("vtk"):
             outputs.update(vtk_folder=out / "vtk")
+        vtk_fractions = (state.get("run_values") or {}).get("vtk_fractions")
+        if vtk_fractions:
+            run_values["vtk_fractions"] = vtk_fractions   # kept in the checkpoints written from here on
         run = resume_creep(specimen, params, stress, out, progress=progress, **outputs)
         t0 -= state.get("wall_s", 0.0)   # wall time of the run up to its checkpoint
         c0 -= state.get("cpu_s", 0.0)    # CPU time of this process up to it (checkpoints older than the key: 0)
     else:
-        if vtk_times is not None:
-            outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
+        if vtk_times is not None or vtk_every:
+            outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times or (), vtk_every=vtk_every or 0)
         run = run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
     numerical = bool(run.numerical_failure)
     rows = run.rows or [_row_before_history(run, broken_counts(run.scene))]
@@ -249,6 +298,10 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                        shear_utilisation_max=float(np.max(run.initial_bond_stresses["shear_utilisation"])))
     run_strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
+    if vtk_fractions:
+        from ..yade_adapter.vtk_output import write_life_series
+        write_life_series(run, out / "vtk", [f * t_ref for f in vtk_fractions], vtk_fractions)
+        summary["vtk_life_fractions"] = [float(f) for f in vtk_fractions]
     for frac in MAP_FRACTIONS:
         t = frac * t_ref
         idx = np.flatnonzero(run.scene.broken & (run.break_time <= t))

@@ -7,11 +7,20 @@ from .creep import add_confinement_option, confinement_override
 from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
+def add_vtk_every_option(parser, strain: str):
+    """``--vtk-every K``: VTK series of a strain-controlled test, timestep the ``strain`` strain."""
+    from .creep import _positive_int
+    parser.add_argument("--vtk-every", type=_positive_int, default=None, metavar="K",
+                        help=f"write VTK files of cells and bonds at every K-th history row and at the end into "
+                             f"DIR/vtk/ (cells.pvd, bonds.pvd: time series whose timestep is the {strain} strain)")
+
+
 def register(sub, common):
     p = sub.add_parser("ucs", help="strain-controlled uniaxial compression test")
     common(p)
     add_confinement_option(p)
     add_resume_option(p, "UCS test")
+    add_vtk_every_option(p, "axial")
     p.set_defaults(func=cmd_ucs, with_params=True, param_overrides=confinement_override)
 
 
@@ -29,7 +38,8 @@ def cmd_ucs(args, params) -> int:
     else:
         require_plane(params, "ucs")
         out = args.out or f"results/ucs_seed{args.seed}"
-        summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
+        summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print,
+                                    vtk_every=args.vtk_every)
     if summary["numerical_failure"]:
         print(f"UCS: no result ({summary['end_reason']}) -> {out}")
         return 0
@@ -52,12 +62,13 @@ MEASURES = ("ucs_pa", "peak_axial_strain", "young_pa", "young_method", "poisson"
             "crack_damage_pa")
 
 
-def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=False) -> dict:
+def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=False, vtk_every=None) -> dict:
     """Run a UCS test into ``out``; summary.json is written last (it marks the run finished).
 
     Checkpoints go to ``out/checkpoint/`` every ``numerics.checkpoint_interval`` s of wall time and are
     removed once summary.json is written.  ``resume``: go on from the checkpoint in ``out`` instead of
-    starting (``out`` keeps its run.json and params.json)."""
+    starting (``out`` keeps its run.json and params.json).  ``vtk_every``: VTK series in ``out/vtk/`` at
+    every k-th history row and the end (None: none; not carried across a resume)."""
     from pathlib import Path
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
@@ -75,8 +86,12 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
         history, result, scene, (broken_peak, mode_peak) = ucs_test.resume_ucs(specimen, params, out,
                                                                               progress=progress)
     else:
+        snapshot = None
+        if vtk_every:
+            from ..yade_adapter.vtk_output import AXIAL_STRAIN, StrainSeries
+            snapshot = StrainSeries(out / "vtk", vtk_every, AXIAL_STRAIN)
         history, result, scene, (broken_peak, mode_peak) = ucs_test.run_ucs(specimen, params, progress=progress,
-                                                                           **outputs)
+                                                                           snapshot=snapshot, **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else ucs_summary(history)
     summary.update(result)

@@ -170,6 +170,8 @@ class BrazilianRun:
                                              run_values or {}, progress, capture=capture)
         #: the checkpoints this run went on from (DEM step, phase, when written)
         self.resumes = []
+        #: a :class:`.vtk_output.StrainSeries` told of each row and of the end (it only reads the scene); None: no VTK
+        self.snapshot = None
 
     def safe_point(self):
         """Before a history row's DEM steps: the state is complete; a checkpoint if one is due."""
@@ -196,6 +198,8 @@ class BrazilianRun:
                     check_value(k, v, scene.O.iter)
                 for k, v in row.items():
                     cols[k].append(v)
+                if self.snapshot is not None:
+                    self.snapshot.row(scene, len(cols["dem_step"]), strain)
                 if (self.split_snapshot is None and load < SPLIT_DROP_RATIO * self.peak
                         and row["broken_total"] > self.broken_at_peak):   # the split: the failure load is behind us
                     self.split_snapshot = self.peak_snapshot
@@ -219,6 +223,8 @@ class BrazilianRun:
             numerical, end = True, f"numerical failure: {exc}"
             if self.progress:
                 self.progress(end)
+        if self.snapshot is not None and cols["dem_step"] and not numerical:
+            self.snapshot.write(scene, len(cols["dem_step"]), cols["diametral_strain"][-1])
         result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0, "dem_timestep_s": scene.O.dt,
                   "n_bonds": scene.n_bonds, **crack_counts(scene), "numerical_failure": numerical,
                   "peak_reached": peak_reached, "end_reason": end,
@@ -263,7 +269,8 @@ def restore(run, where, state, arrays):
     run.resumes = r["resumes"] + [resume_record(state)]
 
 
-def run_brazilian(specimen, params, progress=None, scene=None, levers=None, checkpoint_folder=None, run_values=None):
+def run_brazilian(specimen, params, progress=None, scene=None, levers=None, checkpoint_folder=None, run_values=None,
+                  snapshot=None):
     """Run the test; return (history columns, result dict, scene, snapshot at the failure load).
 
     The snapshot (bonds broken, their modes) is taken at the failure load: the peak before the split
@@ -271,8 +278,12 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None, chec
     load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
     Broken counts and the snapshot leave out slits.  ``checkpoint_folder``: the run folder,
     checkpoints go to its ``checkpoint/`` (None: none); ``run_values``: stored with them (seed, levers).
+    ``snapshot``: a :class:`.vtk_output.StrainSeries` (VTK files, timestep the diametral strain; it only
+    reads the scene), None: no VTK output.
     """
-    return BrazilianRun(specimen, params, progress, scene, levers, checkpoint_folder, run_values).run()
+    run = BrazilianRun(specimen, params, progress, scene, levers, checkpoint_folder, run_values)
+    run.snapshot = snapshot
+    return run.run()
 
 
 def resume_brazilian(specimen, params, run_folder, progress=None):

@@ -133,11 +133,13 @@ class CreepRun:
     """State and bookkeeping of one creep test."""
 
     def __init__(self, specimen, params, target_stress, progress=None, vtk_folder=None, vtk_times=(),
-                 history_sink=None, checkpoint_folder=None, run_values=None):
+                 vtk_every=0, history_sink=None, checkpoint_folder=None, run_values=None):
         self.params, self.target = params, target_stress
         #: VTK snapshots: folder and the creep times [s] still to write (the first equilibrium state
         #: at or after each time; the final state is always written when a folder is given)
         self.vtk_folder, self.vtk_times = vtk_folder, sorted(float(t) for t in vtk_times)
+        #: also a snapshot at every ``vtk_every``-th history row (one row per creep step or event; 0: none)
+        self.vtk_every = int(vtk_every)
         self.vtk_written = []
         self._vtk_rows = -1   # number of history rows when the last snapshot was written
         #: called with the rows so far every HISTORY_FLUSH_ROWS rows (partial history.csv)
@@ -334,14 +336,17 @@ class CreepRun:
         while self.vtk_folder is not None and self.vtk_times and self.vtk_times[0] <= creep_time:
             self.vtk_times.pop(0)
             self.write_vtk(creep_time)
+        if self.vtk_folder is not None and self.vtk_every and len(self.rows) % self.vtk_every == 0:
+            self.write_vtk(creep_time)
         if self.history_sink is not None and len(self.rows) % HISTORY_FLUSH_ROWS == 0:
             self.history_sink(self.rows)
 
     def write_vtk(self, creep_time):
-        """Snapshot of the current state, unless the last one was taken at this same history row."""
-        from .vtk_output import write_snapshot
+        """Snapshot of the current state, unless the last one was taken at this same history row
+        (only reads the scene)."""
+        from .vtk_output import Series, write_creep_snapshot
         if self.corr is not None and self._vtk_rows != len(self.rows):
-            write_snapshot(self.scene, self.corr, self.vtk_folder, len(self.vtk_written), creep_time)
+            write_creep_snapshot(Series(self.vtk_folder, times=self.vtk_written), self, creep_time)
             self.vtk_written.append(creep_time)
             self._vtk_rows = len(self.rows)
 
@@ -538,7 +543,7 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:
     """Ramp, hold and creep ``specimen`` at ``target_stress`` [Pa]; returns the finished run.
 
-    ``outputs``: ``vtk_folder`` and ``vtk_times`` (VTK snapshots), ``history_sink`` (partial history),
+    ``outputs``: ``vtk_folder``, ``vtk_times`` and ``vtk_every`` (VTK snapshots), ``history_sink`` (partial history),
     ``checkpoint_folder`` (the run folder: checkpoints in its ``checkpoint/``) and ``run_values``
     (seed, load: stored with the checkpoints).
     """

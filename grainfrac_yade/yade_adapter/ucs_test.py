@@ -61,6 +61,8 @@ class UcsRun:
         self.resumed = False
         #: the checkpoints this run went on from (DEM step, phase, when written)
         self.resumes = []
+        #: a :class:`.vtk_output.StrainSeries` told of each row and of the end (it only reads the scene); None: no VTK
+        self.snapshot = None
 
     def safe_point(self):
         """Before a history row's DEM steps: the state is complete; a checkpoint if one is due."""
@@ -91,6 +93,8 @@ class UcsRun:
                     check_value(k, v, scene.O.iter)
                 for k, v in row.items():
                     cols[k].append(v)
+                if self.snapshot is not None:
+                    self.snapshot.row(scene, len(cols["dem_step"]), strain)
                 if stress > self.peak:
                     self.peak, self.broken_at_peak = stress, row["broken_total"]
                     self.peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
@@ -111,6 +115,8 @@ class UcsRun:
             numerical, end = True, f"numerical failure: {exc}"
             if self.progress:
                 self.progress(end)
+        if self.snapshot is not None and cols["dem_step"] and not numerical:
+            self.snapshot.write(scene, len(cols["dem_step"]), cols["axial_strain"][-1])
         result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0,
                   "cpu_s": time.process_time() - self.c0, "dem_timestep_s": scene.O.dt,
                   "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
@@ -153,14 +159,17 @@ def restore(run, where, state, arrays):
     run.resumed = True
 
 
-def run_ucs(specimen, params, progress=None, scene=None, checkpoint_folder=None, run_values=None):
+def run_ucs(specimen, params, progress=None, scene=None, checkpoint_folder=None, run_values=None, snapshot=None):
     """Run the test; return (history columns, result dict, scene, broken-at-peak snapshot).
 
     The history holds only finite rows (a row with a NaN or infinite value ends the run as a
     numerical failure instead).  ``checkpoint_folder``: the run folder, checkpoints go to its
-    ``checkpoint/`` (None: none); ``run_values``: stored with them (seed).
+    ``checkpoint/`` (None: none); ``run_values``: stored with them (seed).  ``snapshot``: a
+    :class:`.vtk_output.StrainSeries` (VTK files, timestep the axial strain), None: no VTK output.
     """
-    return UcsRun(specimen, params, progress, scene, checkpoint_folder, run_values).run()
+    run = UcsRun(specimen, params, progress, scene, checkpoint_folder, run_values)
+    run.snapshot = snapshot
+    return run.run()
 
 
 def resume_ucs(specimen, params, run_folder, progress=None, run_values=None):
