@@ -386,7 +386,7 @@ def assert_same_runs(a, b):
 def test_g_the_same_seed_twice_gives_identical_creep_results(tmp_path):
     """Two CLI processes, one thread each: creep at 0.8 x 252 MPa, 4 x 8 mm, seed 1 (5 s each)."""
     for name in ("a", "b"):
-        _cli_run("creep", "--width", 4e-3, "--height", 8e-3, "--seed", 1, "--ratio", 0.8, "--ucs", 252e6,
+        _cli_run("creep", "--width", 4e-3, "--height", 8e-3, "--seed", 1, "--ratio", 0.8, "--ucs", 252,
                  "--out", tmp_path / name)
     assert_same_runs(tmp_path / "a", tmp_path / "b")
     s = clean_folder(tmp_path / "a", ("primary_end_s", "tertiary_start_s"))

@@ -34,7 +34,7 @@ def _cli(*args, **kw):
 
 def _creep_args(spec, out, *extra):
     return ["--width", spec["width"], "--height", spec["height"], "--seed", spec["seed"], "--ratio", spec["ratio"],
-            "--ucs", spec["ucs"], "--set", "stress_corrosion.creep_time_limit=1e30", *extra, "--out", out]
+            "--ucs", spec["ucs"] / 1e6, "--set", "stress_corrosion.creep_time_limit=1e30", *extra, "--out", out]
 
 
 def _state(folder):
@@ -205,7 +205,7 @@ def test_a_bad_resume_is_one_line(tmp_path, case):
         write_json(out / "summary.json", dict(VALUES, failed=True))
     elif case == "conflict":
         _unfinished(out, params)
-        args += ["--stress", "1e8"]
+        args += ["--stress", "100"]
     elif case == "ucs run":
         prepare_run_dir(out, "ucs", params, 1)
     res = _cli(*args)

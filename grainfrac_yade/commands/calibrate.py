@@ -26,13 +26,29 @@ TARGET_YOUNG = 69e9
 CALIBRATION_FILE = Path(__file__).resolve().parents[2] / "params" / "calibration.toml"
 
 
+def _gpa(text: str) -> float:
+    """argparse type of a modulus flag: GPa, returned in Pa."""
+    import argparse
+    import math
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a modulus in GPa (e.g. 69)") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: a modulus must be finite and above 0 GPa (e.g. 69)")
+    return value * 1e9
+
+
 def register(sub, common):
     p = sub.add_parser("calibrate", help="fit strength/stiffness scale factors to UCS 234.5 MPa and E 69 GPa")
     common(p, geometry=True)
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5])
     p.add_argument("--rounds", type=int, default=2, help="fixed-point rounds after the 'before' round")
-    p.add_argument("--target-ucs", type=float, default=TARGET_UCS)
-    p.add_argument("--target-young", type=float, default=TARGET_YOUNG)
+    from .creep import stress_flag
+    p.add_argument("--target-ucs", type=stress_flag, default=TARGET_UCS, metavar="MPA",
+                   help=f"UCS target [MPa, like every stress flag] (default {TARGET_UCS / 1e6:g})")
+    p.add_argument("--target-young", type=_gpa, default=TARGET_YOUNG, metavar="GPA",
+                   help=f"Young's modulus target [GPa] (default {TARGET_YOUNG / 1e9:g})")
     p.add_argument("--jobs", type=int, default=1, help="seeds run in parallel (one process each)")
     p.add_argument("--write", default=str(CALIBRATION_FILE), help="calibration file to (over)write")
     p.set_defaults(func=cmd_calibrate, with_params=True)

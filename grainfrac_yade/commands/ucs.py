@@ -1,9 +1,11 @@
 """``ucs``: uniaxial compression test (paper section 3.1); summary.json, history.csv, figures, crack map at peak."""
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-from .creep import add_confinement_option, confinement_override
+from .creep import add_confinement_option, check_stress_range, confinement_override
 
 
 def register(sub, common):
@@ -16,8 +18,12 @@ def register(sub, common):
 def cmd_ucs(args, params) -> int:
     from ..params import require_plane
     require_plane(params, "ucs")
+    check_stress_range(params, "--confinement" if args.confinement is not None else "confinement.stress")
     out = args.out or f"results/ucs_seed{args.seed}"
     summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print)
+    if summary.get("failed_before_test"):
+        print(f"UCS: failed before the test ({summary['end_reason']}) -> {out}")
+        return 1
     if summary["numerical_failure"]:
         print(f"UCS: no result ({summary['end_reason']}) -> {out}")
         return 0
@@ -55,15 +61,18 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     specimen = build_specimen(params, seed)
     history, result, scene, (broken_peak, mode_peak) = run_ucs(specimen, params, progress=progress)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
-    summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else ucs_summary(history)
+    no_result = result["numerical_failure"] or result.get("failed_before_test")
+    summary = dict.fromkeys(MEASURES) if no_result else ucs_summary(history)
     summary.update(result)
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
-    run_stress_strain_figure(history, summary, out / "stress_strain.png")
+    if history["dem_step"]:
+        run_stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
-    at = "the largest stress before the numerical failure" if result["numerical_failure"] else \
-        f"peak ({summary['ucs_pa'] / 1e6:.0f} MPa)"
+    at = ("the end of the isotropic stage" if result.get("failed_before_test") else
+          "the largest stress before the numerical failure" if result["numerical_failure"] else
+          f"peak ({summary['ucs_pa'] / 1e6:.0f} MPa)")
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}")
     write_json(out / "summary.json", summary)   # last: marks the run finished
@@ -95,11 +104,15 @@ def run_ucs_in_yade():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)
         require_plane(params, "ucs")
+        check_stress_range(params)
         out, done = row_folder(controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}",
                                params, controls, {"seed": int(controls["seed"])})
     if done:
         print(f"UCS row already finished, skipped: {out}")
         return
     s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists())
+    if s.get("failed_before_test"):
+        print(f"UCS: failed before the test ({s['end_reason']}) -> {out}")
+        sys.exit(1)
     print(f"UCS: no result ({s['end_reason']}) -> {out}" if s["numerical_failure"] else
           f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(s['young_pa'], 1e9)} GPa -> {out}")

@@ -14,7 +14,7 @@ from __future__ import annotations
 import time
 
 from ..errors import NumericalFailure
-from .confinement import Confinement, consolidate, young_estimate
+from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
 from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
@@ -40,12 +40,16 @@ def run_ucs(specimen, params, progress=None, scene=None):
     numerical, peak_reached = False, False
     confining = params.confinement.stress
     consolidation = {}
+    broken_apart = ""
     try:
         if confining > 0:
             scene.extras.append(Confinement(scene, confining))
             consolidation = consolidate(scene, platens, confining, params.creep, young_estimate(params))
             platens.set_axial_velocity(closing_speed)
-        while True:
+            broken_apart = end = broken_apart_reason(scene, confining)
+            if broken_apart and progress:
+                progress(end)
+        while not broken_apart:
             scene.run(steps_per_row)
             stress = platens.axial_stress()
             strain = platens.axial_strain()
@@ -76,5 +80,6 @@ def run_ucs(specimen, params, progress=None, scene=None):
             progress(end)
     result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - t0, "cpu_s": time.process_time() - c0, "dem_timestep_s": dt,
               "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
-              "peak_reached": peak_reached, "end_reason": end, "confining_stress_pa": confining, **consolidation}
+              "peak_reached": peak_reached, "end_reason": end,
+              "failed_before_test": bool(broken_apart), "confining_stress_pa": confining, **consolidation}
     return cols, result, scene, peak_snapshot

@@ -1,0 +1,88 @@
+"""A new user's first hour: one unit for stresses, bad input in one line, no folder taken over,
+batch tables checked before they run, ratios that keep their meaning, crack phases.
+
+CLI calls go through :func:`grainfrac_yade.cli.main` in-process where nothing is simulated (the
+refusals come before any run), and through a subprocess where the exit status of the whole
+program matters."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT, needs_yade
+from grainfrac_yade.cli import main
+from grainfrac_yade.errors import GrainfracError
+from grainfrac_yade.params import load_parameters
+
+MPA = 1e6
+#: 3 x 6 mm specimen (about 23 cells): a UCS test in about 2 s.
+TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
+
+
+def _one_line(capsys, *words):
+    """The single stderr line of a refused command; it contains every one of ``words``."""
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    for w in words:
+        assert w in err[0], err[0]
+    return err[0]
+
+
+def _cli(*args, cwd=ROOT, **kw):
+    return subprocess.run([sys.executable, "-m", "grainfrac_yade", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, env=dict(os.environ, OMP_NUM_THREADS="1"), **kw)
+
+
+# ------------------------------------------------------------------ one unit for stresses
+def test_every_stress_flag_states_mpa_in_its_help():
+    from grainfrac_yade.cli import build_parser
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction").choices
+    flags = {"creep": ("--stress", "--ucs", "--confinement"), "ucs": ("--confinement",),
+             "calibrate": ("--target-ucs",), "calibrate-lifetimes": ("--ucs",)}
+    for command, names in flags.items():
+        actions = {o: a for a in sub[command]._actions for o in a.option_strings}
+        for name in names:
+            assert "[MPa" in actions[name].help, (command, name)
+
+
+def test_a_stress_given_in_pa_to_an_mpa_flag_is_refused_in_one_line(capsys):
+    assert main(["creep", "--stress", "160e6", "--out", "/nonexistent/never"]) == 2
+    _one_line(capsys, "--stress", "MPa", "fix:")
+
+
+def test_a_confinement_given_in_pa_is_refused_before_it_runs(capsys):
+    assert main(["ucs", "--confinement", "20e6", "--out", "/nonexistent/never"]) == 2
+    _one_line(capsys, "--confinement", "reference strength", "fix:")
+
+
+@pytest.mark.parametrize("value", ["0", "-5"])
+def test_a_confinement_at_or_below_zero_is_refused(capsys, value):
+    assert main(["creep", "--ratio", "0.5", "--confinement", value, "--out", "/nonexistent/never"]) == 2
+    _one_line(capsys, "--confinement", "above 0")
+
+
+def test_cli_stresses_are_mpa_and_batch_stresses_pa():
+    from grainfrac_yade.commands.creep import resolve_stress
+    p = load_parameters()
+    assert resolve_stress(p, stress=160 * MPA, cli=True)[0] == 160 * MPA
+    with pytest.raises(GrainfracError, match="column stress = 160 Pa: must be above the confining"):
+        resolve_stress(load_parameters(overrides=[("confinement.stress", 1e3)]), stress=160.0, ucs=258e6)
+    with pytest.raises(GrainfracError, match="above 0"):
+        resolve_stress(p, stress=-1.0)
+    with pytest.raises(GrainfracError, match="--ucs 2.58e\\+08 MPa is above 4 x the reference strength"):
+        resolve_stress(p, ratio=0.5, ucs=258e12, cli=True)
+
+
+@needs_yade
+@pytest.mark.yade
+def test_a_specimen_broken_apart_in_the_isotropic_stage_is_a_failure_not_a_ucs_of_zero(tmp_path):
+    """1e6 times the intended 20 MPa (the unit slip of the issue; the CLI refuses it, the adapter is called
+    directly): every bond breaks in the isotropic stage; the run must say so and measure nothing."""
+    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    params = load_parameters(overrides=TINY + [("confinement.stress", 20e12)])
+    s = run_ucs_to_folder(params, 1, tmp_path / "run")
+    assert s["failed_before_test"] is True and s["ucs_pa"] is None
+    assert "broke apart in the isotropic stage" in s["end_reason"]
