@@ -86,3 +86,64 @@ def test_a_specimen_broken_apart_in_the_isotropic_stage_is_a_failure_not_a_ucs_o
     s = run_ucs_to_folder(params, 1, tmp_path / "run")
     assert s["failed_before_test"] is True and s["ucs_pa"] is None
     assert "broke apart in the isotropic stage" in s["end_reason"]
+
+
+# ------------------------------------------------------------------ batch: rows checked before anything runs
+BAD_CREEP_TABLE = """# one bad row per reason, and one good row (line 8)
+ratio stress ucs specimen.width seed study
+0.5 100e6 0 3e-3 1 'x'
+1.2 0 0 3e-3 1 'x'
+0.5 0 0 1 'x'
+0.5 0 0 3e-3 1 x
+0.5 0 0 -3e-3 1 'x'
+0.5 0 0 3e-3 1 'x'
+"""
+
+
+def test_a_batch_table_is_checked_row_by_row_before_anything_runs(tmp_path, capsys):
+    table = tmp_path / "bad.table"
+    table.write_text(BAD_CREEP_TABLE)
+    assert main(["batch", str(table), "--log-dir", str(tmp_path / "logs")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "5 bad row(s), nothing run" in err[0]
+    expected = {3: "both ratio and stress", 4: "must lie in (0, 1)", 5: "5 cells for 6 columns",
+                6: "must be quoted", 7: "specimen.width: must be > 0"}
+    assert len(err) == 1 + len(expected)
+    for (line, words), text in zip(expected.items(), err[1:]):
+        assert f"bad.table:{line}:" in text and words in text, text
+    assert not (tmp_path / "logs").exists()   # nothing made, nothing run
+
+
+def test_an_unknown_batch_column_names_the_close_key(tmp_path, capsys):
+    table = tmp_path / "typo.table"
+    table.write_text("ratio specimen.widht seed\n0.5 3e-3 1\n")
+    assert main(["batch", str(table)]) == 2
+    assert "did you mean specimen.width?" in capsys.readouterr().err
+
+
+def test_the_demo_refuses_a_ratio_at_or_above_one_before_it_simulates(tmp_path, capsys):
+    assert main(["demo", "--ratios", "0.7,1.2", "--out", str(tmp_path / "demo")]) == 2
+    _one_line(capsys, "--ratios 0.7,1.2", "(0, 1)")
+    assert not (tmp_path / "demo").exists()
+
+
+@needs_yade
+@pytest.mark.yade
+def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_path):
+    """Two 3 x 6 mm UCS rows (about 5 s each with YADE's start): line 3 runs; line 4's folder holds a finished
+    run of other parameters, so the row stops with its one line; the batch names line 4 and exits 1."""
+    from grainfrac_yade.runio import prepare_run_dir, write_json
+    taken = tmp_path / "taken"
+    prepare_run_dir(taken, "ucs", load_parameters(), 1)
+    write_json(taken / "summary.json", {"seed": 1, "ucs_pa": 1.0})
+    table = tmp_path / "ucs.table"
+    table.write_text("# tiny UCS rows\nspecimen.width specimen.height seed out\n"
+                     f"3e-3 6e-3 1 '{tmp_path / 'ok'}'\n3e-3 6e-3 1 '{taken}'\n")
+    res = _cli("batch", table, "--jobs", "1", "--log-dir", tmp_path / "logs", timeout=300)
+    lines = res.stdout.strip().splitlines()
+    assert res.returncode == 1, res.stdout + res.stderr
+    assert any(l.startswith("line 3: ok: UCS") for l in lines), lines
+    assert any(l.startswith("line 4: FAILED: error:") and "holds a finished run with other parameters" in l
+               for l in lines), lines
+    assert lines[-1] == f"1 of 2 rows failed: lines 4 of {table}"
+    assert (tmp_path / "ok" / "summary.json").exists()
