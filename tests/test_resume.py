@@ -169,7 +169,7 @@ def test_a_batch_row_skips_resumes_or_starts_by_its_folder(tmp_path):
 
 
 def test_checkpoint_folder_survives_a_kill_between_the_renames(tmp_path):
-    from grainfrac_yade.runio import checkpoint_folder, prepare_run_dir
+    from grainfrac_yade.runio import checkpoint_folder, commit_run_dir, prepare_run_dir
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = _unfinished(tmp_path / "r", params)
     (out / "checkpoint.tmp").mkdir()                    # a new one half written: not used
@@ -178,8 +178,9 @@ def test_checkpoint_folder_survives_a_kill_between_the_renames(tmp_path):
     assert checkpoint_folder(out) == out / "checkpoint.old"
     (out / "checkpoint.tmp" / "state.json").write_text("{}")  # ... with the new one complete
     assert checkpoint_folder(out) == out / "checkpoint.tmp"
-    prepare_run_dir(out, "creep", params, 1, overwrite=True)   # a replaced run never resumes the old one
-    assert checkpoint_folder(out) is None and not any(p.name.startswith("checkpoint") for p in out.iterdir())
+    new = prepare_run_dir(out, "creep", params, 1, overwrite=True)   # a replaced run never resumes the old one
+    assert checkpoint_folder(new) is None and not any(p.name.startswith("checkpoint") for p in new.iterdir())
+    assert commit_run_dir(new) == out and checkpoint_folder(out) is None
 
 
 def test_checkpoint_interval_is_a_checked_parameter_that_no_run_comparison_sees(tmp_path):

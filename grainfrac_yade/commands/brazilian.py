@@ -22,7 +22,8 @@ def register(sub, common):
     p.add_argument("--diameter", type=float, help="disc diameter [m] (brazilian.diameter)")
     p.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
     p.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
-    p.add_argument("--seed", type=int, default=1, help="random seed of the specimen")
+    from ..cli import seed_type
+    p.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     p.add_argument("--tensile-scale", type=float, metavar="F",
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
                         "--set contacts.<a>/<b>.tensile_strength=F x its value for each row (recorded so in "
@@ -124,12 +125,12 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
     from ..disc import build_disc_specimen
-    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
+    from ..runio import commit_run_dir, prepare_run_dir, summary_header, write_csv, write_json
     from ..yade_adapter.brazilian_test import run_brazilian
     from ..yade_adapter.levers import new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
-    out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
+    out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)   # written beside a replaced run
     history, result, scene, (broken_peak, mode_peak) = run_brazilian(specimen, params, progress=progress,
                                                                      levers=levers)
     t = specimen.tessellation
@@ -157,6 +158,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     run_brazilian_load_figure(history, summary, out / "load_strain.png")
     draw_crack_maps(scene, summary, broken_peak, mode_peak, out)
     write_json(out / "summary.json", summary)   # last: marks the run finished
+    commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
 
 

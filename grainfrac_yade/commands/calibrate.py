@@ -42,7 +42,8 @@ def _gpa(text: str) -> float:
 def register(sub, common):
     p = sub.add_parser("calibrate", help="fit strength/stiffness scale factors to UCS 234.5 MPa and E 69 GPa")
     common(p, geometry=True)
-    p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5])
+    from ..cli import seed_type
+    p.add_argument("--seeds", type=seed_type, nargs="+", default=[1, 2, 3, 4, 5], help="specimen seeds (>= 0)")
     p.add_argument("--rounds", type=int, default=2, help="fixed-point rounds after the 'before' round")
     from .creep import stress_flag
     p.add_argument("--target-ucs", type=stress_flag, default=TARGET_UCS, metavar="MPA",
@@ -56,7 +57,7 @@ def register(sub, common):
 
 def cmd_calibrate(args, params) -> int:
     from ..params import load_parameters, require_plane
-    from ..runio import prepare_run_dir, write_csv
+    from ..runio import commit_run_dir, prepare_run_dir, write_csv
     base = list(args.resolved_overrides)   # the overrides of ``params``, for each round's parameter set
     require_plane(params, "calibrate")
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,
@@ -84,6 +85,7 @@ def cmd_calibrate(args, params) -> int:
         if rnd < args.rounds:
             strength *= args.target_ucs / mean_ucs
             stiffness *= args.target_young / mean_e
+    out = commit_run_dir(out)   # a replacing run (--overwrite) takes the old one's place
     write_calibration_file(Path(args.write), rows, args, base)
     print(f"written {args.write} and {out / 'calibration.csv'}")
     return 0

@@ -205,7 +205,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     import json
 
     from ..analysis.runparams import load_run_parameters
-    from ..runio import CHECKPOINT, SUMMARY, read_checkpoint_state
+    from ..runio import CHECKPOINT, SUMMARY, checkpoint_folder, read_checkpoint_state
     folder = Path(folder)
     try:
         command = json.loads((folder / "run.json").read_text()).get("command")
@@ -217,6 +217,11 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     if (folder / SUMMARY).exists():
         return None
     state = read_checkpoint_state(folder)
+    if state is None and checkpoint_folder(folder) is not None:
+        where = checkpoint_folder(folder)
+        raise GrainfracError(f"{where}: the checkpoint's state file ({where.name}/state.json) is unreadable (not the "
+                             "JSON this code writes: garbage or truncated); fix: start the run again with the same "
+                             "command (run.json) and --overwrite")
     if state is None:
         raise GrainfracError(f"{folder}: no checkpoint to resume from ({CHECKPOINT}/ missing: the run stopped before "
                              "the end of its ramp, or was started by code without checkpoints); fix: start it again "
@@ -247,7 +252,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..creep_analysis import creep_stages, damage_index
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import (prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
+    from ..runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
     from ..specimen import build_specimen
     from ..yade_adapter.creep_test import resume_creep, run_creep
@@ -317,6 +322,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                         f"{'lifetime' if lifetime else 'run'})")
     write_json(out / "summary.json", summary)   # last: marks the run finished
     remove_checkpoints(out)                     # a finished run has nothing to resume
+    commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
 
 

@@ -51,7 +51,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import prepare_run_dir, summary_header, write_csv, write_json
+    from ..runio import commit_run_dir, prepare_run_dir, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
@@ -76,6 +76,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}")
     write_json(out / "summary.json", summary)   # last: marks the run finished
+    commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
 
 
