@@ -147,3 +147,123 @@ def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_p
                for l in lines), lines
     assert lines[-1] == f"1 of 2 rows failed: lines 4 of {table}"
     assert (tmp_path / "ok" / "summary.json").exists()
+
+
+# ------------------------------------------------------------------ no folder taken over or mixed
+def test_a_folder_of_another_kind_of_run_is_refused_even_with_overwrite(tmp_path):
+    from grainfrac_yade.runio import prepare_run_dir
+    params = load_parameters(overrides=TINY)
+    out = prepare_run_dir(tmp_path / "r", "specimen", params, 1)
+    for overwrite in (False, True):
+        with pytest.raises(GrainfracError, match="holds a 'specimen' run, not a 'ucs' run"):
+            prepare_run_dir(out, "ucs", params, 1, overwrite=overwrite)
+    assert json.loads((out / "run.json").read_text())["command"] == "specimen"
+
+
+def test_a_folder_of_other_files_is_refused(tmp_path):
+    from grainfrac_yade.runio import prepare_run_dir
+    (tmp_path / "r").mkdir()
+    (tmp_path / "r" / "history.csv").write_text("a\n1\n")
+    with pytest.raises(GrainfracError, match="holds files of something else than a run"):
+        prepare_run_dir(tmp_path / "r", "ucs", load_parameters(overrides=TINY), 1, overwrite=True)
+
+
+def test_an_unfinished_run_with_a_checkpoint_is_refused_naming_resume(tmp_path):
+    from grainfrac_yade.runio import prepare_run_dir
+    params = load_parameters(overrides=TINY)
+    out = prepare_run_dir(tmp_path / "r", "creep", params, 1)
+    (out / "checkpoint").mkdir()
+    (out / "checkpoint" / "state.json").write_text("{}")
+    with pytest.raises(GrainfracError, match=f"creep --resume {out}"):
+        prepare_run_dir(out, "creep", params, 1)
+
+
+def test_a_failed_overwrite_leaves_the_old_run_as_it_was(tmp_path, capsys):
+    """The issue's case: ``--overwrite --grain-size 1e-9`` must leave the old run whole. The cell count is
+    refused before any folder is made; a failure later in a replacing run (here: the specimen build refusing
+    after the folder was prepared) leaves the old folder byte for byte."""
+    from grainfrac_yade.commands.specimen import run_specimen
+    out = tmp_path / "s"
+    assert main(["specimen", "--width", "3e-3", "--height", "6e-3", "--out", str(out)]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    capsys.readouterr()
+    assert main(["specimen", "--overwrite", "--grain-size", "1e-9", "--out", str(out)]) == 2
+    _one_line(capsys, "cells", "more than this machine's memory holds")
+    with pytest.raises(GrainfracError, match="cells"):
+        run_specimen(load_parameters(overrides=["specimen.grain_size=1e-9"]), 1, out, overwrite=True)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert main(["specimen", "--width", "3e-3", "--height", "6e-3", "--seed", "2", "--overwrite",
+                 "--out", str(out)]) == 0   # a replacement that succeeds takes the old run's place
+    assert json.loads((out / "run.json").read_text())["seed"] == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s"]   # nothing left beside it
+
+
+# ------------------------------------------------------------------ one line, no traceback
+@pytest.mark.parametrize("argv, words", [
+    (["specimen", "--seed", "-1"], ("--seed", ">= 0")),
+    (["specimen", "--width", "-10e-3"], ("specimen.width", "must be > 0")),
+    (["specimen", "--width", "3e-3", "--height", "6e-3", "--out", "/proc/x"], ("/proc/x", "cannot write")),
+    (["creep", "--stress", "abc"], ("--stress", "invalid float value")),
+])
+def test_bad_input_is_one_line_without_traceback(argv, words):
+    res = _cli(*argv)
+    assert res.returncode == 2, res.stderr
+    err = [l for l in res.stderr.strip().splitlines() if not l.startswith("Using python")]
+    assert len(err) == 1 and "Traceback" not in res.stderr, res.stderr
+    for w in words:
+        assert w in err[0], err[0]
+
+
+def test_an_out_below_a_file_is_one_line(tmp_path, capsys):
+    (tmp_path / "file").write_text("x")
+    assert main(["specimen", "--width", "3e-3", "--height", "6e-3", "--out", str(tmp_path / "file" / "run")]) == 2
+    _one_line(capsys, "cannot write the run folder", "writable --out")
+
+
+def test_an_unexpected_error_is_one_line_with_the_traceback_in_a_log(tmp_path, monkeypatch, capsys):
+    from grainfrac_yade.commands import specimen as specimen_command
+
+    def broken(*args, **kw):
+        raise ZeroDivisionError("a bug")
+    monkeypatch.setattr(specimen_command, "run_specimen", broken)
+    monkeypatch.chdir(tmp_path)
+    assert main(["specimen", "--out", str(tmp_path / "s")]) == 1
+    line = _one_line(capsys, "specimen failed unexpectedly: ZeroDivisionError: a bug", "--debug")
+    log = line.split("traceback in ")[1].split(" (or rerun")[0]
+    assert "Traceback" in open(log).read() and "a bug" in open(log).read()
+    with pytest.raises(ZeroDivisionError):
+        main(["specimen", "--debug", "--out", str(tmp_path / "s")])
+
+
+def test_a_row_with_a_missing_cell_is_one_line_in_the_row_script_too(tmp_path):
+    """yade-batch run by hand (no pre-check): YADE's own table reader would end in an IndexError."""
+    table = tmp_path / "short.table"
+    table.write_text("specimen.width specimen.height seed\n3e-3 6e-3 1\n3e-3 6e-3\n")
+    from grainfrac_yade.batchrun import read_table_rows
+    columns, rows, problems = read_table_rows(table)
+    assert list(rows) == [2] and len(problems) == 1 and "short.table:3: 2 cells for 3 columns" in problems[0]
+
+
+@needs_yade
+@pytest.mark.yade
+def test_truncated_and_garbage_checkpoints_are_one_line(tmp_path):
+    """A tiny creep run killed mid-creep (test_resume's helper, a few seconds); its checkpoint's scene cut in
+    half, then every checkpoint file replaced by garbage: each resume is one line naming what is wrong."""
+    import shutil
+    from test_resume import TINY as CREEP_TINY, _start_and_kill
+    out = tmp_path / "killed"
+    _start_and_kill(CREEP_TINY, out, lambda st: st["phase"] == "event")
+    keep = tmp_path / "copy"
+    shutil.copytree(out, keep)
+    scene = out / "checkpoint" / "scene.yade.gz"
+    scene.write_bytes(scene.read_bytes()[: scene.stat().st_size // 2])
+    res = _cli("creep", "--resume", out)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "the checkpoint's scene is unreadable" in res.stderr and "gzip" in res.stderr
+    shutil.rmtree(out)
+    shutil.copytree(keep, out)
+    for f in (out / "checkpoint").iterdir():
+        f.write_bytes(b"garbage\x00\x01")
+    res = _cli("creep", "--resume", out)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "state file (checkpoint/state.json) is unreadable" in res.stderr
