@@ -267,3 +267,48 @@ def test_truncated_and_garbage_checkpoints_are_one_line(tmp_path):
     res = _cli("creep", "--resume", out)
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert "state file (checkpoint/state.json) is unreadable" in res.stderr
+
+
+# ------------------------------------------------------------------ ratios keep their meaning; crack phases
+def test_the_calibrated_reference_lists_what_differs_from_its_calibration():
+    from grainfrac_yade.commands.creep import UCS_FROM_CALIBRATION, reference_differences, ucs_reference
+    assert reference_differences(load_parameters()) == []
+    edited = load_parameters(overrides=["contacts.quartz/quartz.tensile_strength=1e6", "specimen.width=3e-3",
+                                        "stress_corrosion.beta1=2e-3"])   # beta1 changes no UCS: not listed
+    diffs = reference_differences(edited)
+    keys = {d.split(":")[0] for d in diffs}   # the mixed quartz pairs average quartz/quartz (section 3.1): listed too
+    assert {"contacts.quartz/quartz.tensile_strength", "specimen.width"} <= keys
+    assert all(k.startswith(("contacts.", "specimen.")) and "quartz" in k or k == "specimen.width" for k in keys)
+    assert ucs_reference(edited, "--ucs") == {"ucs_source": "--ucs", "ucs_reference_differences": None}
+    assert ucs_reference(edited, UCS_FROM_CALIBRATION)["ucs_reference_differences"] == diffs
+
+
+def test_read_cracks_maps_the_ramp_phase_to_the_analysis_convention(tmp_path):
+    from grainfrac_yade.analysis.crack_phases import RAMP_TIME
+    from grainfrac_yade.analysis.study import read_cracks
+    (tmp_path / "cracks.csv").write_text("bond,creep_time_s,phase,mode,kind,x_m,y_m,face_normal_angle_deg\n"
+                                         "1,,ramp,tensile,inter,0,0,0\n2,5.0,creep,shear,intra,0,0,0\n")
+    c = read_cracks(tmp_path)
+    assert c["creep_time_s"].tolist() == [RAMP_TIME, 5.0]
+
+
+@needs_yade
+@pytest.mark.yade
+def test_a_creep_run_records_its_reference_ucs_and_the_phase_of_each_crack(tmp_path):
+    """3 x 6 mm, ratio 0.8 of the calibrated reference (a few seconds): the reference was calibrated on the
+    paper-size specimen, so the run warns and lists the size; cracks.csv has no sentinel times."""
+    import pandas as pd
+    out = tmp_path / "creep"
+    res = _cli("creep", "--width", "3e-3", "--height", "6e-3", "--seed", "1", "--ratio", "0.8", "--set",
+               "stress_corrosion.creep_time_limit=1e30", "--out", out, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert "warning: the ratio refers to calibration.reference_ucs, calibrated with other parameters" in res.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["ucs_source"] == "calibration.reference_ucs" and s["ucs_pa"] == load_parameters().calibration.reference_ucs
+    assert "specimen.width: calibrated 0.0317, run 0.003" in s["ucs_reference_differences"]
+    c = pd.read_csv(out / "cracks.csv")
+    assert list(c.columns[:3]) == ["bond", "creep_time_s", "phase"]
+    assert set(c["phase"]) <= {"ramp", "creep"} and (c["phase"] == "creep").any()
+    assert c["creep_time_s"].isna().tolist() == (c["phase"] == "ramp").tolist()
+    assert (c.loc[c["phase"] == "creep", "creep_time_s"] >= 0).all()
+    assert len(c) == s["broken_total"] and s["broken_ramp"] == int((c["phase"] == "ramp").sum())

@@ -158,6 +158,44 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
     return stress, (stress - confining) / (ref - confining), ref
 
 
+#: Where a ratio's reference strength can come from (summary.json ``ucs_source``).
+UCS_FROM_CALIBRATION = "calibration.reference_ucs"
+#: Parameters that change the UCS a specimen has: a run that differs from the shipped values in one of them
+#: has another strength than calibration.reference_ucs, which was measured with the shipped values
+#: (params/calibration.toml: the paper-size specimen, seeds 1-5).  Prefixes of dotted keys.
+STRENGTH_KEYS = ("specimen.", "composition.", "contacts.", "grains.", "resolution.", "numerics.", "ucs.",
+                 "calibration.strength_scale", "calibration.stiffness_scale")
+
+
+def reference_differences(params) -> list:
+    """"key: calibrated X, run Y" for each parameter in :data:`STRENGTH_KEYS` in which ``params`` differ from
+    the shipped ones, with which calibration.reference_ucs was calibrated ([] if none)."""
+    from ..params import load_parameters
+    from ..runio import comparable_parameters
+    run = comparable_parameters(params.to_dict())
+    shipped = comparable_parameters(load_parameters().to_dict())
+    keys = sorted(k for k in set(run) | set(shipped) if k.startswith(STRENGTH_KEYS))
+    return [f"{k}: calibrated {shipped.get(k)!r}, run {run.get(k)!r}" for k in keys if shipped.get(k) != run.get(k)]
+
+
+def ucs_reference(params, ucs_source: str) -> dict:
+    """summary.json keys saying which UCS the ratio refers to: ``ucs_source`` and, for the calibrated
+    reference, ``ucs_reference_differences`` (:func:`reference_differences`; None for a UCS given)."""
+    diffs = reference_differences(params) if ucs_source == UCS_FROM_CALIBRATION else None
+    return {"ucs_source": ucs_source, "ucs_reference_differences": diffs}
+
+
+def warn_reference(reference: dict) -> None:
+    """A warning line (stderr) when the calibrated reference UCS was measured with other parameters."""
+    import sys
+    diffs = reference.get("ucs_reference_differences")
+    if diffs:
+        shown = "; ".join(diffs[:4]) + (f"; and {len(diffs) - 4} more" if len(diffs) > 4 else "")
+        print(f"warning: the ratio refers to {UCS_FROM_CALIBRATION}, calibrated with other parameters than this "
+              f"run's ({shown}); give the UCS of this specimen and model with --ucs (batch column ucs)",
+              file=sys.stderr)
+
+
 #: Options that shape a run: refused with --resume (the run folder holds them).
 RESUME_CONFLICTS = (("stress", "--stress"), ("ratio", "--ratio"), ("ucs", "--ucs"), ("clock", "--clock"),
                     ("confinement", "--confinement"),
@@ -185,8 +223,11 @@ def cmd_creep(args, params) -> int:
     check_stress_range(params, "--confinement" if args.confinement is not None else "confinement.stress")
     stress, ratio, ref = resolve_stress(params, _pa(args.stress), args.ratio, _pa(args.ucs), cli=True)
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
+    source = "--ucs" if args.ucs is not None else UCS_FROM_CALIBRATION
+    if args.ratio is not None:
+        warn_reference(ucs_reference(params, source))
     s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
-                            vtk_times=args.vtk_times)
+                            vtk_times=args.vtk_times, ucs_source=source)
     confined = f", confinement {params.confinement.stress / 1e6:g} MPa" if params.confinement.stress else ""
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
@@ -236,7 +277,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
 
 
 def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None,
-                        vtk_times=None, resume=False) -> dict:
+                        vtk_times=None, resume=False, ucs_source=None) -> dict:
     """Run a creep test into ``out``; summary.json is written last (it marks the run finished).
 
     Checkpoints go to ``out/checkpoint/`` during the run (end of the ramp, then every
@@ -275,6 +316,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
             outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times)
         run = run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
     numerical = bool(run.numerical_failure)
+    if ucs_source is None:   # a resumed run, or a caller that did not say: the calibrated value or one given
+        ucs_source = UCS_FROM_CALIBRATION if ref_ucs == params.calibration.reference_ucs else "given"
     rows = run.rows or [_row_before_history(run, broken_counts(run.scene))]
     hist = history_columns(rows)
     broken_creep = hist["broken_total"] - run.ramp_broken
@@ -293,6 +336,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
+        **ucs_reference(params, ucs_source),
         "confining_stress_pa": params.confinement.stress, **getattr(run, "consolidation", {}),
         "clock": params.stress_corrosion.clock, "law": params.stress_corrosion.law,
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
@@ -353,16 +397,19 @@ def history_columns(rows) -> dict:
 
 
 def write_crack_list(path, run):
-    """cracks.csv: bond, creep time (-1 = during the ramp), mode, kind, position, orientation,
-    segment end points and the creep time its cells separated (macrocrack; empty if never)."""
+    """cracks.csv: bond, creep time (empty for a crack of the ramp), phase (``ramp`` or ``creep``), mode, kind,
+    position, orientation, segment end points and the creep time its cells separated (macrocrack; empty if
+    never); docs/output_files.md."""
     from ..runio import write_csv
     from ..yade_adapter.scene import SHEAR, bond_segments
     sc = run.scene
     idx = np.flatnonzero(sc.broken)
     normal = sc.specimen.tessellation.face_normal[sc.layout.bond_face[idx]]
     seg = bond_segments(sc, idx)
+    ramp = run.break_time[idx] < 0   # the driver marks cracks of the ramp with a negative creep time
     write_csv(path, {
-        "bond": idx, "creep_time_s": run.break_time[idx],
+        "bond": idx, "creep_time_s": np.where(ramp, np.nan, run.break_time[idx]),
+        "phase": np.where(ramp, "ramp", "creep"),
         "mode": np.where(sc.break_mode[idx] == SHEAR, "shear", "tensile"),
         "kind": np.where(sc.bond_is_inter[idx], "inter", "intra"),
         "x_m": sc.layout.bond_point[idx, 0], "y_m": sc.layout.bond_point[idx, 1],
@@ -410,6 +457,10 @@ def run_creep_in_yade():
         print(note)
     if action == "resume":
         print(f"creep row unfinished, resumed from its checkpoint: {out}")
+    source = "batch column ucs" if given["ucs"] else UCS_FROM_CALIBRATION
+    if given["ratio"]:
+        warn_reference(ucs_reference(params, source))
     s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
-                            overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume")
+                            overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume",
+                            ucs_source=source)
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {outcome(s)} -> {out}")
