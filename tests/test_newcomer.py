@@ -312,3 +312,27 @@ def test_a_creep_run_records_its_reference_ucs_and_the_phase_of_each_crack(tmp_p
     assert c["creep_time_s"].isna().tolist() == (c["phase"] == "ramp").tolist()
     assert (c.loc[c["phase"] == "creep", "creep_time_s"] >= 0).all()
     assert len(c) == s["broken_total"] and s["broken_ramp"] == int((c["phase"] == "ramp").sum())
+
+
+def test_row_outcomes_judge_a_row_by_its_finished_run_not_by_yade_batch(tmp_path):
+    """yade-batch reports a row that printed "Yade: normal exit." as done whatever its status: the batch and the
+    demo judge each row by the summary.json of the folder it recorded, else by the reason in its log."""
+    from grainfrac_yade.batchrun import ROW_RECORDS, row_outcomes
+    from grainfrac_yade.runio import write_json
+    logs = tmp_path / "logs"
+    (logs / ROW_RECORDS).mkdir(parents=True)
+    done, broken = tmp_path / "done", tmp_path / "broken"
+    done.mkdir()
+    broken.mkdir()
+    write_json(done / "summary.json", {"ucs_pa": 2e8})
+    write_json(broken / "summary.json", {"ucs_pa": None, "failed_before_test": True, "end_reason": "broke apart"})
+    for line, folder in ((3, done), (4, broken)):
+        write_json(logs / ROW_RECORDS / f"{line}.json", {"folder": str(folder)})
+    (logs / "5.log").write_text("Using python\nerror: batch table t:5: unknown column 'x'; fix: ...\nYade: normal exit.\n")
+    (logs / "6.log").write_text("Traceback (most recent call last):\n  File x\nIndexError: list index out of range\n")
+    got = {o.line: o for o in row_outcomes(tmp_path / "t.table", logs, [3, 4, 5, 6, 7])}
+    assert [got[n].ok for n in (3, 4, 5, 6, 7)] == [True, False, False, False, False]
+    assert got[4].text.startswith("broke apart")
+    assert got[5].text.startswith("error: batch table t:5: unknown column")
+    assert got[6].text.startswith("IndexError: list index out of range")
+    assert got[7].text.startswith("the row did not run (no log)")
