@@ -130,23 +130,30 @@ def test_the_demo_refuses_a_ratio_at_or_above_one_before_it_simulates(tmp_path, 
 @needs_yade
 @pytest.mark.yade
 def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_path):
-    """Two 3 x 6 mm UCS rows (about 5 s each with YADE's start): line 3 runs; line 4's folder holds a finished
-    run of other parameters, so the row stops with its one line; the batch names line 4 and exits 1."""
+    """Three 3 x 6 mm UCS rows (about 5 s each with YADE's start): line 3 runs; line 4's folder holds a finished
+    run of other parameters, line 5's a specimen run (the issue's take-over), so both stop with their one line;
+    the batch names lines 4 and 5 and exits 1; the specimen folder is left as it was."""
     from grainfrac_yade.runio import prepare_run_dir, write_json
     taken = tmp_path / "taken"
     prepare_run_dir(taken, "ucs", load_parameters(), 1)
     write_json(taken / "summary.json", {"seed": 1, "ucs_pa": 1.0})
+    specimen = tmp_path / "specimen"
+    assert main(["specimen", "--width", "3e-3", "--height", "6e-3", "--out", str(specimen)]) == 0
+    before = {p.name: p.read_bytes() for p in specimen.iterdir()}
     table = tmp_path / "ucs.table"
     table.write_text("# tiny UCS rows\nspecimen.width specimen.height seed out\n"
-                     f"3e-3 6e-3 1 '{tmp_path / 'ok'}'\n3e-3 6e-3 1 '{taken}'\n")
+                     f"3e-3 6e-3 1 '{tmp_path / 'ok'}'\n3e-3 6e-3 1 '{taken}'\n3e-3 6e-3 1 '{specimen}'\n")
     res = _cli("batch", table, "--jobs", "1", "--log-dir", tmp_path / "logs", timeout=300)
     lines = res.stdout.strip().splitlines()
     assert res.returncode == 1, res.stdout + res.stderr
     assert any(l.startswith("line 3: ok: UCS") for l in lines), lines
     assert any(l.startswith("line 4: FAILED: error:") and "holds a finished run with other parameters" in l
                for l in lines), lines
-    assert lines[-1] == f"1 of 2 rows failed: lines 4 of {table}"
+    assert any(l.startswith("line 5: FAILED: error:") and "holds a 'specimen' run, not a 'ucs' run" in l
+               for l in lines), lines
+    assert lines[-1] == f"2 of 3 rows failed: lines 4, 5 of {table}"
     assert (tmp_path / "ok" / "summary.json").exists()
+    assert {p.name: p.read_bytes() for p in specimen.iterdir()} == before
 
 
 # ------------------------------------------------------------------ no folder taken over or mixed

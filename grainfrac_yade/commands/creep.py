@@ -460,7 +460,8 @@ def run_creep_in_yade():
     source = "batch column ucs" if given["ucs"] else UCS_FROM_CALIBRATION
     if given["ratio"]:
         warn_reference(ucs_reference(params, source))
-    s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
-                            overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume",
-                            ucs_source=source)
+    with row_errors():   # e.g. a folder of another kind of run: one line in the row's log
+        s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
+                                overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume",
+                                ucs_source=source)
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {outcome(s)} -> {out}")

@@ -111,7 +111,8 @@ def run_ucs_in_yade():
     if done:
         print(f"UCS row already finished, skipped: {out}")
         return
-    s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists())
+    with row_errors():   # e.g. a folder of another kind of run: one line in the row's log
+        s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists())
     if s.get("failed_before_test"):
         print(f"UCS: failed before the test ({s['end_reason']}) -> {out}")
         sys.exit(1)
