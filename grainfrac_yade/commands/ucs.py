@@ -67,7 +67,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None) -> dict
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
-    if history["dem_step"]:
+    if len(history["dem_step"]):   # none when the specimen broke apart before the axial stage
         run_stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
     at = ("the end of the isotropic stage" if result.get("failed_before_test") else
