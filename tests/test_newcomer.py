@@ -286,7 +286,7 @@ def test_the_calibrated_reference_lists_what_differs_from_its_calibration():
     keys = {d.split(":")[0] for d in diffs}   # the mixed quartz pairs average quartz/quartz (section 3.1): listed too
     assert {"contacts.quartz/quartz.tensile_strength", "specimen.width"} <= keys
     assert all(k.startswith(("contacts.", "specimen.")) and "quartz" in k or k == "specimen.width" for k in keys)
-    assert ucs_reference(edited, "--ucs") == {"ucs_source": "--ucs", "ucs_reference_differences": None}
+    assert ucs_reference(edited, "--ucs") == {"ucs_source": "--ucs", "ucs_reference_differences": []}
     assert ucs_reference(edited, UCS_FROM_CALIBRATION)["ucs_reference_differences"] == diffs
 
 

@@ -180,8 +180,9 @@ def reference_differences(params) -> list:
 
 def ucs_reference(params, ucs_source: str) -> dict:
     """summary.json keys saying which UCS the ratio refers to: ``ucs_source`` and, for the calibrated
-    reference, ``ucs_reference_differences`` (:func:`reference_differences`; None for a UCS given)."""
-    diffs = reference_differences(params) if ucs_source == UCS_FROM_CALIBRATION else None
+    reference, ``ucs_reference_differences`` (:func:`reference_differences`; [] for a UCS given, which is
+    this specimen's own by the giver's word)."""
+    diffs = reference_differences(params) if ucs_source == UCS_FROM_CALIBRATION else []
     return {"ucs_source": ucs_source, "ucs_reference_differences": diffs}
 
 
