@@ -40,7 +40,8 @@ def clean_folder(out, nullable=()) -> dict:
 
     JSON files may not hold NaN/Infinity tokens; summary.json's numbers must be finite, and null only
     for the ``nullable`` keys (not measured, or no result); every number in every CSV must be finite,
-    except cracks.csv's ``macro_time_s`` (empty: never a macrocrack).  ``end_reason`` must say why the
+    except cracks.csv's ``macro_time_s`` (empty: never a macrocrack) and ``creep_time_s`` on the rows of
+    phase ``ramp`` (a crack of the ramp has no creep time).  ``end_reason`` must say why the
     run ended.
     """
     out = Path(out)
@@ -53,7 +54,11 @@ def clean_folder(out, nullable=()) -> dict:
     assert all(math.isfinite(v) for v in numbers.values()), numbers
     assert isinstance(summary["end_reason"], str) and summary["end_reason"]
     for path in out.glob("*.csv"):
-        table = pd.read_csv(path).select_dtypes("number")
+        table = pd.read_csv(path)
+        if path.name == "cracks.csv" and "phase" in table:
+            assert table["creep_time_s"].isna().tolist() == (table["phase"] == "ramp").tolist()
+            table = table[table["phase"] != "ramp"]
+        table = table.select_dtypes("number")
         table = table.drop(columns=["macro_time_s"] if path.name == "cracks.csv" else [], errors="ignore")
         assert np.isfinite(table.to_numpy()).all(), f"{path.name}: NaN or inf"
     return summary
