@@ -23,7 +23,7 @@ run() {  # run <command> <variant> <seed> <options...>
   $py -m grainfrac_yade $cmd --seed $seed --out $out/$name/seed$seed --overwrite "$@" | tail -1
 }
 ls results/brazilian_ldb/seed5/summary.json > /dev/null 2>&1 || \
-  yade-batch -j 1 --log 'results/brazilian_ldb/%.log' params/brazilian_ldb.table yade_scripts/brazilian.py > /dev/null
+  { mkdir -p results/brazilian_ldb; yade-batch -j 1 --log 'results/brazilian_ldb/%.log' params/brazilian_ldb.table yade_scripts/brazilian.py > /dev/null; }
 D15="--diameter 15e-3"
 for s in 1 2 3 4 5; do run brazilian d15_base $s $D15; done
 for s in 1 2 3; do

@@ -196,7 +196,7 @@ small() {  # small <increment> <max_relaxation_steps>
   for s in 1 2; do
     dir=$out/small4x8/$name/s${s}_r0.5
     [ -f $dir/summary.json ] || $py -m grainfrac_yade creep --width 4e-3 --height 8e-3 --seed $s --ratio 0.5 \
-      --ucs 300e6 --overwrite --out $dir --set stress_corrosion.creep_time_limit=1e30 --set numerics.checkpoint_interval=0 \
+      --ucs 300 --overwrite --out $dir --set stress_corrosion.creep_time_limit=1e30 --set numerics.checkpoint_interval=0 \
       --set creep.collapse_strain_increment=$inc --set creep.max_relaxation_steps=$m \
       --set creep.collapse_stress_ratio=1 | tail -1
   done
@@ -208,7 +208,7 @@ for m in 30000 100000; do for i in 1e-3 3e-3 1e-2; do small $i $m; done; done
 for inc in 0 3e-3; do
   dir=$out/paper_tiny/inc$inc
   [ -f $dir/summary.json ] || $py -m grainfrac_yade creep --clock paper --width 3e-3 --height 6e-3 --seed 1 \
-    --ratio 0.8 --ucs 300e6 --overwrite --out $dir --set stress_corrosion.creep_time_limit=1e13 \
+    --ratio 0.8 --ucs 300 --overwrite --out $dir --set stress_corrosion.creep_time_limit=1e13 \
     --set numerics.checkpoint_interval=0 --set creep.record_period=100 --set creep.collapse_strain_increment=$inc \
     --set creep.collapse_stress_ratio=1 | tail -1
 done

@@ -13,12 +13,40 @@ Command modules never import this module.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 
 from .errors import GrainfracError
 
 #: Exit status for user errors (bad input), as argparse uses.
 EXIT_USER_ERROR = 2
+#: Exit status of an unexpected error (a bug or a failure of the machine, not bad input).
+EXIT_INTERNAL_ERROR = 1
+#: Flag (anywhere on the command line) that shows the traceback of an unexpected error instead of logging it.
+DEBUG_FLAG = "--debug"
+#: Folder of the traceback logs of unexpected errors (relative to the working folder; the temporary folder if
+#: that is not writable).
+ERROR_LOG_DIR = "results/logs"
+#: A negative number with an exponent (-10e-3): argparse takes it for an option ("expected one argument").
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
+def seed_type(text: str) -> int:
+    """argparse type of a specimen seed: a whole number >= 0 (numpy's generators take no negative seed)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. 1)") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number >= 0 (e.g. 1)")
+    return value
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse with its errors in one line (no usage block): the flag, the problem, where the help is."""
+
+    def error(self, message):
+        self.exit(EXIT_USER_ERROR, f"error: {self.prog}: {message}; fix: see {self.prog} --help\n")
 
 
 def _common(parser: argparse.ArgumentParser, geometry: bool = True):
@@ -31,7 +59,7 @@ def _common(parser: argparse.ArgumentParser, geometry: bool = True):
         parser.add_argument("--height", type=float, help="specimen height [m] (specimen.height)")
         parser.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
         parser.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
-        parser.add_argument("--seed", type=int, default=1, help="random seed of the specimen")
+        parser.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     parser.add_argument("--out", help="output folder")
     parser.add_argument("--overwrite", action="store_true", help="replace a run already in --out")
 
@@ -53,8 +81,15 @@ def overrides_from_args(args) -> list:
 def load_params_from_args(args):
     """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
     from .params import load_parameters
+    from .specimen import check_cell_count
+    from .tessellation import n_cells_for
     args.resolved_overrides = overrides_from_args(args)
-    return load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
+    params = load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
+    sp = params.specimen   # refused before any folder is made or anything allocated
+    box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
+    check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
+                     sp.grain_size)
+    return params
 
 
 def cmd_specimen(args, params) -> int:
@@ -73,8 +108,11 @@ def _format_summary(summary: dict) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python3 -m grainfrac_yade",
+    parser = OneLineParser(prog="python3 -m grainfrac_yade",
                                      description="Grain-based DEM of time-dependent fracture of granite (YADE).")
+    parser.add_argument(DEBUG_FLAG, action="store_true",
+                        help="show the traceback of an unexpected error (else written to a log file whose path the "
+                             "error line gives); accepted anywhere on the command line")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("specimen", help="build a Voronoi grain specimen; write specimen.json and specimen.png")
     _common(p)
@@ -87,7 +125,41 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def join_negative_values(argv: list) -> list:
+    """``--width -10e-3`` as ``--width=-10e-3``: argparse reads a negative number with an exponent as an option
+    and says only "expected one argument"; joined, the value reaches the parameter check, which names it."""
+    out = []
+    for token in argv:
+        if out and out[-1].startswith("--") and "=" not in out[-1] and NEGATIVE_NUMBER.match(token):
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
+
+
+def _log_traceback(command: str) -> str:
+    """Write the current exception's traceback to a new log file; its path (or a note if none could be written)."""
+    import datetime as _dt
+    import tempfile
+    import traceback
+    from pathlib import Path
+    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    text = f"python3 -m grainfrac_yade {' '.join(sys.argv[1:])}\n\n{traceback.format_exc()}"
+    for folder in (Path(ERROR_LOG_DIR), Path(tempfile.gettempdir())):
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / f"error_{command}_{stamp}.log"
+            path.write_text(text)
+            return str(path.resolve())
+        except OSError:
+            continue
+    return "(no log written: no writable folder)"
+
+
 def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = DEBUG_FLAG in argv
+    argv = join_negative_values([a for a in argv if a != DEBUG_FLAG])
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
@@ -100,3 +172,10 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("interrupted: files already written are complete", file=sys.stderr)
         return 130
+    except Exception as exc:   # noqa: BLE001  the general guard: one line, the traceback in a log
+        if debug:
+            raise
+        where = _log_traceback(args.command)
+        print(f"error: {args.command} failed unexpectedly: {type(exc).__name__}: {exc}; traceback in {where} "
+              f"(or rerun with {DEBUG_FLAG} to see it)", file=sys.stderr)
+        return EXIT_INTERNAL_ERROR

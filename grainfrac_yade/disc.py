@@ -348,6 +348,8 @@ def build_disc_specimen(params, seed: int, diameter: float | None = None):
                              "specimen.dimension = 2")
     diameter = params.brazilian.diameter if diameter is None else diameter
     check_disc_size(diameter, sp.grain_size)
+    from .specimen import check_cell_count
+    check_cell_count(n_cells_for_disc(diameter, sp.grain_size), f"the {diameter * 1e3:g} mm disc", sp.grain_size)
     rng = np.random.default_rng(seed)
     tess, reg = regularise(voronoi_disc(diameter, sp.grain_size, rng, sp.lloyd_iterations), sp.min_edge_fraction,
                            sp.grain_size)

@@ -2,10 +2,11 @@
 
 Every run folder records its resolved parameters, seed and code version.
 Files are written to a temporary name and renamed, so an interrupted run never
-leaves a half-written file; an existing run is never overwritten unless asked.
-``summary.json`` marks a finished run: commands write it last, and replacing a
-run removes the old one first, so a killed run never leaves a summary that
-claims completion.
+leaves a half-written file; an existing run is never overwritten unless asked,
+and a folder is never taken over by another kind of run or mixed with files of
+something else.  ``summary.json`` marks a finished run: commands write it last.
+A replacing run (``--overwrite``) is written beside the old one and swapped in
+when it has finished, so a failed replacement leaves the old run intact.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import json
 import math
 import os
 import platform
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -107,42 +109,106 @@ def write_csv(path, frame) -> Path:
     return _write_atomically(path, lambda tmp: frame.to_csv(tmp, index=False))
 
 
-def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, argv=None) -> Path:
-    """Create ``out`` and write ``run.json`` (command, seed, code version) and ``params.json``.
+#: A run that replaces another (``--overwrite``) is written into ``.<name>.replacing`` beside the old one and
+#: swapped in when it has finished (:func:`commit_run_dir`); the old run moves to ``.<name>.replaced`` for the
+#: instant between the two renames.  A failure leaves the old run as it was.
+REPLACING, REPLACED = ".replacing", ".replaced"
 
-    Refuses a folder that already holds a run unless ``overwrite``; replacing one removes its
-    summary.json first (the old run's completion must not outlive it).
+
+def _staging(out: Path, suffix: str) -> Path:
+    return out.with_name(f".{out.name}{suffix}")
+
+
+def _folder_error(out: Path, exc: OSError) -> GrainfracError:
+    """One line for a run folder that cannot be made or written (read-only, immutable, /proc, ...)."""
+    why = exc.strerror or type(exc).__name__
+    return GrainfracError(f"{out}: cannot write the run folder here ({why}: {exc.filename or out}); fix: choose a "
+                          "writable --out (batch column out)")
+
+
+def run_command_of(out) -> str | None:
+    """The command recorded in ``out/run.json`` ("" if unreadable), or None if the folder holds no run."""
+    path = Path(out) / "run.json"
+    if not path.exists():
+        return None
+    try:
+        command = json.loads(path.read_text()).get("command")
+    except (OSError, ValueError, AttributeError):
+        return ""
+    return command if isinstance(command, str) else ""
+
+
+def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, argv=None) -> Path:
+    """Create the run folder ``out`` and write ``run.json`` (command, seed, code version) and ``params.json``;
+    return the folder to write the run into.
+
+    Refuses, in one line: a folder that holds another kind of run (run.json of another command) or files of
+    something else (no run.json), always; a folder that holds a run of ``command`` unless ``overwrite`` (naming
+    ``--resume`` when that run is unfinished and has a checkpoint).  With ``overwrite`` the new run is written
+    beside the old one (``.<name>.replacing``, the returned folder) and :func:`commit_run_dir` swaps it in once
+    finished: until then, and after a failure, the old run is intact.
     """
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
-    if not overwrite and any((out / m).exists() for m in RUN_MARKERS):
-        if not (out / SUMMARY).exists() and checkpoint_folder(out) is not None:
-            held = _run_command(out) or command
-            raise GrainfracError(f"{out}: holds an unfinished {held} run with a checkpoint; fix: go on with it by "
-                                 f"`{held} --resume {out}`, choose another --out, or pass --overwrite to start "
-                                 "it again")
-        raise GrainfracError(f"{out}: already holds a run (run.json); fix: choose another --out "
-                             "or pass --overwrite to replace it")
-    out.mkdir(parents=True, exist_ok=True)
-    (out / SUMMARY).unlink(missing_ok=True)
-    remove_checkpoints(out)   # a checkpoint of the replaced run must never be resumed into this one
-    write_json(out / "params.json", params.to_dict())
-    write_json(out / "run.json", {
-        "command": command, "argv": list(sys.argv if argv is None else argv), "seed": seed,
-        "code_version": code_version(), "python": sys.version.split()[0], "platform": platform.platform(),
-        "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-    })
-    return out
-
-
-def _run_command(folder) -> str | None:
-    """The command of the run in ``folder`` (run.json), None if unreadable."""
+    old = _staging(out, REPLACED)
     try:
-        command = json.loads((Path(folder) / "run.json").read_text()).get("command")
-    except (OSError, ValueError, AttributeError):
-        return None
-    return command if isinstance(command, str) else None
+        if not out.exists() and old.is_dir():   # killed between the two renames of a swap: the old run is back
+            os.replace(old, out)
+        if out.exists() and not out.is_dir():
+            raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
+        held = run_command_of(out) if out.is_dir() else None
+        if held is None and out.is_dir() and any(out.iterdir()):
+            names = sorted(p.name for p in out.iterdir())
+            raise GrainfracError(f"{out}: holds files of something else than a run ({len(names)} entries, e.g. "
+                                 f"{', '.join(names[:3])}; no run.json); fix: choose another --out, or an empty folder")
+        if held is not None and held != command:
+            kind = f"a {held!r} run" if held else "a run whose run.json is unreadable"
+            raise GrainfracError(f"{out}: holds {kind}, not a {command!r} run; fix: choose another --out (a folder "
+                                 "holds one kind of run; --overwrite replaces only a run of the same command)")
+        if held is not None and not overwrite:
+            if not (out / SUMMARY).exists() and checkpoint_folder(out) is not None:
+                raise GrainfracError(f"{out}: holds an unfinished {command} run with a checkpoint; fix: "
+                                     f"`python3 -m grainfrac_yade {command} --resume {out}` goes on with it "
+                                     "(--overwrite would discard it), or choose another --out")
+            raise GrainfracError(f"{out}: already holds a run (run.json); fix: choose another --out "
+                                 "or pass --overwrite to replace it")
+        where = out
+        if held is not None:   # overwrite: the new run goes beside the old one
+            where = _staging(out, REPLACING)
+            shutil.rmtree(where, ignore_errors=True)   # a replacement that failed earlier
+        where.mkdir(parents=True, exist_ok=True)
+        write_json(where / "params.json", params.to_dict())
+        write_json(where / "run.json", {
+            "command": command, "argv": list(sys.argv if argv is None else argv), "seed": seed,
+            "code_version": code_version(), "python": sys.version.split()[0], "platform": platform.platform(),
+            "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        })
+    except OSError as exc:
+        raise _folder_error(out, exc) from None
+    return where
+
+
+def final_run_dir(where) -> Path:
+    """The folder a run written into ``where`` (:func:`prepare_run_dir`) ends in."""
+    where = Path(where)
+    if where.name.startswith(".") and where.name.endswith(REPLACING):
+        return where.with_name(where.name[1:-len(REPLACING)])
+    return where
+
+
+def commit_run_dir(where) -> Path:
+    """Swap a finished replacement run (``.<name>.replacing``) in for the old run; return the final folder.
+    A run written straight into its folder (nothing replaced) is left as it is."""
+    where = Path(where)
+    out = final_run_dir(where)
+    if out == where:
+        return out
+    old = _staging(out, REPLACED)
+    shutil.rmtree(old, ignore_errors=True)
+    if out.exists():
+        os.replace(out, old)
+    os.replace(where, out)
+    shutil.rmtree(old, ignore_errors=True)
+    return out
 
 
 def remove_checkpoints(folder) -> None:

@@ -58,7 +58,17 @@ def run(name, out, extra=WITHOUT_COLLAPSE):
     summary = json.loads((out / "summary.json").read_text())
     history = pd.read_csv(out / "history.csv", float_precision="round_trip").drop(columns=WALL)
     cracks = pd.read_csv(out / "cracks.csv", float_precision="round_trip")
-    return {k: summary.get(k) for k in SUMMARY_KEYS}, history, cracks
+    return {k: summary.get(k) for k in SUMMARY_KEYS}, history, stored_crack_format(cracks)
+
+
+def stored_crack_format(cracks):
+    """cracks.csv as the stored runs have it: the ramp's cracks at creep time -1.0 and no ``phase`` column
+    (today's file: an empty creep time and phase "ramp"); every other value as written."""
+    if "phase" not in cracks:
+        return cracks
+    out = cracks.copy()
+    out["creep_time_s"] = out["creep_time_s"].where(out["phase"] != "ramp", -1.0)
+    return out.drop(columns="phase")
 
 
 def stored(name, folder):

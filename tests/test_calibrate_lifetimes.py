@@ -127,7 +127,7 @@ def test_synthetic_lab_lifetimes_give_back_the_parameters_that_made_them(tmp_pat
     out = tmp_path / "calibrated.toml"
     res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "calibrate-lifetimes", str(study), "--lab", str(lab),
                           "--width", str(TINY["width"]), "--height", str(TINY["height"]), "--seeds", str(TINY["seed"]),
-                          "--ucs", str(TINY["ucs"]), "--set", "stress_corrosion.creep_time_limit=1e30",
+                          "--ucs", str(TINY["ucs"] / 1e6), "--set", "stress_corrosion.creep_time_limit=1e30",
                           "--out", str(out)],
                          capture_output=True, text=True, cwd=ROOT, env=dict(os.environ, OMP_NUM_THREADS="1"))
     assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-2000:]

@@ -50,7 +50,7 @@ def test_higher_load_fails_sooner(small_ucs):
 def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
     out = tmp_path / "creep"
     res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "creep", "--width", "6e-3", "--height", "12e-3",
-                          "--seed", "1", "--ratio", "0.9", "--ucs", str(small_ucs), "--clock", "event",
+                          "--seed", "1", "--ratio", "0.9", "--ucs", str(small_ucs / 1e6), "--clock", "event",
                           "--set", "stress_corrosion.creep_time_limit=1e30", "--vtk-times", "0", "--out", str(out)],
                          capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 0, res.stderr
@@ -73,7 +73,7 @@ def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
 
 
 def test_load_above_ucs_is_one_clear_line(tmp_path):
-    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "creep", "--stress", "300e6", "--ucs", "200e6",
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "creep", "--stress", "300", "--ucs", "200",
                           "--out", str(tmp_path / "x")], capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
     assert "above the UCS" in res.stderr and "fix:" in res.stderr

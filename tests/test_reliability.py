@@ -322,13 +322,16 @@ def test_a_write_killed_before_the_rename_leaves_the_old_file_whole(tmp_path, mo
     assert (tmp_path / "file.tmp").exists()
 
 
-def test_replacing_a_run_removes_its_old_summary_first(tmp_path):
-    from grainfrac_yade.runio import prepare_run_dir, write_json
+def test_a_replacing_run_is_written_beside_the_old_one_and_swapped_in_when_finished(tmp_path):
+    from grainfrac_yade.runio import commit_run_dir, prepare_run_dir, write_json
     params = load_parameters(overrides=TINY)
     out = prepare_run_dir(tmp_path / "r", "creep", params, 1)
     write_json(out / "summary.json", {"failed": True})
-    prepare_run_dir(out, "creep", params, 1, overwrite=True)
-    assert not (out / "summary.json").exists()
+    new = prepare_run_dir(out, "creep", params, 1, overwrite=True)
+    assert new != out and not (new / "summary.json").exists()
+    assert (out / "summary.json").exists()          # the old run is intact until the new one has finished
+    assert commit_run_dir(new) == out and not new.exists()
+    assert not (out / "summary.json").exists() and (out / "run.json").exists()
 
 
 # ------------------------------------------------------------------ batch rows: no stale results

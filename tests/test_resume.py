@@ -39,7 +39,7 @@ def _cli(*args, **kw):
 
 def _creep_args(spec, out, *extra):
     return ["--width", spec["width"], "--height", spec["height"], "--seed", spec["seed"], "--ratio", spec["ratio"],
-            "--ucs", spec["ucs"], "--set", "stress_corrosion.creep_time_limit=1e30", *extra, "--out", out]
+            "--ucs", spec["ucs"] / 1e6, "--set", "stress_corrosion.creep_time_limit=1e30", *extra, "--out", out]
 
 
 def _state(folder):
@@ -174,7 +174,7 @@ def test_a_batch_row_skips_resumes_or_starts_by_its_folder(tmp_path):
 
 
 def test_checkpoint_folder_survives_a_kill_between_the_renames(tmp_path):
-    from grainfrac_yade.runio import checkpoint_folder, prepare_run_dir
+    from grainfrac_yade.runio import checkpoint_folder, commit_run_dir, prepare_run_dir
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = _unfinished(tmp_path / "r", params)
     (out / "checkpoint.tmp").mkdir()                    # a new one half written: not used
@@ -183,8 +183,9 @@ def test_checkpoint_folder_survives_a_kill_between_the_renames(tmp_path):
     assert checkpoint_folder(out) == out / "checkpoint.old"
     (out / "checkpoint.tmp" / "state.json").write_text("{}")  # ... with the new one complete
     assert checkpoint_folder(out) == out / "checkpoint.tmp"
-    prepare_run_dir(out, "creep", params, 1, overwrite=True)   # a replaced run never resumes the old one
-    assert checkpoint_folder(out) is None and not any(p.name.startswith("checkpoint") for p in out.iterdir())
+    new = prepare_run_dir(out, "creep", params, 1, overwrite=True)   # a replaced run never resumes the old one
+    assert checkpoint_folder(new) is None and not any(p.name.startswith("checkpoint") for p in new.iterdir())
+    assert commit_run_dir(new) == out and checkpoint_folder(out) is None
 
 
 def test_checkpoint_interval_is_a_checked_parameter_that_no_run_comparison_sees(tmp_path):
@@ -263,7 +264,7 @@ def test_a_bad_resume_is_one_line(tmp_path, case):
         write_json(out / "summary.json", dict(VALUES, failed=True))
     elif case == "conflict":
         _unfinished(out, params)
-        args += ["--stress", "1e8"]
+        args += ["--stress", "100"]
     elif case == "ucs run":
         prepare_run_dir(out, "ucs", params, 1)
     res = _cli(*args)

@@ -1,7 +1,8 @@
 """Brazilian disc test, one run per yade-batch row.
 
     yade -x yade_scripts/brazilian.py
-    yade-batch -j 2 --log 'results/brazilian/%.log' params/brazilian_seeds.table yade_scripts/brazilian.py
+    python3 -m grainfrac_yade batch params/brazilian_ldb.table --test brazilian --jobs 2   # every row checked first
+    mkdir -p results/brazilian_ldb && yade-batch -j 2 --log 'results/brazilian_ldb/%.log' params/brazilian_ldb.table yade_scripts/brazilian.py
 Columns: any parameter path (e.g. brazilian.diameter, specimen.grain_size), plus seed, out, study.
 Each row writes results/<study>/<row name>/ (summary.json, history.csv, cracks.csv, figures).
 """

@@ -1,8 +1,9 @@
 """Constant-load creep test to failure, one run per yade-batch row.
 
     yade -x yade_scripts/creep.py                       (defaults: needs a ratio or stress column)
-    yade-batch -j 2 --log 'results/lifetime_small/%.log' params/lifetime_small.table yade_scripts/creep.py
-Columns: ratio (or stress [Pa]), optional ucs [Pa], seed, study, out, and any parameter path
+    python3 -m grainfrac_yade batch params/lifetime_small.table --test creep --jobs 2   # every row checked first
+    mkdir -p results/lifetime_small && yade-batch -j 2 --log 'results/lifetime_small/%.log' params/lifetime_small.table yade_scripts/creep.py
+Columns: ratio or stress [Pa] (not both), optional ucs [Pa], seed, study, out, and any parameter path
 (e.g. stress_corrosion.clock). Each row writes results/<study>/<row name>/.
 """
 import os

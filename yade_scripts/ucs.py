@@ -1,7 +1,8 @@
 """Uniaxial compression test, one run per yade-batch row.
 
     yade -x yade_scripts/ucs.py
-    yade-batch -j 2 params/resolution_small.table yade_scripts/ucs.py
+    python3 -m grainfrac_yade batch params/resolution_small.table --test ucs --jobs 2   # every row checked first
+    mkdir -p results/resolution && yade-batch -j 2 --log 'results/resolution/%.log' params/resolution_small.table yade_scripts/ucs.py
 Columns: any parameter path (e.g. resolution.spheres_per_cell, specimen.grain_size), plus seed, out, study.
 Each row writes results/<study>/<row name>/ (summary.json, history.csv, figures).
 """

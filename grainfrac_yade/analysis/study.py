@@ -187,9 +187,14 @@ def read_history(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
 
 
 def read_cracks(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
-    """cracks.csv of a run (creep times >= 0 multiplied by ``time_factor``; -1 = ramp stays), or None."""
+    """cracks.csv of a run (creep times >= 0 multiplied by ``time_factor``), or None.  Cracks of the ramp get
+    the creep time -1 in the frame (:data:`grainfrac_yade.analysis.crack_phases.RAMP_TIME`): files with a
+    ``phase`` column leave their creep time empty, older files wrote -1."""
     cracks = _read_csv(Path(folder) / "cracks.csv", ("creep_time_s", "mode", "kind", "x_m", "y_m",
                                                      "face_normal_angle_deg"))
+    if cracks is not None and "phase" in cracks:
+        from .crack_phases import RAMP_TIME
+        cracks["creep_time_s"] = cracks["creep_time_s"].where(cracks["phase"] != "ramp", RAMP_TIME)
     return rescale.scale_times(cracks, time_factor, rescale.CRACK_TIME_COLUMNS)
 
 

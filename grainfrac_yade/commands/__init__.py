@@ -6,7 +6,7 @@ def register_all(subparsers, common):
     import importlib
     for name in ("ucs", "calibrate", "calibrate_beta1", "calibrate_lifetimes", "analyze_ucs", "creep", "analyze", "demo",
                  "elastic", "bench", "accuracy_cost",
-                 "submit", "status", "brazilian"):
+                 "submit", "status", "brazilian", "batch"):
         try:
             module = importlib.import_module(f"{__name__}.{name}")
         except ModuleNotFoundError as exc:

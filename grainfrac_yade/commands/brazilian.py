@@ -22,7 +22,8 @@ def register(sub, common):
     p.add_argument("--diameter", type=float, help="disc diameter [m] (brazilian.diameter)")
     p.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
     p.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
-    p.add_argument("--seed", type=int, default=1, help="random seed of the specimen")
+    from ..cli import seed_type
+    p.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     p.add_argument("--tensile-scale", type=float, metavar="F",
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
                         "--set contacts.<a>/<b>.tensile_strength=F x its value for each row (recorded so in "
@@ -147,7 +148,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
     from ..disc import build_disc_specimen
-    from ..runio import prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
+    from ..runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..yade_adapter.brazilian_test import resume_brazilian, run_brazilian
     from ..yade_adapter.levers import Levers, new_breaks
     require_disc_model(params)
@@ -191,6 +192,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     draw_crack_maps(scene, summary, broken_peak, mode_peak, out)
     write_json(out / "summary.json", summary)   # last: marks the run finished
     remove_checkpoints(out)                     # a finished run has nothing to resume
+    commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
 
 

@@ -26,13 +26,30 @@ TARGET_YOUNG = 69e9
 CALIBRATION_FILE = Path(__file__).resolve().parents[2] / "params" / "calibration.toml"
 
 
+def _gpa(text: str) -> float:
+    """argparse type of a modulus flag: GPa, returned in Pa."""
+    import argparse
+    import math
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a modulus in GPa (e.g. 69)") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: a modulus must be finite and above 0 GPa (e.g. 69)")
+    return value * 1e9
+
+
 def register(sub, common):
     p = sub.add_parser("calibrate", help="fit strength/stiffness scale factors to UCS 234.5 MPa and E 69 GPa")
     common(p, geometry=True)
-    p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5])
+    from ..cli import seed_type
+    p.add_argument("--seeds", type=seed_type, nargs="+", default=[1, 2, 3, 4, 5], help="specimen seeds (>= 0)")
     p.add_argument("--rounds", type=int, default=2, help="fixed-point rounds after the 'before' round")
-    p.add_argument("--target-ucs", type=float, default=TARGET_UCS)
-    p.add_argument("--target-young", type=float, default=TARGET_YOUNG)
+    from .creep import stress_flag
+    p.add_argument("--target-ucs", type=stress_flag, default=TARGET_UCS, metavar="MPA",
+                   help=f"UCS target [MPa, like every stress flag] (default {TARGET_UCS / 1e6:g})")
+    p.add_argument("--target-young", type=_gpa, default=TARGET_YOUNG, metavar="GPA",
+                   help=f"Young's modulus target [GPa] (default {TARGET_YOUNG / 1e9:g})")
     p.add_argument("--jobs", type=int, default=1, help="seeds run in parallel (one process each)")
     p.add_argument("--write", default=str(CALIBRATION_FILE), help="calibration file to (over)write")
     p.set_defaults(func=cmd_calibrate, with_params=True)
@@ -40,7 +57,7 @@ def register(sub, common):
 
 def cmd_calibrate(args, params) -> int:
     from ..params import load_parameters, require_plane
-    from ..runio import prepare_run_dir, write_csv
+    from ..runio import commit_run_dir, prepare_run_dir, write_csv
     base = list(args.resolved_overrides)   # the overrides of ``params``, for each round's parameter set
     require_plane(params, "calibrate")
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,
@@ -68,6 +85,7 @@ def cmd_calibrate(args, params) -> int:
         if rnd < args.rounds:
             strength *= args.target_ucs / mean_ucs
             stiffness *= args.target_young / mean_e
+    out = commit_run_dir(out)   # a replacing run (--overwrite) takes the old one's place
     write_calibration_file(Path(args.write), rows, args, base)
     print(f"written {args.write} and {out / 'calibration.csv'}")
     return 0

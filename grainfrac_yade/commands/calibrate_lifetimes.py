@@ -37,6 +37,7 @@ def _ints(text):
 
 
 def register(sub, common):
+    from .creep import stress_flag
     p = sub.add_parser("calibrate-lifetimes", help="fit beta1, beta2 (and a threshold) to lab lifetimes (runs "
                                                    "the creep rows it needs through yade-batch)")
     common(p)
@@ -44,8 +45,8 @@ def register(sub, common):
     p.add_argument("--lab", required=True, help="CSV driving_stress_ratio,lifetime_s[,source]")
     p.add_argument("--seeds", type=_ints, default=None,
                    help="specimen seeds of each ratio (default: those of the study's creep runs, else 1,2,3)")
-    p.add_argument("--ucs", type=float, default=None,
-                   help="UCS [Pa] the lab ratios refer to (default: the study's runs' ucs_pa if they agree, else "
+    p.add_argument("--ucs", type=stress_flag, default=None, metavar="MPA",
+                   help="UCS [MPa, like every stress flag; files and batch columns in Pa] the lab ratios refer to (default: the study's runs' ucs_pa if they agree, else "
                         "calibration.reference_ucs)")
     p.add_argument("--threshold-ratios", type=_floats, default=None, metavar="R1,R2,...",
                    help="also fit stress_corrosion.threshold_ratio among these values, e.g. 0,0.3,0.4")

@@ -13,10 +13,12 @@ def register(sub, common):
     p = sub.add_parser("creep", help="constant-load creep test to failure with stress corrosion")
     common(p)
     load = p.add_mutually_exclusive_group()
-    load.add_argument("--stress", type=float, help="creep stress [Pa], e.g. 160e6")
+    load.add_argument("--stress", type=float, metavar="MPA",
+                      help="creep stress sigma_1 [MPa], e.g. 160 (every stress flag is in MPa; files and batch "
+                           "columns are in Pa)")
     load.add_argument("--ratio", type=float, help="driving-stress ratio sigma/sigma_c (sigma_c: --ucs, else "
                                                   "calibration.reference_ucs, the calibrated mean UCS)")
-    p.add_argument("--ucs", type=float, help="UCS [Pa] that --ratio refers to")
+    p.add_argument("--ucs", type=float, metavar="MPA", help="UCS [MPa] that --ratio refers to, e.g. 258")
     p.add_argument("--clock", choices=("event", "paper"), help="stress_corrosion.clock")
     add_confinement_option(p)
     p.add_argument("--vtk-times", type=_times, default=None, metavar="T1,T2,...",
@@ -41,17 +43,54 @@ def _clock_override(args) -> list:
     return ([f"stress_corrosion.clock={args.clock}"] if args.clock else []) + confinement_override(args)
 
 
+#: Pa per MPa: every stress flag of the CLI is in MPa, every file and batch column in Pa.
+PA_PER_MPA = 1e6
+#: Largest load, confining stress or reference strength accepted, as a multiple of the specimen's reference
+#: strength (calibration.reference_ucs): above it a value is taken for a unit slip (Pa given where MPa is
+#: meant is 1e6 times too large), not a test.  Confined peak strengths measured here stay below 2 x it
+#: (426 MPa at 20 MPa confinement against 236 MPa).
+MAX_STRESS_OVER_REFERENCE = 4.0
+
+
 def add_confinement_option(parser):
     """``--confinement MPA``: the confining stress sigma_3 (sets confinement.stress)."""
     parser.add_argument("--confinement", type=float, metavar="MPA",
-                        help="confining stress sigma_3 [MPa] held on the side walls (biaxial test; confinement.stress); "
-                             "default 0: uniaxial")
+                        help="confining stress sigma_3 [MPa], e.g. 20, held on the side walls (biaxial test; "
+                             "confinement.stress, in Pa in files); omit for a uniaxial test")
 
 
 def confinement_override(args) -> list:
-    """The override of ``--confinement MPA`` (none if not given)."""
+    """The override of ``--confinement MPA`` (none if not given); refuses a value at or below 0 in one line."""
     value = getattr(args, "confinement", None)
-    return [] if value is None else [("confinement.stress", value * 1e6)]
+    if value is None:
+        return []
+    if not (math.isfinite(value) and value > 0):
+        raise GrainfracError(f"--confinement {value:g} MPa (confinement.stress): a confining stress must be above 0 "
+                             "MPa; fix: e.g. --confinement 20, or omit it for a uniaxial test")
+    return [("confinement.stress", value * PA_PER_MPA)]
+
+
+def stress_flag(text: str) -> float:
+    """argparse type of a stress flag: a number of MPa, returned in Pa."""
+    import argparse
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a stress in MPa (e.g. 258)") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: a stress must be finite and above 0 MPa (e.g. 258)")
+    return value * PA_PER_MPA
+
+
+def check_stress_range(params, where: str = "confinement.stress") -> None:
+    """Refuse a confining stress above :data:`MAX_STRESS_OVER_REFERENCE` x calibration.reference_ucs (one line;
+    ``where``: how the user gave it)."""
+    confining, ref = params.confinement.stress, params.calibration.reference_ucs
+    if confining > MAX_STRESS_OVER_REFERENCE * ref:
+        raise GrainfracError(f"{where}: confining stress {confining / PA_PER_MPA:.4g} MPa is above "
+                             f"{MAX_STRESS_OVER_REFERENCE:g} x the reference strength (calibration.reference_ucs = "
+                             f"{ref / PA_PER_MPA:.4g} MPa); fix: --confinement is in MPa (e.g. 20), "
+                             "confinement.stress in files and batch columns in Pa (e.g. 20e6)")
 
 
 def outcome(summary: dict) -> str:
@@ -102,38 +141,93 @@ def _times(text: str) -> list:
     return times
 
 
-def resolve_stress(params, stress=None, ratio=None, ucs=None):
-    """(axial stress sigma_1 [Pa], ratio, strength used [Pa]).
+def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
+    """(axial stress sigma_1 [Pa], ratio, strength used [Pa]); ``stress`` and ``ucs`` in Pa.
 
     Uniaxial: the ratio is sigma_1 / UCS, the UCS being ``ucs`` or the calibrated mean UCS.  Confined
     (``confinement.stress`` sigma_3 > 0): the ratio is the deviatoric one, (sigma_1 - sigma_3) /
     (sigma_peak - sigma_3), and ``ucs`` must be given: the peak axial stress sigma_peak of the
-    compression test at the same sigma_3 (``ucs --confinement``).
+    compression test at the same sigma_3 (``ucs --confinement``).  ``cli``: name the values as the
+    CLI flags give them (MPa) in the messages, else as batch columns (Pa).
     """
+    def named(flag, value):   # how the user gave a stress [Pa]
+        return f"--{flag} {value / PA_PER_MPA:.4g} MPa" if cli else f"column {flag} = {value:.4g} Pa"
+    example = {"stress": "--stress 160" if cli else "stress 160e6", "ucs": "--ucs 258" if cli else "ucs 258e6"}
     confining = params.confinement.stress
+    calibrated = params.calibration.reference_ucs
     if stress is None and ratio is None:
-        raise GrainfracError("no creep load: give a stress [Pa] or a driving-stress ratio (CLI --stress/--ratio, "
-                             "batch column stress/ratio); fix: e.g. ratio 0.7")
+        raise GrainfracError("no creep load: give a stress or a driving-stress ratio (CLI --stress MPA / --ratio, "
+                             "batch column stress [Pa] / ratio); fix: e.g. ratio 0.7")
+    for flag, value in (("stress", stress), ("ucs", ucs)):
+        if value is None:
+            continue
+        if not (math.isfinite(value) and value > 0):
+            raise GrainfracError(f"{named(flag, value)}: a stress must be finite and above 0; fix: e.g. "
+                                 f"{example[flag]}")
+        if value > MAX_STRESS_OVER_REFERENCE * calibrated:
+            raise GrainfracError(f"{named(flag, value)} is above {MAX_STRESS_OVER_REFERENCE:g} x the reference "
+                                 f"strength (calibration.reference_ucs = {calibrated / PA_PER_MPA:.4g} MPa); fix: "
+                                 "CLI stress flags are in MPa, batch columns in Pa: e.g. " + example[flag])
     if confining > 0 and ucs is None:
         raise GrainfracError(f"confinement.stress = {confining:.4g} Pa: the driving-stress ratio refers to the peak "
                              "strength at this confinement; fix: give --ucs (batch column ucs), the peak axial stress "
                              "of `ucs --confinement` at the same confining stress")
-    ref = ucs if ucs is not None else params.calibration.reference_ucs
+    ref = ucs if ucs is not None else calibrated
     if not ref > confining:
-        raise GrainfracError(f"--ucs {ref:.4g} Pa is not above the confining stress {confining:.4g} Pa; fix: give the "
-                             "peak axial stress at this confinement")
+        raise GrainfracError(f"{named('ucs', ref)} is not above the confining stress {confining / PA_PER_MPA:.4g} MPa; "
+                             "fix: give the peak axial stress at this confinement")
     if stress is None:
         if not (0 < ratio < 1):
-            raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")
+            raise GrainfracError(f"ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. ratio 0.7")
         stress = confining + ratio * (ref - confining)
-    if not (math.isfinite(stress) and stress > confining):
-        raise GrainfracError(f"--stress {stress}: must be a finite stress in Pa above the confining stress "
-                             f"({confining:.4g} Pa); fix: e.g. --stress 160e6")
+    if not stress > confining:
+        raise GrainfracError(f"{named('stress', stress)}: must be above the confining stress "
+                             f"({confining / PA_PER_MPA:.4g} MPa); fix: e.g. {example['stress']}")
     if stress >= ref:
         strength = "the UCS" if confining == 0 else "the peak strength at this confinement"
-        raise GrainfracError(f"--stress {stress:.4g} Pa is at or above {strength} it refers to ({ref:.4g} Pa): the "
-                             "specimen fails during the ramp; fix: give a stress below it (or --ucs)")
+        raise GrainfracError(f"{named('stress', stress)} is at or above {strength} it refers to "
+                             f"({ref / PA_PER_MPA:.4g} MPa): the specimen fails during the ramp; fix: give a stress "
+                             "below it (or --ucs)")
     return stress, (stress - confining) / (ref - confining), ref
+
+
+#: Where a ratio's reference strength can come from (summary.json ``ucs_source``).
+UCS_FROM_CALIBRATION = "calibration.reference_ucs"
+#: Parameters that change the UCS a specimen has: a run that differs from the shipped values in one of them
+#: has another strength than calibration.reference_ucs, which was measured with the shipped values
+#: (params/calibration.toml: the paper-size specimen, seeds 1-5).  Prefixes of dotted keys.
+STRENGTH_KEYS = ("specimen.", "composition.", "contacts.", "grains.", "resolution.", "numerics.", "ucs.",
+                 "calibration.strength_scale", "calibration.stiffness_scale")
+
+
+def reference_differences(params) -> list:
+    """"key: calibrated X, run Y" for each parameter in :data:`STRENGTH_KEYS` in which ``params`` differ from
+    the shipped ones, with which calibration.reference_ucs was calibrated ([] if none)."""
+    from ..params import load_parameters
+    from ..runio import comparable_parameters
+    run = comparable_parameters(params.to_dict())
+    shipped = comparable_parameters(load_parameters().to_dict())
+    keys = sorted(k for k in set(run) | set(shipped) if k.startswith(STRENGTH_KEYS))
+    return [f"{k}: calibrated {shipped.get(k)!r}, run {run.get(k)!r}" for k in keys if shipped.get(k) != run.get(k)]
+
+
+def ucs_reference(params, ucs_source: str) -> dict:
+    """summary.json keys saying which UCS the ratio refers to: ``ucs_source`` and, for the calibrated
+    reference, ``ucs_reference_differences`` (:func:`reference_differences`; [] for a UCS given, which is
+    this specimen's own by the giver's word)."""
+    diffs = reference_differences(params) if ucs_source == UCS_FROM_CALIBRATION else []
+    return {"ucs_source": ucs_source, "ucs_reference_differences": diffs}
+
+
+def warn_reference(reference: dict) -> None:
+    """A warning line (stderr) when the calibrated reference UCS was measured with other parameters."""
+    import sys
+    diffs = reference.get("ucs_reference_differences")
+    if diffs:
+        shown = "; ".join(diffs[:4]) + (f"; and {len(diffs) - 4} more" if len(diffs) > 4 else "")
+        print(f"warning: the ratio refers to {UCS_FROM_CALIBRATION}, calibrated with other parameters than this "
+              f"run's ({shown}); give the UCS of this specimen and model with --ucs (batch column ucs)",
+              file=sys.stderr)
 
 
 #: Options that shape a run: refused with --resume (the run folder holds them).
@@ -164,16 +258,25 @@ def cmd_creep(args, params) -> int:
               f"DEM steps -> {args.resume}")
         return 0
     require_plane(params, "creep")
-    stress, ratio, ref = resolve_stress(params, args.stress, args.ratio, args.ucs)
+    check_stress_range(params, "--confinement" if args.confinement is not None else "confinement.stress")
+    stress, ratio, ref = resolve_stress(params, _pa(args.stress), args.ratio, _pa(args.ucs), cli=True)
     out = args.out or f"results/creep_{stress / 1e6:.0f}MPa_seed{args.seed}"
+    source = "--ucs" if args.ucs is not None else UCS_FROM_CALIBRATION
+    if args.ratio is not None:
+        warn_reference(ucs_reference(params, source))
     s = run_creep_to_folder(params, args.seed, out, stress, ratio, ref, overwrite=args.overwrite, progress=print,
                             vtk_times=args.vtk_times, vtk_every=args.vtk_every,
                             vtk_fractions=None if args.vtk_fractions is False else
-                            (args.vtk_fractions or list(MAP_FRACTIONS)))
+                            (args.vtk_fractions or list(MAP_FRACTIONS)), ucs_source=source)
     confined = f", confinement {params.confinement.stress / 1e6:g} MPa" if params.confinement.stress else ""
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
     return 0
+
+
+def _pa(mpa):
+    """A CLI stress [MPa] in Pa (None stays None)."""
+    return None if mpa is None else mpa * PA_PER_MPA
 
 
 def resume_creep_folder(folder, progress=None) -> dict | None:
@@ -183,7 +286,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     import json
 
     from ..analysis.runparams import load_run_parameters
-    from ..runio import CHECKPOINT, SUMMARY, read_checkpoint_state
+    from ..runio import CHECKPOINT, SUMMARY, checkpoint_folder, read_checkpoint_state
     folder = Path(folder)
     try:
         command = json.loads((folder / "run.json").read_text()).get("command")
@@ -195,6 +298,11 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     if (folder / SUMMARY).exists():
         return None
     state = read_checkpoint_state(folder)
+    if state is None and checkpoint_folder(folder) is not None:
+        where = checkpoint_folder(folder)
+        raise GrainfracError(f"{where}: the checkpoint's state file ({where.name}/state.json) is unreadable (not the "
+                             "JSON this code writes: garbage or truncated); fix: start the run again with the same "
+                             "command (run.json) and --overwrite")
     if state is None:
         raise GrainfracError(f"{folder}: no checkpoint to resume from ({CHECKPOINT}/ missing: the run stopped before "
                              "the end of its ramp, or was started by code without checkpoints); fix: start it again "
@@ -209,7 +317,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
 
 
 def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=False, progress=None,
-                        vtk_times=None, resume=False, vtk_every=None, vtk_fractions=None) -> dict:
+                        vtk_times=None, resume=False, vtk_every=None, vtk_fractions=None, ucs_source=None) -> dict:
     """Run a creep test into ``out``; summary.json is written last (it marks the run finished).
 
     Checkpoints go to ``out/checkpoint/`` during the run (end of the ramp, then every
@@ -229,7 +337,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..creep_analysis import CreepStages, damage_index, resolve_creep_stages
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import (prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
+    from ..runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
     from ..specimen import build_specimen
     from ..yade_adapter.creep_test import resume_creep, run_creep
@@ -258,6 +366,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
             outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times or (), vtk_every=vtk_every or 0)
         run = run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
     numerical = bool(run.numerical_failure)
+    if ucs_source is None:   # a resumed run, or a caller that did not say: the calibrated value or one given
+        ucs_source = UCS_FROM_CALIBRATION if ref_ucs == params.calibration.reference_ucs else "given"
     rows = run.rows or [_row_before_history(run, broken_counts(run.scene))]
     hist = history_columns(rows)
     broken_creep = hist["broken_total"] - run.ramp_broken
@@ -277,6 +387,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
+        **ucs_reference(params, ucs_source),
         "confining_stress_pa": params.confinement.stress, **getattr(run, "consolidation", {}),
         "clock": params.stress_corrosion.clock, "law": params.stress_corrosion.law,
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
@@ -311,6 +422,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                         f"{'lifetime' if lifetime else 'run'})")
     write_json(out / "summary.json", summary)   # last: marks the run finished
     remove_checkpoints(out)                     # a finished run has nothing to resume
+    commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
 
 
@@ -341,16 +453,19 @@ def history_columns(rows) -> dict:
 
 
 def write_crack_list(path, run):
-    """cracks.csv: bond, creep time (-1 = during the ramp), mode, kind, position, orientation,
-    segment end points and the creep time its cells separated (macrocrack; empty if never)."""
+    """cracks.csv: bond, creep time (empty for a crack of the ramp), phase (``ramp`` or ``creep``), mode, kind,
+    position, orientation, segment end points and the creep time its cells separated (macrocrack; empty if
+    never); docs/output_files.md."""
     from ..runio import write_csv
     from ..yade_adapter.scene import SHEAR, bond_segments
     sc = run.scene
     idx = np.flatnonzero(sc.broken)
     normal = sc.specimen.tessellation.face_normal[sc.layout.bond_face[idx]]
     seg = bond_segments(sc, idx)
+    ramp = run.break_time[idx] < 0   # the driver marks cracks of the ramp with a negative creep time
     write_csv(path, {
-        "bond": idx, "creep_time_s": run.break_time[idx],
+        "bond": idx, "creep_time_s": np.where(ramp, np.nan, run.break_time[idx]),
+        "phase": np.where(ramp, "ramp", "creep"),
         "mode": np.where(sc.break_mode[idx] == SHEAR, "shear", "tensile"),
         "kind": np.where(sc.bond_is_inter[idx], "inter", "intra"),
         "x_m": sc.layout.bond_point[idx, 0], "y_m": sc.layout.bond_point[idx, 1],
@@ -381,6 +496,10 @@ def run_creep_in_yade():
         params = load_parameters(overrides=overrides)
         require_plane(params, "creep")
         given = {k: (float(controls[k]) or None) for k in CREEP_ROW_COLUMNS}
+        if given["ratio"] and given["stress"]:
+            raise GrainfracError("batch row gives both ratio and stress; fix: keep one of the two columns per row "
+                                 "(stress in Pa, ratio of the UCS)")
+        check_stress_range(params)
         stress, ratio, ref = resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
         name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
         name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
@@ -394,6 +513,11 @@ def run_creep_in_yade():
         print(note)
     if action == "resume":
         print(f"creep row unfinished, resumed from its checkpoint: {out}")
-    s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
-                            overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume")
+    source = "batch column ucs" if given["ucs"] else UCS_FROM_CALIBRATION
+    if given["ratio"]:
+        warn_reference(ucs_reference(params, source))
+    with row_errors():   # e.g. a folder of another kind of run: one line in the row's log
+        s = run_creep_to_folder(params, int(controls["seed"]), out, stress, ratio, ref,
+                                overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume",
+                                ucs_source=source)
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {outcome(s)} -> {out}")

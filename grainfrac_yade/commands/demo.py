@@ -56,6 +56,7 @@ def cmd_demo(args, params) -> int:
     if out.exists() and any(out.iterdir()) and not args.overwrite:
         raise GrainfracError(f"{out} already holds results; fix: choose another --out or add --overwrite")
     require_plane(params, "demo")   # params: loaded (--params/--set validated) before anything runs
+    check_demo_arguments(args, params)
     extra = flat_values(args.params, args.resolved_overrides)   # --params, --set and --width/--height
     _say(t0, f"specimen {args.width * 1e3:.0f} x {args.height * 1e3:.0f} mm, seeds {args.seeds}, "
              f"ratios {args.ratios}, {args.jobs} jobs -> {out}")
@@ -67,7 +68,8 @@ def cmd_demo(args, params) -> int:
     run_batch(table, repo / "yade_scripts" / "ucs.py", args.jobs, out / "logs_ucs",
               watch=[r["out"] for r in ucs_rows], repo=repo,
               progress=lambda w: _say(t0, f"UCS {w.name}: {_ucs_line(_read(w))}"))
-    ucs = [_read(Path(r["out"]))["ucs_pa"] for r in ucs_rows if (Path(r["out"]) / "summary.json").exists()]
+    failed = _failed_rows(table, out / "logs_ucs")
+    ucs = [_read(Path(r["out"])).get("ucs_pa") for r in ucs_rows if (Path(r["out"]) / "summary.json").exists()]
     ucs = [u for u in ucs if u is not None]   # a numerical failure has no UCS
     if not ucs:
         raise GrainfracError(f"no UCS run finished; see the logs in {out / 'logs_ucs'}")
@@ -79,14 +81,40 @@ def cmd_demo(args, params) -> int:
     table = write_table(out / "creep.table", creep_rows, f"creep rows of the demo; ucs = mean of {len(ucs)} seeds")
     run_batch(table, repo / "yade_scripts" / "creep.py", args.jobs, out / "logs_creep",
               watch=[r["out"] for r in creep_rows], repo=repo, progress=lambda w: _say(t0, _creep_line(w)))
-    missing = [r["out"] for r in creep_rows if not (Path(r["out"]) / "summary.json").exists()]
-    if missing:
-        _say(t0, f"{len(missing)} creep rows did not finish (listed in the report): {missing}")
+    failed += _failed_rows(table, out / "logs_creep")
 
     from ..analysis.study import analyze_study
     report = analyze_study(out / "creep")
+    if failed:
+        _say(t0, f"report of the finished runs: {report}")
+        for row in failed:
+            _say(t0, f"FAILED {row}")
+        _say(t0, f"{len(failed)} rows failed (listed above; their logs say why)")
+        return 1
     _say(t0, f"done. Report: {report}")
     return 0
+
+
+def check_demo_arguments(args, params) -> None:
+    """Refuse, before anything runs, what would make rows fail: ratios outside (0, 1), negative seeds, no
+    seeds or ratios, fewer than one job (one line each)."""
+    from ..errors import GrainfracError
+    bad = [r for r in args.ratios if not 0 < r < 1]
+    if bad or not args.ratios:
+        raise GrainfracError(f"--ratios {','.join(f'{r:g}' for r in args.ratios) or '(none)'}: a driving-stress "
+                             "ratio must lie in (0, 1) (at 1 or above the specimen fails on loading); fix: e.g. "
+                             "--ratios 0.7,0.8,0.9")
+    if not args.seeds or any(s < 0 for s in args.seeds):
+        raise GrainfracError(f"--seeds {args.seeds}: fix: whole numbers >= 0, e.g. --seeds 1,2")
+    if args.jobs < 1:
+        raise GrainfracError(f"--jobs {args.jobs}: fix: at least 1")
+
+
+def _failed_rows(table, log_dir) -> list:
+    """The rows of ``table`` run into ``log_dir`` that did not finish a run (:func:`row_outcomes`)."""
+    from ..batchrun import read_table_rows, row_outcomes
+    _, rows, _ = read_table_rows(table)
+    return [o for o in row_outcomes(table, log_dir, list(rows)) if not o.ok]
 
 
 def _read(folder: Path) -> dict:

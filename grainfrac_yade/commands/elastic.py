@@ -60,7 +60,7 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     """
     from ..analysis.figures import contact_stress_histograms
     from ..elastic import contact_ratios, elastic_summary
-    from ..runio import code_version, prepare_run_dir, write_json
+    from ..runio import code_version, commit_run_dir, prepare_run_dir, write_json
     from ..specimen import build_specimen
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
@@ -82,4 +82,5 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     write_json(out / "summary.json", summary)
     size = f"{specimen.tessellation.box[0] * 1e3:.1f} x {specimen.tessellation.box[1] * 1e3:.1f} mm"
     contact_stress_histograms(ratios, out / "contact_stress_histogram.png", title=f"{size}, seed {seed}")
+    commit_run_dir(out)   # a replacing run (--overwrite) takes the old one's place
     return summary

@@ -8,7 +8,7 @@ import numpy as np
 from ..dem_step import critical_dem_step
 from ..layout import layout_for
 from ..plotting import specimen_figure
-from ..runio import prepare_run_dir, write_json
+from ..runio import commit_run_dir, prepare_run_dir, write_json
 from ..specimen import build_specimen
 
 
@@ -53,7 +53,7 @@ def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bo
     write_json(Path(out) / "specimen.json", record)
     specimen_figure(specimen, Path(out) / "specimen.png",
                     bonds=bond_network_segments(specimen, layout) if draw_bonds else None)
-    record["out"] = str(out)
+    record["out"] = str(commit_run_dir(out))
     return record
 
 

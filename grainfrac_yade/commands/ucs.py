@@ -1,9 +1,11 @@
 """``ucs``: uniaxial compression test (paper section 3.1); summary.json, history.csv, figures, crack map at peak."""
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-from .creep import add_confinement_option, confinement_override
+from .creep import add_confinement_option, check_stress_range, confinement_override
 from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
@@ -37,9 +39,13 @@ def cmd_ucs(args, params) -> int:
         summary = run_ucs_to_folder(params, int(state["run_values"]["seed"]), out, progress=print, resume=True)
     else:
         require_plane(params, "ucs")
+        check_stress_range(params, "--confinement" if args.confinement is not None else "confinement.stress")
         out = args.out or f"results/ucs_seed{args.seed}"
         summary = run_ucs_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print,
                                     vtk_every=args.vtk_every)
+    if summary.get("failed_before_test"):
+        print(f"UCS: failed before the test ({summary['end_reason']}) -> {out}")
+        return 1
     if summary["numerical_failure"]:
         print(f"UCS: no result ({summary['end_reason']}) -> {out}")
         return 0
@@ -73,7 +79,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
+    from ..runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
@@ -93,19 +99,23 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
         history, result, scene, (broken_peak, mode_peak) = ucs_test.run_ucs(specimen, params, progress=progress,
                                                                            snapshot=snapshot, **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
-    summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else ucs_summary(history)
+    no_result = result["numerical_failure"] or result.get("failed_before_test")
+    summary = dict.fromkeys(MEASURES) if no_result else ucs_summary(history)
     summary.update(result)
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
-    run_stress_strain_figure(history, summary, out / "stress_strain.png")
+    if len(history["dem_step"]):   # none when the specimen broke apart before the axial stage
+        run_stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
-    at = "the largest stress before the numerical failure" if result["numerical_failure"] else \
-        f"peak ({summary['ucs_pa'] / 1e6:.0f} MPa)"
+    at = ("the end of the isotropic stage" if result.get("failed_before_test") else
+          "the largest stress before the numerical failure" if result["numerical_failure"] else
+          f"peak ({summary['ucs_pa'] / 1e6:.0f} MPa)")
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}")
     write_json(out / "summary.json", summary)   # last: marks the run finished
     remove_checkpoints(out)                     # a finished run has nothing to resume
+    commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
 
 
@@ -135,6 +145,7 @@ def run_ucs_in_yade():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)
         require_plane(params, "ucs")
+        check_stress_range(params)
         out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/"
                                      f"{run_folder_name(controls, overrides)}",
                                      params, controls, {"seed": int(controls["seed"])})
@@ -145,7 +156,11 @@ def run_ucs_in_yade():
         print(note)
     if action == "resume":
         print(f"UCS row unfinished, resumed from its checkpoint: {out}")
-    s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists(),
-                          resume=action == "resume")
+    with row_errors():   # e.g. a folder of another kind of run: one line in the row's log
+        s = run_ucs_to_folder(params, int(controls["seed"]), out, overwrite=(out / "run.json").exists(),
+                              resume=action == "resume")
+    if s.get("failed_before_test"):
+        print(f"UCS: failed before the test ({s['end_reason']}) -> {out}")
+        sys.exit(1)
     print(f"UCS: no result ({s['end_reason']}) -> {out}" if s["numerical_failure"] else
           f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(s['young_pa'], 1e9)} GPa -> {out}")

@@ -21,6 +21,7 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
+from ..batchrun import read_table_rows
 from ..errors import GrainfracError
 from ..params import nearest_key, renamed_key_fix, shipped_values
 from ..runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
@@ -59,8 +60,10 @@ def read_table(extra_columns=None) -> tuple:
     spec = os.environ.get("YADE_BATCH", "")
     if spec:
         table, line = spec.rsplit(":", 1)
-        row = utils.TableParamReader(table).paramDict().get(int(line), {})
-        check_columns(row, {**defaults, **run_defaults}, spec)
+        columns, rows, problems = read_table_rows(table)
+        if problems:   # YADE's own reader would end every row in an IndexError
+            raise GrainfracError(f"batch table row {spec}: the table has bad lines ({'; '.join(problems)})")
+        check_columns(columns, {**defaults, **run_defaults}, spec)
     try:
         utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
     except NameError as exc:   # YADE evaluates every cell as Python: text without quotes (columns checked above)
@@ -109,10 +112,24 @@ def run_folder_name(controls: dict, overrides) -> str:
 ROW_FOLDER_ENV = "GRAINFRAC_ROW_FOLDER_FILE"
 
 
-def record_row_folder(out: Path) -> Path:
-    """Write ``{"folder": <absolute out>}`` to the file named by :data:`ROW_FOLDER_ENV`, if set; return ``out``.
+#: Environment variable naming a folder in which each yade-batch row records the run folder it chose, as
+#: ``<line number>.json`` (set by the ``batch`` command and the demo, :func:`grainfrac_yade.batchrun.run_batch`;
+#: the same name as ``grainfrac_yade.batchrun.ROW_FOLDERS_ENV``).
+ROW_FOLDERS_ENV = "GRAINFRAC_ROW_FOLDERS"
 
-    A SLURM task learns this way where its row runs (to mark it failed there, and to tell finished rows)."""
+
+def record_row_folder(out: Path) -> Path:
+    """Write ``{"folder": <absolute out>}`` to the file named by :data:`ROW_FOLDER_ENV`, and to
+    ``<line>.json`` in the folder named by :data:`ROW_FOLDERS_ENV`, if set; return ``out``.
+
+    A SLURM task or a batch learns this way where its row runs (to mark it failed there, and to tell finished
+    rows)."""
+    spec = os.environ.get("YADE_BATCH", "")
+    folders = os.environ.get(ROW_FOLDERS_ENV)
+    if folders and ":" in spec:
+        from ..runio import write_json
+        Path(folders).mkdir(parents=True, exist_ok=True)
+        write_json(Path(folders) / f"{spec.rsplit(':', 1)[1]}.json", {"folder": str(Path(out).resolve())})
     target = os.environ.get(ROW_FOLDER_ENV)
     if target:
         from ..runio import write_json

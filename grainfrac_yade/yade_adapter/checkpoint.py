@@ -251,7 +251,11 @@ def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):
         raise GrainfracError(f"{where}: checkpoint of another scene ({state['scene']['n_bodies']} bodies, "
                              f"{state['scene']['n_bonds']} bonds; rebuilt: {n_bodies}, {sc.n_bonds}); fix: start the "
                              "run again with --overwrite")
-    O.load(str(where / SCENE_FILE))
+    try:
+        O.load(str(where / SCENE_FILE))
+    except (RuntimeError, OSError, EOFError, ValueError) as exc:   # truncated or garbage: YADE's gzip/boost errors
+        raise GrainfracError(f"{where / SCENE_FILE}: the checkpoint's scene is unreadable ({type(exc).__name__}: "
+                             f"{exc}; truncated or not a YADE scene); fix: start the run again with --overwrite") from None
     rebind_scene(sc)
     if confinement is not None:
         confinement.apply()   # permanent forces are not saved with the scene

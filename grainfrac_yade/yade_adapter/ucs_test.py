@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from ..errors import NumericalFailure
-from .confinement import Confinement, consolidate, young_estimate
+from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
 from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
@@ -75,6 +75,7 @@ class UcsRun:
         scene, platens, ucs, cols = self.scene, self.platens, self.params.ucs, self.cols
         confining = self.confining
         numerical, peak_reached = False, False
+        broken_apart = ""   # why the specimen broke apart before the axial stage (confined tests), "" if not
         try:
             if confining > 0 and not self.resumed:
                 self.confinement = Confinement(scene, confining)
@@ -82,7 +83,10 @@ class UcsRun:
                 self.consolidation = consolidate(scene, platens, confining, self.params.creep,
                                                  young_estimate(self.params))
                 platens.set_axial_velocity(self.closing_speed)
-            while True:
+                broken_apart = end = broken_apart_reason(scene, confining)
+                if broken_apart and self.progress:
+                    self.progress(end)
+            while not broken_apart:
                 self.safe_point()
                 scene.run(self.steps_per_row)
                 stress = platens.axial_stress()
@@ -120,7 +124,8 @@ class UcsRun:
         result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0,
                   "cpu_s": time.process_time() - self.c0, "dem_timestep_s": scene.O.dt,
                   "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
-                  "peak_reached": peak_reached, "end_reason": end, "confining_stress_pa": confining,
+                  "peak_reached": peak_reached, "end_reason": end, "failed_before_test": bool(broken_apart),
+                  "confining_stress_pa": confining,
                   **self.consolidation}
         if self.resumes:
             result["resumed_from"] = self.resumes

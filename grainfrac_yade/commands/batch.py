@@ -1,0 +1,178 @@
+"""``batch TABLE``: run a yade-batch table of creep, UCS or Brazilian rows, checked before anything runs.
+
+Every row is checked first as the CLI checks its flags (unknown column, a cell that is not a number
+or quoted text, a missing cell, ratio and stress in one row, a ratio outside (0, 1), a stress or
+confinement out of range, parameters the schema refuses): one line per bad row, exit status 2,
+nothing run.  Then the log folder (``--log-dir``, default ``results/logs/<table name>/``) and each
+row's study folder are made, yade-batch runs the rows, one line per row is printed as it ends, and
+the exit status is 1 when a row did not finish a run, naming those rows.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import GrainfracError
+
+#: The scripts of each kind of row, in yade_scripts/.
+SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}
+#: Exit status of a batch in which some row did not finish (rows checked and run; not a user error).
+EXIT_ROWS_FAILED = 1
+
+
+def register(sub, common):
+    p = sub.add_parser("batch", help="run a yade-batch table (creep, UCS or Brazilian rows), every row checked first")
+    p.add_argument("table", help="yade-batch table: one row per run; columns are parameter paths (Pa for "
+                                 "stresses), seed, out, study, and for creep rows ratio or stress [Pa], ucs [Pa]")
+    p.add_argument("--test", choices=tuple(SCRIPTS),
+                   help="kind of rows (default: creep if the table has a ratio or stress column, brazilian if "
+                        "it has a brazilian.* column or its name says brazilian, else ucs)")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="rows run at a time (default: cores)")
+    p.add_argument("--log-dir", help="folder of the rows' logs (default results/logs/<table name>)")
+    p.set_defaults(func=cmd_batch)
+
+
+def guess_test(columns, name: str = "") -> str:
+    """The kind of rows a table holds, from its columns and its file ``name`` (see ``--test``)."""
+    if "ratio" in columns or "stress" in columns:
+        return "creep"
+    if any(c.startswith("brazilian.") for c in columns) or "brazilian" in name:
+        return "brazilian"
+    return "ucs"
+
+
+def row_columns(test: str) -> dict:
+    """The run-control columns of a kind of row, with defaults (parameters aside)."""
+    from ..yade_adapter.batch import RUN_COLUMNS
+    if test == "creep":
+        from .creep import CREEP_ROW_COLUMNS
+        return dict(RUN_COLUMNS, **CREEP_ROW_COLUMNS)
+    return dict(RUN_COLUMNS)
+
+
+def check_row(test: str, columns, cells: dict, where: str):
+    """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
+    (one line, naming ``where``) if the row would be refused."""
+    from ..batchrun import cell_value
+    from ..params import load_parameters, shipped_values
+    from ..yade_adapter.batch import ON_CHANGE, check_columns
+    defaults, controls = shipped_values(), row_columns(test)
+    check_columns(columns, {**defaults, **controls}, where)
+    values = {}
+    for col, text in cells.items():
+        if col.startswith("!"):
+            continue
+        try:
+            values[col] = cell_value(text)
+        except ValueError as exc:
+            raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: text cells must be quoted, e.g. "
+                                 "'deformable'") from None
+    overrides = [(k, v) for k, v in values.items() if k in defaults and v != defaults[k]]
+    controls.update({k: v for k, v in values.items() if k in controls})
+    if controls["on_change"] not in ON_CHANGE:
+        raise GrainfracError(f"batch table {where}: on_change = {controls['on_change']!r}; fix: use one of "
+                             f"{', '.join(repr(v) for v in ON_CHANGE)}")
+    if not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool) or controls["seed"] < 0:
+        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number >= 0")
+    try:
+        params = load_parameters(overrides=overrides)
+    except GrainfracError as exc:
+        raise GrainfracError(f"batch table {where}: {exc}") from None
+    try:
+        from ..specimen import check_cell_count
+        from ..tessellation import n_cells_for
+        sp = params.specimen
+        check_cell_count(n_cells_for([sp.width, sp.height], sp.grain_size), "the row's specimen", sp.grain_size)
+        _check_kind(test, params, controls)
+    except GrainfracError as exc:
+        raise GrainfracError(f"batch table {where}: {exc}") from None
+    return overrides, controls
+
+
+def _check_kind(test, params, controls):
+    from ..params import require_plane
+    from .creep import check_stress_range, resolve_stress
+    if test == "brazilian":
+        from .brazilian import require_disc_model
+        require_disc_model(params)
+        return
+    require_plane(params, test)
+    check_stress_range(params)
+    if test == "creep":
+        given = {k: (float(controls[k]) or None) for k in ("stress", "ratio", "ucs")}
+        if given["ratio"] and given["stress"]:
+            raise GrainfracError("the row gives both ratio and stress; fix: keep one of the two columns per row "
+                                 "(stress in Pa, ratio of the UCS)")
+        resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
+
+
+def check_table(table, test=None) -> tuple:
+    """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row`;
+    else GrainfracError with one line per bad row."""
+    from ..batchrun import read_table_rows
+    columns, rows, problems = read_table_rows(table)
+    test = test or guess_test(columns, Path(table).name)
+    checked = {}
+    for line, cells in rows.items():
+        try:
+            checked[line] = check_row(test, columns, cells, f"{table}:{line}")
+        except GrainfracError as exc:
+            problems.append(str(exc))
+    if problems:
+        problems.sort(key=_line_of)
+        raise GrainfracError(f"{table}: {len(problems)} bad row(s), nothing run; fix each:\n" + "\n".join(problems))
+    return test, checked
+
+
+def _line_of(problem: str) -> int:
+    import re
+    m = re.search(r":(\d+)\b", problem)
+    return int(m.group(1)) if m else 0
+
+
+def describe(summary: dict) -> str:
+    """The result phrase of a finished row."""
+    if "lifetime_s" in summary:
+        from .creep import outcome
+        return f"creep {summary['stress_pa'] / 1e6:.1f} MPa: {outcome(summary)}"
+    if "tensile_strength_pa" in summary:
+        t = summary["tensile_strength_pa"]
+        return "Brazilian: no result" if t is None else f"Brazilian tensile strength {t / 1e6:.2f} MPa"
+    u = summary.get("ucs_pa")
+    return f"UCS: no result ({summary.get('end_reason')})" if u is None else f"UCS {u / 1e6:.1f} MPa"
+
+
+def cmd_batch(args) -> int:
+    from ..batchrun import row_outcomes, run_batch
+    table = Path(args.table)
+    if args.jobs < 1:
+        raise GrainfracError(f"--jobs {args.jobs}: fix: at least 1")
+    test, rows = check_table(table, args.test)
+    repo = Path(__file__).resolve().parents[2]
+    log_dir = Path(args.log_dir or Path("results") / "logs" / table.stem).resolve()
+    try:
+        log_dir.mkdir(parents=True, exist_ok=True)
+        for _, controls in rows.values():
+            if not controls["out"]:
+                Path("results", str(controls["study"])).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise GrainfracError(f"cannot make the log and study folders ({exc.strerror}: {exc.filename}); fix: "
+                             "give a writable --log-dir, run from a writable folder") from None
+    print(f"{len(rows)} {test} rows of {table} checked; running {args.jobs} at a time, logs in {log_dir}", flush=True)
+    done = {}
+
+    def ended(line):
+        if line in rows and line not in done:
+            done[line] = row_outcomes(table, log_dir, [line], describe)[0]
+            print(done[line], flush=True)
+
+    run_batch(table.resolve(), repo / "yade_scripts" / SCRIPTS[test], args.jobs, log_dir, repo=Path.cwd(),
+              on_row_end=ended)
+    for line in rows:
+        ended(line)
+    failed = [o for o in done.values() if not o.ok]
+    if failed:
+        print(f"{len(failed)} of {len(rows)} rows failed: lines {', '.join(str(o.line) for o in failed)} of {table}")
+        return EXIT_ROWS_FAILED
+    print(f"all {len(rows)} rows finished")
+    return 0
