@@ -1,7 +1,7 @@
 """Is a finite-element UCS test quasi-static?  Table of the runs of params/fem_quasi_static_small.table
 (and any other UCS folders given), grouped by platen strain rate and mass scaling.
 
-    /usr/bin/python3 docs/fem_quasi_static.py results/fem_quasi_static [more folders] > docs/studies/fem_quasi_static_table.md
+    /usr/bin/python3 docs/fem_quasi_static.py results/fem_quasi_static [more folders] [--csv RUNS.csv]
 
 Per (strain rate, density scale): the UCS, E, CI/UCS and CD/UCS of each seed, their mean, the change of
 the mean UCS against the next faster setting of the same density scale (paired seeds only), the
@@ -63,5 +63,27 @@ def table(rows):
     return "\n".join(out)
 
 
+def write_csv(rows, path):
+    """One line per run, units in the column names."""
+    import csv
+    names = {"rate": "strain_rate_per_s", "ds": "density_scale", "seed": "seed", "ucs": "ucs_mpa",
+             "young": "young_gpa", "ci": "ci_over_ucs", "cd": "cd_over_ucs", "steps": "dem_steps", "cpu": "cpu_s",
+             "crossings": "wave_crossings_to_peak", "verlet_q": "verlet_radius_quantile", "run": "run"}
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(names.values())
+        for r in rows:
+            w.writerow([r[k] for k in names])
+
+
 if __name__ == "__main__":
-    print(table(list(runs(sys.argv[1:]))))
+    args = sys.argv[1:]
+    csv_path = None
+    if "--csv" in args:
+        i = args.index("--csv")
+        csv_path = args[i + 1]
+        del args[i:i + 2]
+    rows = list(runs(args))
+    if csv_path:
+        write_csv(rows, csv_path)
+    print(table(rows))
