@@ -12,24 +12,17 @@ import json
 import platform
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # also when tests/reference_creep.py runs as a script
+from grainfrac_yade.commands.bench import cpu_model  # noqa: E402  (the CPU's model name, as the benchmark records it)
+
 REFERENCE = Path(__file__).resolve().parent / "data" / "reference"
 #: What must be equal for an exact comparison (see module doc).
 FINGERPRINT_KEYS = ("machine", "cpu", "simd", "libc", "python", "numpy", "yade_package")
-
-
-def cpu_model() -> str:
-    """The CPU's model name as the kernel reports it (``/proc/cpuinfo``), or the platform's processor."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def numpy_simd() -> str:
