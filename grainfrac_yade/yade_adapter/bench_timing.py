@@ -34,9 +34,9 @@ class TimedCreepRun(CreepRun):
         self._loop_calls = None  # relaxations inside the event-clock loop so far (None: not in it)
         self._last_end = None
 
-    def ramp(self):
+    def ramp(self, resume=None):
         t = time.perf_counter()
-        super().ramp()
+        super().ramp(resume)
         self.ramp_wall_s = time.perf_counter() - t
 
     def run_event_clock(self, resume=None):
