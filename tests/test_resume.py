@@ -239,11 +239,13 @@ def test_a_folder_holding_a_resumable_run_is_refused_naming_resume(tmp_path):
     from grainfrac_yade.runio import prepare_run_dir
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = _unfinished(tmp_path / "killed", params)   # a creep run's folder
-    for command in ("creep", "ucs"):                 # the fix names the command of the run it holds
-        with pytest.raises(GrainfracError) as exc:
-            prepare_run_dir(out, command, params, 1)
-        assert f"unfinished creep run with a checkpoint; fix: go on with it by `creep --resume {out}`" in \
-            str(exc.value) and "--overwrite" in str(exc.value)
+    with pytest.raises(GrainfracError) as exc:
+        prepare_run_dir(out, "creep", params, 1)
+    assert f"unfinished creep run with a checkpoint; fix: `python3 -m grainfrac_yade creep --resume {out}` goes " \
+           "on with it" in str(exc.value) and "--overwrite" in str(exc.value)
+    with pytest.raises(GrainfracError) as exc:     # another command never takes the folder over
+        prepare_run_dir(out, "ucs", params, 1)
+    assert "holds a 'creep' run, not a 'ucs' run" in str(exc.value)
     plain = prepare_run_dir(tmp_path / "no_checkpoint", "ucs", params, 1)
     with pytest.raises(GrainfracError) as exc:
         prepare_run_dir(plain, "ucs", params, 1)
