@@ -72,6 +72,9 @@ def _read_run(folder: Path):
             raise GrainfracError(f"{folder / name}: missing; fix: animate a creep run folder (it writes {name})")
     hist = pd.read_csv(folder / "history.csv")
     cracks = pd.read_csv(folder / "cracks.csv")
+    if "phase" in cracks:   # the ramp's cracks have no creep time: they are there from the first frame on
+        from .analysis.crack_phases import RAMP_TIME
+        cracks["creep_time_s"] = cracks["creep_time_s"].where(cracks["phase"] != "ramp", RAMP_TIME)
     for name, frame, cols in (("history.csv", hist, ("creep_time_s", "axial_strain")),
                               ("cracks.csv", cracks, ("creep_time_s", "mode"))):
         missing = [c for c in cols if c not in frame]
