@@ -48,12 +48,10 @@ def _state(folder):
     return read_checkpoint_state(folder)
 
 
-def _start_and_kill(spec, out, ready, timeout=120, extra=(), every_safe_point=True):
-    """Start a creep run (CLI options ``extra`` added) with a checkpoint at every safe point (else only
-    the shipped ones: at the end of the ramp, then every 600 s); SIGKILL it once ``ready(state)``."""
-    interval = ["--set", EVERY_SAFE_POINT] if every_safe_point else []
-    proc = subprocess.Popen([sys.executable, "-m", "grainfrac_yade", "creep",
-                             *map(str, _creep_args(spec, out, *extra, *interval))],
+def _kill_when_ready(argv, out, ready, timeout):
+    """Start ``python3 -m grainfrac_yade *argv`` (writing into ``out``) and SIGKILL it once
+    ``ready(state)`` of its checkpoint; the state the kill left."""
+    proc = subprocess.Popen([sys.executable, "-m", "grainfrac_yade", *map(str, argv)],
                             cwd=ROOT, env=dict(os.environ, OMP_NUM_THREADS="1"),
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     t0 = time.time()
@@ -69,6 +67,13 @@ def _start_and_kill(spec, out, ready, timeout=120, extra=(), every_safe_point=Tr
     assert proc.returncode == -signal.SIGKILL, "the run ended before it could be killed"
     assert not (out / "summary.json").exists()
     return _state(out)
+
+
+def _start_and_kill(spec, out, ready, timeout=120, extra=(), every_safe_point=True):
+    """Start a creep run (CLI options ``extra`` added) with a checkpoint at every safe point (else only
+    the shipped ones: at the end of the ramp, then every 600 s); SIGKILL it once ``ready(state)``."""
+    interval = ["--set", EVERY_SAFE_POINT] if every_safe_point else []
+    return _kill_when_ready(["creep", *_creep_args(spec, out, *extra, *interval)], out, ready, timeout)
 
 
 def _reference(spec, out):
@@ -331,22 +336,7 @@ def test_a_bad_resume_of_a_loading_test_is_one_line(tmp_path, command, case):
 # ------------------------------------------------------------------ loading tests and the creep ramp
 def _start_and_kill_command(command, args, out, ready, timeout=180):
     """Start ``command`` (a checkpoint at every safe point) and SIGKILL it once ``ready(state)``."""
-    proc = subprocess.Popen([sys.executable, "-m", "grainfrac_yade", command, *map(str, args), "--set", EVERY_SAFE_POINT,
-                             "--out", str(out)], cwd=ROOT, env=dict(os.environ, OMP_NUM_THREADS="1"),
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    t0 = time.time()
-    try:
-        while proc.poll() is None and time.time() - t0 < timeout:
-            state = _state(out)
-            if state is not None and ready(state):
-                break
-            time.sleep(0.01)
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
-    assert proc.returncode == -signal.SIGKILL, "the run ended before it could be killed"
-    assert not (out / "summary.json").exists()
-    return _state(out)
+    return _kill_when_ready([command, *args, "--set", EVERY_SAFE_POINT, "--out", out], out, ready, timeout)
 
 
 #: summary.json keys that differ between a resumed run and the uninterrupted one by design.

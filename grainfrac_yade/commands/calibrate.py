@@ -26,17 +26,14 @@ TARGET_YOUNG = 69e9
 CALIBRATION_FILE = Path(__file__).resolve().parents[2] / "params" / "calibration.toml"
 
 
+#: Pa in one GPa (the unit of the modulus flags).
+PA_PER_GPA = 1e9
+
+
 def _gpa(text: str) -> float:
     """argparse type of a modulus flag: GPa, returned in Pa."""
-    import argparse
-    import math
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a modulus in GPa (e.g. 69)") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"{text!r}: a modulus must be finite and above 0 GPa (e.g. 69)")
-    return value * 1e9
+    from .creep import positive_flag
+    return positive_flag(text, "a modulus", "GPa", PA_PER_GPA, "69")
 
 
 def register(sub, common):

@@ -70,16 +70,22 @@ def confinement_override(args) -> list:
     return [("confinement.stress", value * PA_PER_MPA)]
 
 
-def stress_flag(text: str) -> float:
-    """argparse type of a stress flag: a number of MPa, returned in Pa."""
+def positive_flag(text: str, what: str, unit: str, si_per_unit: float, example: str) -> float:
+    """A finite positive number of ``unit`` from a flag, returned in SI (x ``si_per_unit``); argparse's
+    ArgumentTypeError naming ``what`` (a stress, a modulus) otherwise."""
     import argparse
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a stress in MPa (e.g. 258)") from None
+        raise argparse.ArgumentTypeError(f"{text!r} is not {what} in {unit} (e.g. {example})") from None
     if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"{text!r}: a stress must be finite and above 0 MPa (e.g. 258)")
-    return value * PA_PER_MPA
+        raise argparse.ArgumentTypeError(f"{text!r}: {what} must be finite and above 0 {unit} (e.g. {example})")
+    return value * si_per_unit
+
+
+def stress_flag(text: str) -> float:
+    """argparse type of a stress flag: a number of MPa, returned in Pa."""
+    return positive_flag(text, "a stress", "MPa", PA_PER_MPA, "258")
 
 
 def check_stress_range(params, where: str = "confinement.stress") -> None:

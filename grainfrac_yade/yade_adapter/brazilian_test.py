@@ -38,6 +38,7 @@ import numpy as np
 
 from ..disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
+from .checkpoint import LoadingCheckpoints
 from .levers import Levers, apply_levers, new_breaks
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
@@ -142,7 +143,7 @@ HISTORY_COLUMNS = ("dem_step", "dem_time_s", "diametral_strain", "horizontal_str
 HISTORY_ARRAY = "history_"
 
 
-class BrazilianRun:
+class BrazilianRun(LoadingCheckpoints):
     """State of one Brazilian test: scene, jaws, history so far, peak and snapshots so far."""
 
     def __init__(self, specimen, params, progress=None, scene=None, levers=None, checkpoint_folder=None,
@@ -163,21 +164,7 @@ class BrazilianRun:
         self.peak, self.broken_at_peak = 0.0, 0
         self.peak_snapshot = (new_breaks(scene), scene.break_mode.copy())
         self.split_snapshot = None
-        self.checkpointer = None
-        if checkpoint_folder is not None:
-            from .checkpoint import Checkpointer
-            self.checkpointer = Checkpointer(checkpoint_folder, params.numerics.checkpoint_interval,
-                                             run_values or {}, progress, capture=capture)
-        #: the checkpoints this run went on from (DEM step, phase, when written)
-        self.resumes = []
-        #: a :class:`.vtk_output.StrainSeries` told of each row and of the end (it only reads the scene); None: no VTK
-        self.snapshot = None
-
-    def safe_point(self):
-        """Before a history row's DEM steps: the state is complete; a checkpoint if one is due."""
-        ck = self.checkpointer
-        if ck is not None and self.scene.O.iter > 0 and ck.due():
-            ck.write(self, "loading", {})
+        self.init_checkpoints(checkpoint_folder, params, run_values, progress, capture)
 
     def run(self):
         """Load to the end of the test; (history columns, result dict, scene, snapshot at the failure load)."""

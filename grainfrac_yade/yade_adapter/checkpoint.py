@@ -81,6 +81,26 @@ def _fsync(path):
         os.close(fd)
 
 
+class LoadingCheckpoints:
+    """Checkpoints of a strain-controlled test (UCS, Brazilian): one is due before a history row's DEM
+    steps (its :meth:`safe_point`), when the state is complete.  The test's runner calls
+    :meth:`init_checkpoints` in its constructor; ``capture`` is the test's (state, arrays) writer."""
+
+    def init_checkpoints(self, checkpoint_folder, params, run_values, progress, capture):
+        self.checkpointer = None if checkpoint_folder is None else Checkpointer(
+            checkpoint_folder, params.numerics.checkpoint_interval, run_values or {}, progress, capture=capture)
+        #: the checkpoints this run went on from (DEM step, phase, when written)
+        self.resumes = []
+        #: a :class:`.vtk_output.StrainSeries` told of each row and of the end (it only reads the scene); None: no VTK
+        self.snapshot = None
+
+    def safe_point(self):
+        """Before a history row's DEM steps: the state is complete; a checkpoint if one is due."""
+        ck = self.checkpointer
+        if ck is not None and self.scene.O.iter > 0 and ck.due():
+            ck.write(self, "loading", {})
+
+
 class Checkpointer:
     """Writes the checkpoints of one run into ``run_folder/checkpoint/``.
 

@@ -21,6 +21,7 @@ import time
 import numpy as np
 
 from ..errors import NumericalFailure
+from .checkpoint import LoadingCheckpoints
 from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
 from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
@@ -32,7 +33,7 @@ HISTORY_COLUMNS = ("dem_step", "dem_time_s", "axial_strain", "lateral_strain", "
 HISTORY_ARRAY = "history_"
 
 
-class UcsRun:
+class UcsRun(LoadingCheckpoints):
     """State of one compression test: scene, platens, history so far, peak so far."""
 
     def __init__(self, specimen, params, progress=None, scene=None, checkpoint_folder=None, run_values=None):
@@ -52,23 +53,9 @@ class UcsRun:
         self.consolidation = {}
         #: side-wall forces of a confined test, made when the test starts (None: unconfined or not yet)
         self.confinement = None
-        self.checkpointer = None
-        if checkpoint_folder is not None:
-            from .checkpoint import Checkpointer
-            self.checkpointer = Checkpointer(checkpoint_folder, params.numerics.checkpoint_interval,
-                                             run_values or {}, progress, capture=capture)
+        self.init_checkpoints(checkpoint_folder, params, run_values, progress, capture)
         #: True once restored from a checkpoint (:func:`resume_ucs`): loading goes on from it
         self.resumed = False
-        #: the checkpoints this run went on from (DEM step, phase, when written)
-        self.resumes = []
-        #: a :class:`.vtk_output.StrainSeries` told of each row and of the end (it only reads the scene); None: no VTK
-        self.snapshot = None
-
-    def safe_point(self):
-        """Before a history row's DEM steps: the state is complete; a checkpoint if one is due."""
-        ck = self.checkpointer
-        if ck is not None and self.scene.O.iter > 0 and ck.due():
-            ck.write(self, "loading", {})
 
     def run(self):
         """Load to the end of the test; (history columns, result dict, scene, broken-at-peak snapshot)."""
