@@ -130,6 +130,10 @@ class NumericsParams:
                                    "has moved farther (YADE's default: 0.5)")
     verlet_radius_quantile: float = _spec("1", "fraction", "quantile of the sphere radii the Verlet distance refers "
                                           "to: 0 = the smallest sphere (YADE's own rule), 0.5 = the median sphere")
+    keep_intact_joints: bool = _spec("", "bool", "bonds on their face's plane (fem cells, YADE's smooth joints): "
+                                     "keep an intact bond from being erased once the path its faces slid in all "
+                                     "exceeds twice its smaller sphere's radius (YADE's rule for a broken joint); "
+                                     "false: YADE's rule for intact bonds too")
     checkpoint_interval: float = _spec("s", "nonnegative",
                                        "wall time between checkpoints of a long run (UCS, Brazilian and creep "
                                        "tests, for --resume DIR); 0 = none, but a creep run's at the end of its "
@@ -407,7 +411,7 @@ def renamed_key_fix(dotted: str) -> str | None:
 
 #: Keys added to the schema after runs were made, with the value every run before had by construction
 #: (no such knob then): params.json of older runs read them so (:func:`migrate_tree`).
-ADDED_KEYS = {"specimen.min_edge_fraction": 0.0}
+ADDED_KEYS = {"specimen.min_edge_fraction": 0.0, "numerics.keep_intact_joints": False}
 
 
 def migrate_tree(tree: dict) -> list:

@@ -175,7 +175,7 @@ def test_a_verlet_distance_of_the_median_sphere_stops_the_resorting():
     from grainfrac_yade.yade_adapter.platens import Platens
     from grainfrac_yade.yade_adapter.scene import build_scene
     sorts = {}
-    for name, extra in (("yade_rule", []), ("median", MEDIAN_VERLET)):
+    for name, extra in (("yade_rule", ["numerics.verlet_radius_quantile=0"]), ("median", MEDIAN_VERLET)):
         q = load_parameters(extra_files=[FEM_PRESET], overrides=["specimen.width=10e-3", "specimen.height=20e-3",
                                                                   *extra])
         scene = build_scene(build_specimen(q, 3), q)
@@ -200,7 +200,7 @@ def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
     s = build_specimen(p, 1)
     scene = build_scene(s, p)
     assert scene.engine_names() == ["ForceResetter", "InsertionSortCollider", "InteractionLoop",
-                                    "FEInternalForceEngine", "NewtonIntegrator"]
+                                    "FEInternalForceEngine", "NewtonIntegrator", "IntactJointGuard"]
     O = scene.O
     # each cell's bodies: its spheres, the apex sphere replaced by the clump that moves it
     clumps = [b for c in range(s.n_cells) for b in scene.bodies_of([c]) if O.bodies[int(b)].isClump]

@@ -214,6 +214,7 @@ class BrazilianRun(LoadingCheckpoints):
             self.snapshot.write(scene, len(cols["dem_step"]), cols["diametral_strain"][-1])
         result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0, "dem_timestep_s": scene.O.dt,
                   "n_bonds": scene.n_bonds, **crack_counts(scene), "numerical_failure": numerical,
+                  "bonds_erased_by_sliding": scene.sliding_erasures(),
                   "peak_reached": peak_reached, "end_reason": end,
                   "jaw_cells": [len(jaws.top), len(jaws.bottom)], "loaded_arc_deg": jaws.loaded_arc_deg,
                   **self.applied}

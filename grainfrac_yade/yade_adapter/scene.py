@@ -43,6 +43,7 @@ from ..layout import BondProperties, ClumpLayout, bond_properties, cell_mass_ine
 from ..params import Parameters
 from ..specimen import Specimen
 from . import load_yade
+from .joints import IntactJointGuard
 
 #: Bond break modes, the codes of YADE's JCFpm crack file.
 INTACT, TENSION, SHEAR = 0, 1, 2
@@ -105,6 +106,9 @@ class GrainScene:
     #: conservative critical DEM step of the scene [s] (:func:`critical_timestep`); :meth:`run` refuses
     #: to step with a larger ``O.dt`` (an unstable step blows up or, before it does, gives nonsense)
     dt_critical: float = math.inf
+    #: bonds YADE's smooth-joint law erased by their cumulative sliding path, not by a strength
+    #: criterion (:mod:`.joints`), as far as synced; :meth:`sliding_erasures` adds those not synced yet
+    erased_by_sliding: int = 0
     _cracks_seen: int = 0
 
     def __post_init__(self):
@@ -174,6 +178,8 @@ class GrainScene:
         candidates = np.flatnonzero(~self.broken)
         new = [k for k in candidates if not self.interactions[k].phys.isCohesive]
         new = np.asarray(new, dtype=np.int64)
+        # the law counts its strength breaks; bonds beyond them lost cohesion by their sliding path
+        self.erased_by_sliding += max(0, len(new) - (n_tens + n_shear - self._cracks_seen))
         prev_tens = getattr(self, "_tens_seen", 0)
         tens_new = n_tens - prev_tens
         for k in new:
@@ -191,6 +197,14 @@ class GrainScene:
         self._cracks_seen = n_tens + n_shear
         self._tens_seen = n_tens
         return new
+
+    def sliding_erasures(self) -> int:
+        """Bonds erased by their sliding path so far (:mod:`.joints`): those synced as breaks, and the
+        intact ones without cohesion that no strength break has synced yet; 0 without smooth joints."""
+        if self.layout.bond_normal is None:
+            return 0
+        pending = sum(1 for k in np.flatnonzero(~self.broken) if not self.interactions[k].phys.isCohesive)
+        return self.erased_by_sliding + pending
 
     def break_bonds(self, indices, mode: int):
         """Break bonds ourselves (no JCFpm crack record): no cohesion or tension, residual friction.
@@ -586,6 +600,9 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
         raise GrainfracError(f"the scene's critical DEM step is {dt_crit:g} s (a cell without mass, or no bond "
                              "at all); fix: check the specimen's cells and faces")
     O.dt = params.numerics.timestep_safety * dt_crit
-    return GrainScene(specimen=specimen, layout=layout, props=props, params=params, O=O,
-                      cell_body=cell_body, cell_bodies=cell_bodies, sphere_body=sphere_body,
-                      interactions=interactions, law=law, newton=newton, links=links, dt_critical=dt_crit)
+    scene = GrainScene(specimen=specimen, layout=layout, props=props, params=params, O=O,
+                       cell_body=cell_body, cell_bodies=cell_bodies, sphere_body=sphere_body,
+                       interactions=interactions, law=law, newton=newton, links=links, dt_critical=dt_crit)
+    if layout.bond_normal is not None and params.numerics.keep_intact_joints:
+        scene.drivers.append(IntactJointGuard(scene))
+    return scene

@@ -111,6 +111,7 @@ class UcsRun(LoadingCheckpoints):
         result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0,
                   "cpu_s": time.process_time() - self.c0, "dem_timestep_s": scene.O.dt,
                   "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
+                  "bonds_erased_by_sliding": scene.sliding_erasures(),
                   "peak_reached": peak_reached, "end_reason": end, "failed_before_test": bool(broken_apart),
                   "confining_stress_pa": confining,
                   **self.consolidation}
