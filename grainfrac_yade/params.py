@@ -568,6 +568,9 @@ class FlagOverride(tuple):
         self.flag = flag
         return self
 
+    def __getnewargs__(self):   # copy and pickle rebuild it from these (a tuple's own would drop the flag)
+        return (self[0], self[1], self.flag)
+
 
 def override_origin(item) -> str:
     """How the user gave override ``item``: its shortcut flag, else ``--set``."""
