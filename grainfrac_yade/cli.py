@@ -161,6 +161,8 @@ def _log_traceback(command: str) -> str:
 
 
 def main(argv=None) -> int:
+    from .yade_adapter import use_default_threads
+    use_default_threads()   # before any command module loads the OpenMP runtime
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = DEBUG_FLAG in argv
     argv = join_negative_values([a for a in argv if a != DEBUG_FLAG])

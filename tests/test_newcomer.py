@@ -112,6 +112,21 @@ def test_a_creep_specimen_broken_apart_in_the_isotropic_stage_fails_before_the_t
     assert list(classify_runs(collect_runs(tmp_path))["outcome"]) == ["failed before test"]
 
 
+@needs_yade
+@pytest.mark.yade
+def test_a_cli_run_uses_one_yade_thread_unless_told_otherwise(tmp_path):
+    """A command draws its figures with matplotlib, which loads the OpenMP runtime; the runtime reads
+    OMP_NUM_THREADS once, so the one-thread default must be set before: else YADE imported after it ran 2
+    threads (the README's UCS gave 280.4 and 282.0 MPa in two runs, at 16 x the CPU time)."""
+    code = ("import sys; from grainfrac_yade.cli import main\n"
+            f"main(['specimen', '--width', '3e-3', '--height', '6e-3', '--out', {str(tmp_path / 's')!r}])\n"
+            "from grainfrac_yade.yade_adapter import load_yade; load_yade(); from yade import O; print(O.numThreads)")
+    env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.strip().splitlines()[-1] == "1", res.stdout
+
+
 # ------------------------------------------------------------------ shortcut flags named in their refusals
 @pytest.mark.parametrize("argv, flag, words", [
     (["ucs", "--width", "-10e-3"], "--width", "specimen.width: must be > 0"),
