@@ -65,7 +65,9 @@ def _common(parser: argparse.ArgumentParser, geometry: bool = True):
 
 
 def overrides_from_args(args) -> list:
-    """``--set`` strings plus the geometry shortcuts (--width etc.) and the command's own (``param_overrides``)."""
+    """``--set`` strings plus the geometry shortcuts (--width etc.) and the command's own (``param_overrides``);
+    a shortcut's override is a :class:`~grainfrac_yade.params.FlagOverride` (its errors name the flag)."""
+    from .params import FlagOverride
     out = list(args.overrides)
     extra = getattr(args, "param_overrides", None)
     if extra is not None:
@@ -74,21 +76,23 @@ def overrides_from_args(args) -> list:
                      ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell")):
         value = getattr(args, opt, None)
         if value is not None:
-            out.append((key, value))
+            out.append(FlagOverride(key, value, "--" + opt.replace("_", "-")))
     return out
 
 
 def load_params_from_args(args):
     """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
-    from .params import load_parameters
+    from .params import load_parameters, override_origin
     from .specimen import check_cell_count
     from .tessellation import n_cells_for
     args.resolved_overrides = overrides_from_args(args)
     params = load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
     sp = params.specimen   # refused before any folder is made or anything allocated
     box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
+    flags = ", ".join(override_origin(o) for o in args.resolved_overrides
+                      if override_origin(o) != "--set" and o[0].startswith("specimen."))
     check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
-                     sp.grain_size)
+                     sp.grain_size, flags)
     return params
 
 
@@ -157,6 +161,8 @@ def _log_traceback(command: str) -> str:
 
 
 def main(argv=None) -> int:
+    from .yade_adapter import use_default_threads
+    use_default_threads()   # before any command module loads the OpenMP runtime
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = DEBUG_FLAG in argv
     argv = join_negative_values([a for a in argv if a != DEBUG_FLAG])

@@ -563,6 +563,24 @@ def write_parameter_file(path, values: Mapping[str, Any], header=(), notes: Mapp
     return _write_atomically(path, lambda tmp: Path(tmp).write_text(text))
 
 
+class FlagOverride(tuple):
+    """A ``(key, value)`` override given by a shortcut flag (``--width``, ``--confinement``, ...): unpacks as the
+    pair; ``flag`` is what the user typed, named by a refusal in place of ``--set``."""
+
+    def __new__(cls, key: str, value, flag: str = "--set"):
+        self = super().__new__(cls, (key, value))
+        self.flag = flag
+        return self
+
+    def __getnewargs__(self):   # copy and pickle rebuild it from these (a tuple's own would drop the flag)
+        return (self[0], self[1], self.flag)
+
+
+def override_origin(item) -> str:
+    """How the user gave override ``item``: its shortcut flag, else ``--set``."""
+    return getattr(item, "flag", "--set")
+
+
 def parse_override(text: str) -> tuple:
     """Split ``section.key=value``; the value is read as TOML, else as a plain string."""
     if "=" not in text or "." not in text.split("=", 1)[0]:
@@ -624,8 +642,9 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
     ----------
     files : list of paths, optional
         Files merged in order (later wins). Default: :func:`default_files`.
-    overrides : iterable of str
-        ``section.key=value`` strings applied last (as ``--set`` on the CLI).
+    overrides : iterable of str or (key, value)
+        ``section.key=value`` strings or pairs applied last (as ``--set`` on the CLI); a
+        :class:`FlagOverride` pair is named by its flag in errors.
     extra_files : list of paths
         Files merged after ``files`` (the CLI's ``--params``).
     """
@@ -635,15 +654,16 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
         _merge(merged, read_toml(path), origins, str(path))
     for text in overrides:
         key, value = parse_override(text) if isinstance(text, str) else text
+        origin = override_origin(text)
         flat_known = flatten(merged)
         if renamed_key_fix(key):
-            raise ParameterError("--set", key, "renamed key", renamed_key_fix(key))
+            raise ParameterError(origin, key, "renamed key", renamed_key_fix(key))
         if key not in flat_known and not _is_new_pair_key(key):
             close = nearest_key(key, flat_known)
-            raise ParameterError("--set", key, "no such parameter",
+            raise ParameterError(origin, key, "no such parameter",
                                  f"did you mean {close}?" if close else "use a dotted key that exists in the "
                                  "parameter files, e.g. stress_corrosion.beta1")
-        _merge(merged, _nest(key, value), origins, "--set")
+        _merge(merged, _nest(key, value), origins, origin)
     return build_parameters(merged, origins, tuple(str(p) for p in files))
 
 

@@ -99,13 +99,14 @@ def memory_bytes() -> float:
         return float("inf")
 
 
-def check_cell_count(n_cells: int, what: str, grain_size: float) -> None:
+def check_cell_count(n_cells: int, what: str, grain_size: float, flags: str = "") -> None:
     """Refuse, before anything is allocated, a specimen of more cells than this machine's memory holds
-    (:data:`BYTES_PER_CELL` each): one line with the cell count."""
+    (:data:`BYTES_PER_CELL` each): one line with the cell count (``flags``: the shortcut flags that gave the
+    size, named first)."""
     from .errors import GrainfracError
     limit = memory_bytes() / BYTES_PER_CELL
     if n_cells > limit:
-        raise GrainfracError(f"specimen.grain_size = {grain_size:g} m: {what} would have {n_cells:.3g} cells, more than "
+        raise GrainfracError(f"{flags + ': ' if flags else ''}specimen.grain_size = {grain_size:g} m: {what} would have {n_cells:.3g} cells, more than "
                              f"this machine's memory holds (at most {limit:.3g} cells of {BYTES_PER_CELL / 1e3:g} kB); "
                              "fix: a larger grain size or a smaller specimen (e.g. --grain-size 1e-3)")
 

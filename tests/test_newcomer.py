@@ -88,6 +88,81 @@ def test_a_specimen_broken_apart_in_the_isotropic_stage_is_a_failure_not_a_ucs_o
     assert "broke apart in the isotropic stage" in s["end_reason"]
 
 
+@needs_yade
+@pytest.mark.yade
+def test_a_creep_specimen_broken_apart_in_the_isotropic_stage_fails_before_the_test(tmp_path):
+    """A 3 x 6 mm confined creep run (a few seconds) whose reference strength is set far up, so that the CLI
+    accepts a confinement of 2e7 MPa: every bond breaks in the isotropic stage; the run ends there, one line
+    and exit status 1, and its summary is no creep result (no lifetime, not a survival)."""
+    out = tmp_path / "creep"
+    res = _cli("creep", "--width", "3e-3", "--height", "6e-3", "--set", "calibration.reference_ucs=1e13",
+               "--confinement", "2e7", "--ratio", "0.5", "--ucs", "3e7", "--out", out)
+    assert res.returncode == 1, res.stderr
+    last = res.stdout.strip().splitlines()[-1]
+    assert "failed before the test (the specimen broke apart in the isotropic stage" in last and str(out) in last
+    assert "Traceback" not in res.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["failed_before_test"] is True and s["failed"] is None and s["lifetime_s"] is None
+    assert not s["numerical_failure"] and not s["failed_on_loading"] and s["n_events"] == 0
+    assert "broke apart in the isotropic stage" in s["failure_reason"] and s["end_reason"] == s["failure_reason"]
+    assert s["broken_ramp"] >= s["n_bonds"] / 2 and s["broken_creep"] == 0
+    assert not (out / "history.csv").exists() and not (out / "checkpoint").exists()
+    from grainfrac_yade.analysis.collect import collect_runs
+    from grainfrac_yade.analysis.lifetimes import classify_runs
+    assert list(classify_runs(collect_runs(tmp_path))["outcome"]) == ["failed before test"]
+
+
+@needs_yade
+@pytest.mark.yade
+def test_a_cli_run_uses_one_yade_thread_unless_told_otherwise(tmp_path):
+    """A command draws its figures with matplotlib, which loads the OpenMP runtime; the runtime reads
+    OMP_NUM_THREADS once, so the one-thread default must be set before: else YADE imported after it ran 2
+    threads (the README's UCS gave 280.4 and 282.0 MPa in two runs, at 16 x the CPU time)."""
+    code = ("import sys; from grainfrac_yade.cli import main\n"
+            f"main(['specimen', '--width', '3e-3', '--height', '6e-3', '--out', {str(tmp_path / 's')!r}])\n"
+            "from grainfrac_yade.yade_adapter import load_yade; load_yade(); from yade import O; print(O.numThreads)")
+    env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.strip().splitlines()[-1] == "1", res.stdout
+
+
+# ------------------------------------------------------------------ shortcut flags named in their refusals
+@pytest.mark.parametrize("argv, flag, words", [
+    (["ucs", "--width", "-10e-3"], "--width", "specimen.width: must be > 0"),
+    (["creep", "--ratio", "0.5", "--height", "0"], "--height", "specimen.height: must be > 0"),
+    (["ucs", "--grain-size", "1"], "--grain-size", "at or above the specimen's width"),
+    (["ucs", "--grain-size", "1e-9"], "--grain-size", "cells, more than this machine's memory holds"),
+    (["ucs", "--spheres-per-cell", "0"], "--spheres-per-cell", "must be >= 1"),
+    (["creep", "--ratio", "1.5"], "--ratio", "must lie in (0, 1); fix: e.g. --ratio 0.7"),
+    (["creep", "--ratio", "0.5", "--ucs", "300", "--confinement", "2000"], "--confinement", "reference strength"),
+    (["brazilian", "--diameter", "-1"], "--diameter", "brazilian.diameter: must be > 0"),
+    (["elastic", "--nodes-per-face", "0"], "--nodes-per-face", "must be >= 1"),
+    (["demo", "--width", "0"], "--width", "specimen.width: must be > 0"),
+])
+def test_a_shortcut_flags_refusal_names_the_flag_not_set(capsys, argv, flag, words):
+    assert main(argv + ["--out", "/nonexistent/never"]) == 2
+    line = _one_line(capsys, words, "fix:")
+    assert line.startswith(f"error: {flag}") and "--set" not in line, line
+
+
+def test_a_set_override_is_still_named_set(capsys):
+    assert main(["ucs", "--set", "specimen.width=0", "--out", "/nonexistent/never"]) == 2
+    assert _one_line(capsys, "specimen.width: must be > 0").startswith("error: --set: ")
+
+
+def test_a_flag_override_unpacks_as_a_pair_and_survives_a_copy():
+    import copy
+    import pickle
+    from grainfrac_yade.params import FlagOverride, flat_values, override_origin
+    o = FlagOverride("specimen.width", 3e-3, "--width")
+    key, value = o
+    assert (key, value) == ("specimen.width", 3e-3) and flat_values([], [o]) == {"specimen.width": 3e-3}
+    for same in (copy.deepcopy(o), pickle.loads(pickle.dumps(o))):
+        assert tuple(same) == tuple(o) and override_origin(same) == "--width"
+    assert override_origin(("specimen.width", 1.0)) == override_origin("specimen.width=1") == "--set"
+
+
 # ------------------------------------------------------------------ batch: rows checked before anything runs
 BAD_CREEP_TABLE = """# one bad row per reason, and one good row (line 8)
 ratio stress ucs specimen.width seed study
@@ -208,7 +283,7 @@ def test_a_failed_overwrite_leaves_the_old_run_as_it_was(tmp_path, capsys):
 # ------------------------------------------------------------------ one line, no traceback
 @pytest.mark.parametrize("argv, words", [
     (["specimen", "--seed", "-1"], ("--seed", ">= 0")),
-    (["specimen", "--width", "-10e-3"], ("specimen.width", "must be > 0")),
+    (["specimen", "--width", "-10e-3"], ("--width: specimen.width", "must be > 0")),
     (["specimen", "--width", "3e-3", "--height", "6e-3", "--out", "/proc/x"], ("/proc/x", "cannot write")),
     (["creep", "--stress", "abc"], ("--stress", "invalid float value")),
 ])

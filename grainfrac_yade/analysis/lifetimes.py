@@ -8,6 +8,8 @@ Outcome of each run folder (column ``outcome``):
   lifetime, drawn but not fitted;
 - ``numerical failure``: the run stopped on NaN/inf numbers or a stalled clock (summary key
   ``numerical_failure``): no result, listed with its reason, never a lifetime or a lower bound;
+- ``failed before test``: a confined specimen broke apart in the isotropic stage (summary key
+  ``failed_before_test``): no creep test, listed with its reason, never a lifetime or a lower bound;
 - ``unfinished``: no summary.json yet (running, killed or crashed, or a SLURM row not started yet);
 - ``run error``: no summary.json, and the batch task that ran it recorded an error (failed.json);
 - ``unreadable``: a JSON file that cannot be parsed, or a summary that contradicts itself;
@@ -48,6 +50,8 @@ def outcome(row) -> str:
         return "unfinished"
     if row.get("numerical_failure") in (True, 1):
         return "numerical failure"
+    if row.get("failed_before_test") in (True, 1):
+        return "failed before test"
     failed = row.get("failed")
     if failed is True or failed == 1:
         if row.get("failed_on_loading") is True:

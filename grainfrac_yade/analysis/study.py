@@ -29,7 +29,8 @@ from .runparams import default_tree, rebuild_specimen
 #: was checkpointed changes nothing it computes).
 VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
 #: Outcomes of creep runs that belong to a model variant.
-CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "unfinished", "run error")
+CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "failed before test", "unfinished",
+                  "run error")
 #: Columns of runs.csv (those present).
 RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
              "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
@@ -130,8 +131,8 @@ def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
         known = runs.at[i, "problem"]   # a failed task's error, a SLURM row not started yet
         runs.at[i, "problem"] = (known if isinstance(known, str) and known else
                                  "no summary.json (running, stopped or crashed)") + reach
-    for i in runs.index[runs["outcome"] == "numerical failure"]:
-        runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else "numerical failure"
+    for i in runs.index[runs["outcome"].isin(("numerical failure", "failed before test"))]:
+        runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else runs.at[i, "outcome"]
     runs.attrs["filled"] = filled
     return runs
 
@@ -415,6 +416,8 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         note += f"; {n_load} failed at load (t = 0, not in the log fit)" if n_load else ""
         n_num = int((g["outcome"] == "numerical failure").sum())
         note += f"; {n_num} numerical failure(s) (no result: not fitted, not a lower bound)" if n_num else ""
+        n_apart = int((g["outcome"] == "failed before test").sum())
+        note += f"; {n_apart} broke apart before the test (no result: not fitted)" if n_apart else ""
         n_err = int((g["outcome"] == "run error").sum())
         note += f"; {n_err} run error(s) (the task failed, error in problem: not used)" if n_err else ""
         note += f"; {int((g['outcome'] == 'unfinished').sum())} unfinished (not used)."

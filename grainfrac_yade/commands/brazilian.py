@@ -58,7 +58,8 @@ def cmd_brazilian(args) -> int:
         return 0
     params = load_params_from_args(args)
     if args.diameter is not None or args.tensile_scale is not None:
-        extra = [] if args.diameter is None else [("brazilian.diameter", args.diameter)]
+        from ..params import FlagOverride
+        extra = [] if args.diameter is None else [FlagOverride("brazilian.diameter", args.diameter, "--diameter")]
         if args.tensile_scale is not None:
             extra += tensile_scale_overrides(params, args.tensile_scale)
         params = _reload(args, extra, params, args.tensile_scale)

@@ -81,12 +81,15 @@ def finished_runs(study: Path) -> list:
 
 def model_point(ratio, summaries) -> "ModelPoint | None":
     """The model at one ratio from its seeds' summaries: geometric mean of the lifetimes; a lower bound if a
-    seed did not fail; None if no seed gives a value (failed on loading, numerical failure)."""
+    seed did not fail; None if no seed gives a value (failed on loading, numerical failure, broken apart before the
+    test)."""
     from ..analysis.lifetime_calibration import ModelPoint
     logs, censored, notes = [], False, []
     for s in summaries:
         if s.get("numerical_failure"):
             notes.append("numerical failure")
+        elif s.get("failed_before_test"):
+            notes.append("broke apart before the test")
         elif s.get("failed_on_loading"):
             notes.append("failed on loading")
         elif s.get("failed"):

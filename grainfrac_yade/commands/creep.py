@@ -40,7 +40,9 @@ def register(sub, common):
 
 
 def _clock_override(args) -> list:
-    return ([f"stress_corrosion.clock={args.clock}"] if args.clock else []) + confinement_override(args)
+    from ..params import FlagOverride
+    return ([FlagOverride("stress_corrosion.clock", args.clock, "--clock")] if args.clock else []) + \
+        confinement_override(args)
 
 
 #: Pa per MPa: every stress flag of the CLI is in MPa, every file and batch column in Pa.
@@ -67,7 +69,8 @@ def confinement_override(args) -> list:
     if not (math.isfinite(value) and value > 0):
         raise GrainfracError(f"--confinement {value:g} MPa (confinement.stress): a confining stress must be above 0 "
                              "MPa; fix: e.g. --confinement 20, or omit it for a uniaxial test")
-    return [("confinement.stress", value * PA_PER_MPA)]
+    from ..params import FlagOverride
+    return [FlagOverride("confinement.stress", value * PA_PER_MPA, "--confinement")]
 
 
 def positive_flag(text: str, what: str, unit: str, si_per_unit: float, example: str) -> float:
@@ -103,6 +106,8 @@ def outcome(summary: dict) -> str:
     """One phrase: numerical failure, lifetime, failure on loading, or not failed by the end."""
     if summary.get("numerical_failure"):
         return f"no result ({summary['failure_reason']})"
+    if summary.get("failed_before_test"):
+        return f"failed before the test ({summary['failure_reason']})"
     if summary.get("failed_on_loading"):
         return "failed on loading (during the ramp)"
     if summary["failed"]:
@@ -184,7 +189,9 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
                              "fix: give the peak axial stress at this confinement")
     if stress is None:
         if not (0 < ratio < 1):
-            raise GrainfracError(f"ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. ratio 0.7")
+            given = f"--ratio {ratio:g}" if cli else f"column ratio = {ratio:g}"
+            raise GrainfracError(f"{given}: a driving-stress ratio must lie in (0, 1); fix: e.g. "
+                                 f"{'--ratio' if cli else 'ratio'} 0.7")
         stress = confining + ratio * (ref - confining)
     if not stress > confining:
         raise GrainfracError(f"{named('stress', stress)}: must be above the confining stress "
@@ -275,6 +282,9 @@ def cmd_creep(args, params) -> int:
                             vtk_fractions=None if args.vtk_fractions is False else
                             (args.vtk_fractions or list(MAP_FRACTIONS)), ucs_source=source)
     confined = f", confinement {params.confinement.stress / 1e6:g} MPa" if params.confinement.stress else ""
+    if s["failed_before_test"]:
+        print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}): {outcome(s)} -> {out}")
+        return 1
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
           f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
     return 0
@@ -335,7 +345,9 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     the end; ``vtk_fractions`` (of the lifetime) after it, from the bonds' break times.
 
     A numerical failure (NaN/inf, a stalled clock) gives ``numerical_failure: true``, ``failed:
-    null`` (unknown) and ``lifetime_s: null``, with the reason in ``failure_reason``.
+    null`` (unknown) and ``lifetime_s: null``, with the reason in ``failure_reason``; so does a confined
+    specimen that broke apart in the isotropic stage, with ``failed_before_test: true`` (no history.csv,
+    no strain-time figure; its cracks are the ramp's).
     """
     import time
 
@@ -372,6 +384,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
             outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times or (), vtk_every=vtk_every or 0)
         run = run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
     numerical = bool(run.numerical_failure)
+    no_test = numerical or run.failed_before_test   # no creep result: neither a lifetime nor a survival
     if ucs_source is None:   # a resumed run, or a caller that did not say: the calibrated value or one given
         ucs_source = UCS_FROM_CALIBRATION if ref_ucs == params.calibration.reference_ucs else "given"
     rows = run.rows or [_row_before_history(run, broken_counts(run.scene))]
@@ -389,9 +402,10 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         write_csv(out / "history.csv", hist)
     write_crack_list(out / "cracks.csv", run)
     summary = {
-        "lifetime_s": lifetime, "failed": None if numerical else run.failed, "failure_reason": run.failure_reason,
+        "lifetime_s": lifetime, "failed": None if no_test else run.failed, "failure_reason": run.failure_reason,
         "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
+        "failed_before_test": run.failed_before_test,
         "creep_time_end_s": t_end, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs,
         **ucs_reference(params, ucs_source),
         "confining_stress_pa": params.confinement.stress, **getattr(run, "consolidation", {}),
@@ -414,7 +428,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         t = run.initial_bond_stresses["shear_stress_pa"]
         summary.update(shear_stress_p99_pa=float(np.percentile(t, 99)), shear_stress_max_pa=float(t.max()),
                        shear_utilisation_max=float(np.max(run.initial_bond_stresses["shear_utilisation"])))
-    run_strain_time_figure(hist, summary, out / "strain_time.png")
+    if not run.failed_before_test:   # a specimen broken apart before the ramp has no strain-time curve
+        run_strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
     if vtk_fractions:
         from ..yade_adapter.vtk_output import write_life_series
@@ -436,7 +451,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
 def end_reason(run, params, t_end) -> str:
     """Why the run ended: its failure or numerical failure, else why it stopped without failing."""
     sc = params.stress_corrosion
-    if run.failed or run.numerical_failure:
+    if run.failed or run.numerical_failure or run.failed_before_test:
         return run.failure_reason
     if not sc.enabled:
         return "load held without stress corrosion (stress_corrosion.enabled = false): not failed"
@@ -528,3 +543,6 @@ def run_creep_in_yade():
                                 overwrite=(out / "run.json").exists(), progress=print, resume=action == "resume",
                                 ucs_source=source)
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}): {outcome(s)} -> {out}")
+    if s["failed_before_test"]:
+        import sys
+        sys.exit(1)

@@ -29,7 +29,9 @@ def register(sub, common):
 
 
 def _model_overrides(args) -> list:
-    out = [f"resolution.nodes_per_face={args.nodes_per_face}"] if args.nodes_per_face is not None else []
+    from ..params import FlagOverride
+    out = ([FlagOverride("resolution.nodes_per_face", args.nodes_per_face, "--nodes-per-face")]
+           if args.nodes_per_face is not None else [])
     if args.grains in CLUSTER_MODELS:
         out.append(f"resolution.grain_model={CLUSTER_MODELS[args.grains]}")
     return out

@@ -23,12 +23,19 @@ DEFAULT_THREADS = "1"
 _yade = None
 
 
+def use_default_threads():
+    """OMP_NUM_THREADS = :data:`DEFAULT_THREADS` unless the user set it.  Must come before anything loads the
+    OpenMP runtime, which reads it once: Debian's matplotlib loads it (libgomp), and a YADE imported after a
+    figure module then ran 2 threads (not reproducible, and 16 x the CPU time on a loaded machine)."""
+    os.environ.setdefault("OMP_NUM_THREADS", DEFAULT_THREADS)
+
+
 def load_yade():
     """Import YADE once and return the ``yade`` module; clear error if impossible."""
     global _yade
     if _yade is not None:
         return _yade
-    os.environ.setdefault("OMP_NUM_THREADS", DEFAULT_THREADS)
+    use_default_threads()
     if YADE_PY_PATH not in sys.path:
         sys.path.insert(0, YADE_PY_PATH)
     try:

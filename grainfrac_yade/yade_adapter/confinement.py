@@ -96,11 +96,11 @@ def consolidate(scene, platens, stress: float, creep_params, young: float) -> di
     return {"consolidation_steps": done, "consolidated": balanced, "consolidation_axial_stress_pa": servo.stress}
 
 
-def broken_apart_reason(scene, stress: float) -> str:
+def broken_apart_reason(scene, stress: float, lost: str = "no strength measured") -> str:
     """"" if the specimen is intact after the isotropic stage at ``stress`` [Pa], else why it is not
-    (:data:`BROKEN_APART_FRACTION` of its bonds or more broken)."""
+    (:data:`BROKEN_APART_FRACTION` of its bonds or more broken; ``lost``: what the test cannot give then)."""
     broken, total = int(np.count_nonzero(scene.broken)), scene.n_bonds
     if total and broken >= BROKEN_APART_FRACTION * total:
         return (f"the specimen broke apart in the isotropic stage at sigma_3 = {stress / 1e6:.4g} MPa ({broken} of "
-                f"{total} bonds broken before axial loading): no strength measured; fix: a smaller confinement")
+                f"{total} bonds broken before axial loading): {lost}; fix: a smaller confinement")
     return ""

@@ -1,7 +1,9 @@
 """Constant-load creep test to failure with stress corrosion (paper section 4.1).
 
 0. Confined tests (``confinement.stress`` sigma_3 > 0): side-wall forces, then the isotropic
-   stage to sigma_1 = sigma_3 at equilibrium (:mod:`.confinement`).
+   stage to sigma_1 = sigma_3 at equilibrium (:mod:`.confinement`).  A specimen that breaks apart in
+   it (:func:`.confinement.broken_apart_reason`) ends the run there with ``failed_before_test`` set
+   and the reason in ``failure_reason``: no ramp, no creep, neither a lifetime nor a survival.
 1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
    stress reaches the target; bonds broken during the ramp are counted apart.
 2. Hold: a servo keeps the axial stress at the target (:class:`StressServo`).
@@ -41,7 +43,7 @@ from ..clocks import EventClock, PaperClock
 from ..errors import NumericalFailure
 from ..law import creep_step, shear_strength
 from ..params import unbalanced_threshold
-from .confinement import Confinement, consolidate, young_estimate
+from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
 from .corrosion_engine import ContactStiffnessRestorer, StressCorrosion
 from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
 from .scene import broken_counts, build_scene, check_value, resultant_forces
@@ -161,6 +163,8 @@ class CreepRun:
         self.failed, self.failure_reason = False, ""
         self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
         self.numerical_failure = False   # NaN/inf or a stalled clock: no result (failure_reason says why)
+        #: broke apart in the isotropic stage of a confined test: no creep test (failure_reason says why)
+        self.failed_before_test = False
         self.corr = None
         self.n_events = 0
         self.initial_bond_stresses = None
@@ -248,6 +252,10 @@ class CreepRun:
                 self.failed, self.failure_reason = True, "failed during the ramp: load above the specimen's strength"
                 self.failed_on_loading = True
                 break
+        self.count_loading_cracks()
+
+    def count_loading_cracks(self):
+        """The bonds broken so far (isotropic stage and ramp) are the ramp's: counted apart, before creep time 0."""
         self.mark_breaks(0.0)
         self.ramp_broken = int(self.scene.broken.sum())
         self.break_time[self.scene.broken] = -1.0  # ramp cracks: before creep time 0
@@ -366,6 +374,12 @@ class CreepRun:
             if phase is None and self.confinement is not None:
                 self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params.creep,
                                                  young_estimate(self.params))
+                self.failure_reason = broken_apart_reason(self.scene, self.confinement.stress, "no creep test")
+                if self.failure_reason:   # no specimen left to load: neither a lifetime nor a survival
+                    self.failed_before_test = True
+                    self.count_loading_cracks()
+                    self.progress(self.failure_reason)
+                    return self
             self.ramp(loop if phase == "loading" else None)
             self.record(0.0)
             self.macro_time[np.isfinite(self.macro_time)] = -1.0  # separated during the ramp
