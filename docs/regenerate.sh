@@ -23,7 +23,6 @@ declare -A WHAT=(
   [resolution]="docs/studies/ucs_calibration.md resolution (params/resolution_small.table): about 20 min"
   [fem_ucs]="docs/studies/deformable_grains.md fem UCS table (params/fem_ucs_small.table): about 30 min"
   [fem_creep]="docs/studies/deformable_grains.md fem creep table and the fem beta1 (params/fem_creep_small.table): about 20 min on 2 cores"
-  [lattice]="docs/studies/spring_lattice.md (params/deformable_*.table): about 3 h"
   [lifetime_small]="docs/studies/lifetime.md 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
   [lifetime_ldb]="docs/studies/lifetime.md paper size, docs/studies/creep.md 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
   [creep_numerics]="docs/studies/creep.md creep numerics (params/creep_numerics_small.table): about 1 h"
@@ -39,7 +38,7 @@ declare -A WHAT=(
 run_target() {
   case "$1" in
     elastic) bash docs/elastic_study.sh
-             cp results/elastic_study/w31.7e-3_s2_deformable_k2_r1_cells/contact_stress_histogram.png docs/figures/elastic_contact_stress_ldb_seed2.png ;;
+             cp results/elastic_study/w31.7e-3_s2_mesh_k2_r1_cells/contact_stress_histogram.png docs/figures/elastic_contact_stress_ldb_seed2.png ;;
     bench) $PY -m grainfrac_yade bench ;;
     calibration) $PY -m grainfrac_yade calibrate --seeds 1 2 3 4 5 --rounds 2 --jobs 2 ;;
     calibration_check) batch params/calibration_check_ldb.table ucs.py calibration_check
@@ -51,12 +50,6 @@ run_target() {
     fem_creep) batch params/fem_creep_small.table creep.py fem_creep
                $PY -m grainfrac_yade analyze results/fem_creep
                $PY -m grainfrac_yade calibrate-beta1 results/fem_creep --out params/presets/fem_stress_corrosion_calibrated.toml ;;
-    lattice) batch params/deformable_ucs_small.table ucs.py deformable_ucs
-             batch params/deformable_creep_small.table creep.py deformable_creep
-             batch params/deformable_scaled_small.table ucs.py deformable_scaled
-             batch params/deformable_scaled_creep.table creep.py deformable_scaled
-             $PY -m grainfrac_yade analyze-ucs results/deformable_ucs
-             $PY -m grainfrac_yade analyze results/deformable_creep ;;
     lifetime_small) batch params/lifetime_small.table creep.py lifetime_small
                     batch params/lifetime_small_beta2x3.table creep.py lifetime_small_beta2x3
                     batch params/lifetime_spread_small.table creep.py lifetime_spread_small
@@ -98,7 +91,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
   exit 0
 fi
 targets=("$@")
-[ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lattice lifetime_small
+[ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
                            regularisation)
 for t in "${targets[@]}"; do

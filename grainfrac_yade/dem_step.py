@@ -8,7 +8,6 @@ with the functions of this module, so that :func:`critical_dem_step` (``specimen
 * rigid cells (one YADE body per cell): sqrt(m / K) and sqrt(I / K_rot), K summing k_n + k_s of the
   cell's bonds, K_rot (k_n + k_s) |r|^2 with r the lever arm from the body to the bond point
   (:func:`body_steps`);
-* deformable cells (spheres held by links): the same per sphere, translation only;
 * finite-element cells: sqrt(m / K) per sphere, K the Gershgorin bound of its stiffness row (elements
   and bonds, :func:`grainfrac_yade.elastic.node_stiffness`); a cell's mass is spread over its spheres
   in proportion to the area lumped on each (:func:`sphere_mass_inertia`);
@@ -25,24 +24,18 @@ from .layout import BondProperties, ClumpLayout, bond_properties, cell_mass_iner
 from .params import Parameters
 from .specimen import Specimen
 
-#: Blocked DOFs of the spheres of deformable cells: in-plane translation only, the springs that
-#: :mod:`grainfrac_yade.deformable` fits and the static lattice solve assumes.  Measured (layout of
-#: commit fa5f3f4) on 4 x 8 mm, seed 1, 2 nodes per face, axial strain 3e-4 (5x the UCS rate;
-#: static lattice solve: E 89.6 GPa, nu 0.209, bond shear p99 1.05 x the applied stress):
-#:   "zXYZ", plain kinematics (below): E 89.8 GPa, nu 0.208, p99 1.05, DEM step 3.7e-8 s;
-#:   "zXY" (free spin, as rigid cells), YADE's default kinematics: E 80.5 GPa, nu 0.255, p99 0.80
-#:   (max 1.56), DEM step 8.1e-9 s (the rotation of the smallest spheres sets it: 4.6x more steps).
-#: Blocking has a price only where links carry shear springs: a translation-only link with one
-#: resists the rigid rotation of its cell (its shear spring sees the chord).  With such links a
-#: 4 x 8 mm specimen with the rigid-cell calibration reached a UCS of 1414 MPa (677 MPa free spin,
-#: 252 MPa rigid cells); the links of :mod:`grainfrac_yade.deformable` are normal springs only.
+#: Blocked DOFs of the spheres of fem cells: in-plane translation only, the two-node springs and
+#: plane elements that the static solve (:func:`grainfrac_yade.elastic.cluster_network`) assumes.
+#: Measured on the retired spring lattice (4 x 8 mm, seed 1, 2 nodes per face, axial strain 3e-4):
+#: "zXYZ" with plain kinematics (below) gave the static solve's E and nu (89.8 against 89.6 GPa,
+#: 0.208 against 0.209); "zXY" (free spin, as rigid cells) with YADE's default kinematics gave
+#: E 80.5 GPa, nu 0.255 and a DEM step 4.6 x shorter (the rotation of the smallest spheres sets it).
 DEFORMABLE_BLOCKED_DOFS = "zXYZ"
-#: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in deformable scenes.  YADE's default (True)
+#: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in fem scenes.  YADE's default (True)
 #: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
-#: a link between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
-#: False: the plain relative displacement, k_s as given (bonds join touching spheres: no change for
-#: them); the DEM then gives the static lattice solve's E and Poisson's ratio (tested; 85.5 GPa,
-#: nu 0.227 with the default).  Rigid cells keep YADE's default.
+#: a spring between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
+#: False: the plain relative displacement, k_s as given, the static solve's kinematics.  Rigid cells
+#: keep YADE's default.
 DEFORMABLE_RATCHETING_GUARD = False
 
 
@@ -65,13 +58,6 @@ def _oscillation_steps(n_bodies: int, ends: np.ndarray, k: np.ndarray, lever_sq:
     return np.minimum(t_trans, t_rot)
 
 
-def _links(layout: ClumpLayout):
-    """(m, 2) sphere pairs, k_n and k_s [N/m] of the layout's intra-cell links (empty without links)."""
-    if not layout.n_links:
-        return np.empty((0, 2), dtype=np.int64), np.empty(0), np.empty(0)
-    return layout.link_spheres, layout.link_normal_stiffness, layout.link_shear_stiffness
-
-
 def body_steps(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
                mass: np.ndarray, inertia: np.ndarray, body_pos: np.ndarray | None = None,
                rotating: bool = True, ratcheting_guard: bool = True) -> np.ndarray:
@@ -81,8 +67,8 @@ def body_steps(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
     the cell bodies' positions).  K sums k_n + k_s of a cell's bonds; K_rot sums
     (k_n + k_s) |r|^2 with r the lever arm from the cell body to the bond point.
 
-    Deformable cells: the bodies are the spheres (``mass``, ``inertia`` per sphere).  K sums
-    k_n + k_s of a sphere's bonds and links.  ``rotating=False`` (rotation blocked,
+    Sphere bodies: the bodies are the spheres (``mass``, ``inertia`` per sphere).  K sums
+    k_n + k_s of a sphere's bonds.  ``rotating=False`` (rotation blocked,
     ``DEFORMABLE_BLOCKED_DOFS``, the default): sqrt(m/K) only.  Otherwise K_rot sums
     (k_n + k_s) a l: l = max(r, (d + r - r_other)/2) the lever of the JCFpm torque (r for touching
     spheres; for spheres d apart the force acts half-way across the gap), a the lever of rotation
@@ -95,9 +81,8 @@ def body_steps(layout: ClumpLayout, props: BondProperties, specimen: Specimen,
                                 layout.bond_point - body_pos[cells[:, 1]]])
         return _oscillation_steps(specimen.n_cells, cells, props.normal_stiffness + props.shear_stiffness,
                                   (lever**2).sum(1), mass, inertia)
-    link_spheres, link_kn, link_ks = _links(layout)
-    ends = np.concatenate([layout.bond_spheres, link_spheres]).astype(np.int64)
-    k = np.concatenate([props.normal_stiffness + props.shear_stiffness, link_kn + link_ks])
+    ends = layout.bond_spheres.astype(np.int64)
+    k = props.normal_stiffness + props.shear_stiffness
     r = layout.sphere_radius[ends]
     d = np.linalg.norm(layout.sphere_center[ends[:, 0]] - layout.sphere_center[ends[:, 1]], axis=1)
     torque_lever = np.maximum(r, 0.5 * (d[:, None] + r - r[:, ::-1]))

@@ -12,7 +12,7 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
     series stiffness, with YADE's contact kinematics (normal along the line of
     sphere centres; rotations act on lever arms equal to the sphere radii, as
     ``Ig2_Sphere_Sphere_ScGeom`` with ``avoidGranularRatcheting``).
-``deformable``
+``mesh``
     The paper's deformable UDEC blocks: each cell a fan of linear (constant
     strain) triangles from its centroid, plane strain with its mineral's
     Table 1 moduli; cells joined at face nodes by Table 2 springs (k_n, k_s
@@ -21,11 +21,11 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
     trapezoid share (K = 2: UDEC's corner sub-contacts, each half the face);
     ``contacts="midpoints"`` puts them at the centres of K equal sub-segments,
     each carrying 1/K of the face (as the DEM's deformable cells do).
-``lattice`` and ``fem``
-    The YADE deformable cells (:mod:`grainfrac_yade.deformable`) solved
+``fem``
+    The YADE finite-element cells (:mod:`grainfrac_yade.deformable`) solved
     statically: every sphere a body (translation only), bonds as YADE springs,
-    and the cell's interior as links (``grain_model = "deformable"``) or as
-    the constant-strain triangles on which the spheres sit (``"fem"``).
+    and the cell's interior as the constant-strain triangles on which the
+    spheres sit.
 
 Loading: the cells with a face on the top (bottom) wall form rigid-in-y
 platens closing by ``strain`` x height (rotation blocked, lateral motion free,
@@ -322,28 +322,24 @@ def rigid_network(specimen: Specimen, params: Parameters, layout=None) -> Networ
 
 
 def cluster_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
-    """The YADE deformable cells: every sphere a body that translates only (rotations blocked, see
-    :mod:`grainfrac_yade.deformable`), bonds and links as YADE springs, finite elements as
-    constant-strain triangles of the cell's mineral (plane strain, Table 1)."""
+    """The YADE finite-element cells: every sphere a body that translates only (rotations blocked, see
+    :mod:`grainfrac_yade.deformable`), bonds as YADE springs, finite elements as constant-strain
+    triangles of the cell's mineral (plane strain, Table 1)."""
     from .layout import bond_properties, layout_for
     _require_2d(specimen.tessellation)
     layout = layout or layout_for(specimen, params)
     if layout.rigid_cells:
-        raise GrainfracError("elastic --grains lattice|fem needs resolution.grain_model = \"deformable\" or "
-                             "\"fem\"; fix: add --set resolution.grain_model=deformable (or fem)")
+        raise GrainfracError("elastic --grains fem needs resolution.grain_model = \"fem\"; "
+                             "fix: add --set resolution.grain_model=fem")
     props = bond_properties(specimen, layout, params)
     c2, r = layout.sphere_center[:, :2], layout.sphere_radius
-    link_spheres = layout.link_spheres if layout.n_links else np.empty((0, 2), dtype=np.int64)
-    link_kn = layout.link_normal_stiffness if layout.n_links else np.empty(0)
-    link_ks = layout.link_shear_stiffness if layout.n_links else np.empty(0)
-    pairs = np.concatenate([layout.bond_spheres, link_spheres])
+    pairs = layout.bond_spheres
     # spheres translate only and the scene takes the plain relative displacement (no ratcheting
     # guard): the arms play no part
     normal, arm, _, _ = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
                                          c2[pairs[:, 0]], c2[pairs[:, 1]])
     if layout.bond_normal is not None:       # bonds acting on their face's plane
         normal[:layout.n_bonds] = layout.bond_normal
-    n_links = layout.n_links
     if layout.n_elements:
         tri = layout.element_spheres
         names = specimen.mineral_names
@@ -354,10 +350,8 @@ def cluster_network(specimen: Specimen, params: Parameters, layout=None) -> Netw
         tri, tri_stiffness = np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3, 3))
     return Network(node_pos=c2.copy(), node_rotates=np.zeros(layout.n_spheres, dtype=bool),
                    node_cell=layout.sphere_cell.copy(), spring_nodes=pairs, spring_normal=normal, spring_arm=arm,
-                   spring_kn=np.concatenate([props.normal_stiffness, link_kn]),
-                   spring_ks=np.concatenate([props.shear_stiffness, link_ks]),
-                   spring_area=np.concatenate([layout.bond_area, np.full(n_links, np.nan)]),
-                   spring_face=np.concatenate([layout.bond_face, np.full(n_links, -1)]),
+                   spring_kn=props.normal_stiffness, spring_ks=props.shear_stiffness,
+                   spring_area=layout.bond_area.copy(), spring_face=layout.bond_face.copy(),
                    tri_nodes=tri, tri_stiffness=tri_stiffness)
 
 
@@ -378,7 +372,7 @@ def _require_2d(t):
         raise GrainfracError("elastic reference: built for 2D specimens only; fix: use specimen.dimension = 2")
 
 
-def deformable_network(specimen: Specimen, params: Parameters, nodes_per_face: int = 2,
+def mesh_network(specimen: Specimen, params: Parameters, nodes_per_face: int = 2,
                        contacts: str = "corners", rings: int = 1) -> Network:
     """The deformable-block reference: triangles with their mineral's Table 1 moduli (plane strain),
     cells joined at face nodes by Table 2 springs (k_n, k_s [Pa/m] x the node's share of the face)."""
@@ -408,7 +402,7 @@ def contact_stiffness(specimen: Specimen, params: Parameters, faces: np.ndarray)
     return kn[fm[:, 0], fm[:, 1]] * scale, ks[fm[:, 0], fm[:, 1]] * scale
 
 
-GRAIN_MODELS = ("rigid", "deformable", "lattice", "fem")
+GRAIN_MODELS = ("rigid", "mesh", "fem")
 
 
 def build_network(specimen: Specimen, params: Parameters, grains: str, nodes_per_face: int = 2,
@@ -416,9 +410,9 @@ def build_network(specimen: Specimen, params: Parameters, grains: str, nodes_per
     """The network of one grain model (see module doc)."""
     if grains == "rigid":
         return rigid_network(specimen, params)
-    if grains == "deformable":
-        return deformable_network(specimen, params, nodes_per_face, contacts, rings)
-    if grains in ("lattice", "fem"):
+    if grains == "mesh":
+        return mesh_network(specimen, params, nodes_per_face, contacts, rings)
+    if grains == "fem":
         return cluster_network(specimen, params)
     raise GrainfracError(f"elastic: grains {grains!r} unknown; fix: use one of {list(GRAIN_MODELS)}")
 
@@ -433,6 +427,6 @@ def elastic_summary(specimen: Specimen, params: Parameters, grains: str, nodes_p
                "applied_stress_pa": sol.applied_stress, "axial_strain": strain,
                "n_nodes": net.n_nodes, "n_triangles": int(len(net.tri_nodes)),
                **contact_statistics(net, sol)}
-    if grains == "deformable":
+    if grains == "mesh":
         summary.update(nodes_per_face=nodes_per_face, contacts=contacts, rings=rings)
     return summary, net, sol

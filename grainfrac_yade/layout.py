@@ -40,12 +40,9 @@ class ClumpLayout:
     bond_face: np.ndarray       # (b,) face index
     bond_area: np.ndarray       # (b,) [m^2]
     bond_point: np.ndarray      # (b, 3) contact point on the face [m]
-    #: False for deformable cells (``resolution.grain_model = "deformable"``): every sphere is a
-    #: body of its own, and the spheres of one cell are held together by the links below
+    #: False for finite-element cells (``resolution.grain_model = "fem"``): every sphere is a
+    #: body of its own, and the spheres of one cell are held together by the elements below
     rigid_cells: bool = True
-    link_spheres: np.ndarray | None = None           # (m, 2) sphere pairs of unbreakable intra-cell links
-    link_normal_stiffness: np.ndarray | None = None  # (m,) [N/m]
-    link_shear_stiffness: np.ndarray | None = None   # (m,) [N/m]
     sphere_area: np.ndarray | None = None            # (s,) cell area lumped on each sphere [m^2] (mass share)
     #: (e, 3) sphere triangles of finite-element cells (``grain_model = "fem"``): each a constant-strain
     #: element of its cell's mineral (plane strain, Table 1), the mesh on which the spheres sit
@@ -55,12 +52,8 @@ class ClumpLayout:
     #: face, as the reference's contacts); None: along the line of the two sphere centres
     bond_normal: np.ndarray | None = None
     #: fraction of the centroid-to-face distance of grain in series with each bond (1: rigid cells,
-    #: whose elasticity lives in the bonds; the inset of deformable cells, whose links carry the rest)
+    #: whose elasticity lives in the bonds; the inset of fem cells, whose elements carry the rest)
     series_fraction: float = 1.0
-
-    @property
-    def n_links(self) -> int:
-        return 0 if self.link_spheres is None else len(self.link_spheres)
 
     @property
     def n_elements(self) -> int:
@@ -87,10 +80,7 @@ def build_layout(specimen: Specimen, spheres_per_cell: int) -> ClumpLayout:
 
 
 def layout_for(specimen: Specimen, params: Parameters) -> ClumpLayout:
-    """The layout of ``params.resolution``: rigid cells (``spheres_per_cell``) or deformable cells."""
-    if params.resolution.grain_model == "deformable":
-        from .deformable import build_deformable_layout
-        return build_deformable_layout(specimen, params)
+    """The layout of ``params.resolution``: rigid cells (``spheres_per_cell``) or fem cells."""
     if params.resolution.grain_model == "fem":
         from .deformable import build_fem_layout
         return build_fem_layout(specimen, params)

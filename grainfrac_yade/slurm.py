@@ -127,7 +127,7 @@ def read_batch_table(path) -> BatchTable:
         cells = _strip_comment(lines[i]).split()
         if len(cells) != len(header):
             raise GrainfracError(f"{path}:{i}: {len(cells)} cells but {len(header)} columns; fix: one cell per "
-                                 "column, text quoted without spaces ('deformable'), '=' repeats the cell above")
+                                 "column, text quoted without spaces ('fem'), '=' repeats the cell above")
         row = {}
         for col, cell in zip(header, cells):
             if cell == "=":

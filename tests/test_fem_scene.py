@@ -12,7 +12,7 @@ import pytest
 
 from conftest import needs_yade
 from grainfrac_yade.deformable import build_fem_layout, element_apex
-from grainfrac_yade.elastic import (cluster_network, contact_statistics, deformable_network, node_stiffness,
+from grainfrac_yade.elastic import (cluster_network, contact_statistics, mesh_network, node_stiffness,
                                     solve_uniaxial, stiffness_matrix)
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
@@ -43,7 +43,7 @@ def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes():
     10 x 20 mm seed 1: E -3.0 / -1.0 / -0.1 % at insets 0.03 / 0.01 / 0.001, nu within 0.3 %)."""
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 1)
-    ref = solve_uniaxial(deformable_network(s, p, p.resolution.nodes_per_face), s)
+    ref = solve_uniaxial(mesh_network(s, p, p.resolution.nodes_per_face), s)
     errors = []
     for inset in (0.03, 0.01, 0.001):
         q = _with_inset(p, inset)
@@ -210,8 +210,8 @@ def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
     scene.run(1)
     assert scene.law.smoothJoint and not scene.bond_separated(range(scene.n_bonds)).any()
     assert all(i.phys.isOnJoint for i in scene.interactions)
-    # plain deformable scenes carry no element engine
-    q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=deformable"])
+    # rigid scenes carry no element engine
+    q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=rigid"])
     assert "FEInternalForceEngine" not in build_scene(build_specimen(q, 1), q).engine_names()
 
 

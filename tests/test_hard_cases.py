@@ -27,7 +27,7 @@ from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
 
 TINY = ["specimen.width=4e-3", "specimen.height=8e-3"]
-DEFORMABLE = [str(ROOT / "params" / "presets" / "deformable.toml")]
+FEM = [str(ROOT / "params" / "presets" / "fem.toml")]
 
 
 # ------------------------------------------------------------------ checks shared by every run
@@ -200,9 +200,9 @@ def test_b_a_load_above_the_ucs_fails_on_loading_with_lifetime_0(tmp_path, rigid
 @needs_yade
 @pytest.mark.yade
 @pytest.mark.slow
-def test_b_deformable_grains_above_their_ucs_fail_on_loading(tmp_path, captured):
-    """Deformable preset, 4 x 8 mm: UCS (measured 513 MPa; 13 s), then 1.001 x it (10 s)."""
-    p = load_parameters(overrides=TINY, extra_files=DEFORMABLE)
+def test_b_fem_grains_above_their_ucs_fail_on_loading(tmp_path, captured):
+    """Fem preset, 4 x 8 mm: UCS, then 1.001 x it."""
+    p = load_parameters(overrides=TINY, extra_files=FEM)
     ucs = ucs_folder(p, tmp_path / "ucs", captured)["ucs_pa"]
     _fails_on_loading(creep_folder(p, tmp_path / "creep", 1.001 * ucs, ucs, captured, NO_LIFETIME[1:]))
 
@@ -401,10 +401,10 @@ def test_g_the_same_seed_twice_gives_identical_creep_results(tmp_path):
 @needs_yade
 @pytest.mark.yade
 @pytest.mark.slow
-def test_g_the_same_seed_twice_gives_identical_deformable_ucs_results(tmp_path):
-    """Deformable preset, 4 x 8 mm, seed 1, two CLI processes (15 s each)."""
+def test_g_the_same_seed_twice_gives_identical_fem_ucs_results(tmp_path):
+    """Fem preset, 4 x 8 mm, seed 1, two CLI processes."""
     for name in ("a", "b"):
-        _cli_run("ucs", "--params", DEFORMABLE[0], "--width", 4e-3, "--height", 8e-3, "--seed", 1,
+        _cli_run("ucs", "--params", FEM[0], "--width", 4e-3, "--height", 8e-3, "--seed", 1,
                  "--out", tmp_path / name)
     assert_same_runs(tmp_path / "a", tmp_path / "b")
 

@@ -66,7 +66,7 @@ def check_row(test: str, columns, cells: dict, where: str):
             values[col] = cell_value(text)
         except ValueError as exc:
             raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: text cells must be quoted, e.g. "
-                                 "'deformable'") from None
+                                 "'fem'") from None
     overrides = [(k, v) for k, v in values.items() if k in defaults and v != defaults[k]]
     controls.update({k: v for k, v in values.items() if k in controls})
     if controls["on_change"] not in ON_CHANGE:

@@ -3,7 +3,7 @@
 Every parameter path (``section.key``, the names of ``--set``) is a possible
 column of a batch table, plus ``seed``, ``out``, ``study``, ``description`` and
 ``on_change``.  Values are read with YADE's own ``readParamsFromTable`` (each cell
-is a Python expression, so text is quoted: ``'deformable'``) and validated like files.
+is a Python expression, so text is quoted: ``'fem'``) and validated like files.
 
 A row whose folder already holds a finished run (summary.json) is skipped only if
 that run's stored parameters (params.json) and run values (seed, load) equal the
@@ -67,7 +67,7 @@ def read_table(extra_columns=None) -> tuple:
     try:
         utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
     except NameError as exc:   # YADE evaluates every cell as Python: text without quotes (columns checked above)
-        raise GrainfracError(f"batch table row {spec}: {exc}; fix: text cells must be quoted, e.g. 'deformable'"
+        raise GrainfracError(f"batch table row {spec}: {exc}; fix: text cells must be quoted, e.g. 'fem'"
                              ) from None
     table = yade.params.table
     overrides = [(k, getattr(table, k)) for k, v in defaults.items() if getattr(table, k) != v]

@@ -253,8 +253,6 @@ def rebind_scene(scene):
         return out
 
     scene.interactions = pairs(scene.layout.bond_spheres)
-    if scene.links:
-        scene.links = pairs(scene.layout.link_spheres)
     loops = [e for e in O.engines if isinstance(e, w.InteractionLoop)]
     scene.law = next(f for f in loops[0].lawDispatcher.functors
                      if isinstance(f, w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM))

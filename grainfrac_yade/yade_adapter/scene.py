@@ -16,16 +16,14 @@ writes the residual friction phi_r itself (the law keeps phi).
 
 Rigid cells (``layout.rigid_cells``, the default grain model) are one YADE body
 each: a sphere, or a clump of spheres with the polygon's mass and inertia.
-Deformable cells are clusters of separate sphere bodies held together by
-*links*: JCFpm bonds with strengths so large that they never break, kept in
-:attr:`GrainScene.links` apart from the breakable bonds
-(:attr:`GrainScene.interactions`), so bond bookkeeping, stress corrosion and
-cracks see only the breakable bonds.  Code that acts on cells uses
+Finite-element cells are clusters of separate sphere bodies held together by
+YADE's finite elements; only the breakable bonds are interactions
+(:attr:`GrainScene.interactions`).  Code that acts on cells uses
 :meth:`GrainScene.bodies_of`, which covers both models.  Their spheres translate
 only (``DEFORMABLE_BLOCKED_DOFS``) and their contact geometry takes the plain
-relative displacement (``DEFORMABLE_RATCHETING_GUARD``): every bond and link is a
-two-node spring, the model :mod:`grainfrac_yade.deformable` fits and
-:func:`grainfrac_yade.elastic.cluster_network` solves statically.
+relative displacement (``DEFORMABLE_RATCHETING_GUARD``): every bond is a
+two-node spring, the model that :func:`grainfrac_yade.elastic.cluster_network`
+solves statically.
 """
 from __future__ import annotations
 
@@ -36,7 +34,7 @@ import numpy as np
 
 from ..errors import GrainfracError, NumericalFailure
 from ..law import check_finite
-from ..dem_step import (DEFORMABLE_BLOCKED_DOFS, DEFORMABLE_RATCHETING_GUARD, _links,  # noqa: F401 (re-exported)
+from ..dem_step import (DEFORMABLE_BLOCKED_DOFS, DEFORMABLE_RATCHETING_GUARD,  # noqa: F401 (re-exported)
                         body_steps, cell_steps, critical_timestep, fem_node_stiffness, inertia_about_bodies,
                         lift_short_steps, rigid_masses_and_step, sphere_mass_inertia, sphere_masses_and_step)
 from ..layout import BondProperties, ClumpLayout, bond_properties, cell_mass_inertia, layout_for
@@ -48,9 +46,6 @@ from . import load_yade
 INTACT, TENSION, SHEAR = 0, 1, 2
 #: Material type shared by all cells: JCFpm bonds only form between equal types.
 COHESIVE_TYPE = 1
-#: FnMax and FsMax [N] of the intra-cell links of deformable cells: never reached, so a link never
-#: breaks (not 0: FnMax = 0 only switches the tension check off, a shear break would still happen).
-LINK_STRENGTH = 1e30
 #: Collision mask bit shared by every sphere of a scene with per-cell masks (and the collider's
 #: ``avoidSelfInteractionMask``): YADE makes no contact between two bodies of equal masks that
 #: carry this bit, and lets bodies of different masks that share it meet.
@@ -82,7 +77,7 @@ class GrainScene:
     breakable bond (``interactions`` and everything ``bond_*``).  ``cell_bodies[c]`` holds all
     body ids of cell c (one for rigid cells); ``cell_body[c]`` is the cell's body for rigid
     cells, and for deformable cells only a representative: the body of the cell's sphere
-    nearest its centroid.  ``links`` are the unbreakable intra-cell links of deformable cells.
+    nearest its centroid.
     """
     specimen: Specimen
     layout: ClumpLayout
@@ -95,7 +90,6 @@ class GrainScene:
     interactions: list
     law: object
     newton: object
-    links: list = field(default_factory=list)     # unbreakable intra-cell links (deformable cells)
     drivers: list = field(default_factory=list)   # called before every DEM step
     extras: list = field(default_factory=list)    # listed engines acting between steps (platens, corrosion)
     broken: np.ndarray = None
@@ -461,23 +455,6 @@ def _append_fem_elements(O, w, utils, Vector3, specimen, params, layout, sphere_
     return {s: ids[0] for s, ids in clump_of.items()}
 
 
-def _create_links(utils, specimen, layout, params, sphere_body) -> list:
-    """Unbreakable JCFpm bonds between spheres of one cell (k_n, k_s from the layout, friction of the
-    cell's mineral, strengths ``LINK_STRENGTH``)."""
-    link_spheres, link_kn, link_ks = _links(layout)
-    names = specimen.mineral_names
-    tan_phi = np.array([math.tan(params.contact(m, m).friction_angle) for m in names])
-    links = []
-    for k, (i, j) in enumerate(link_spheres):
-        inter = utils.createInteraction(int(sphere_body[i]), int(sphere_body[j]))
-        ph = inter.phys
-        ph.kn, ph.ks = float(link_kn[k]), float(link_ks[k])
-        ph.FnMax = ph.FsMax = LINK_STRENGTH
-        ph.tanFrictionAngle = float(tan_phi[specimen.mineral[layout.sphere_cell[i]]])
-        links.append(inter)
-    return links
-
-
 def verlet_distance(layout: ClumpLayout, numerics) -> float:
     """``InsertionSortCollider.verletDist``: ``numerics.verlet_fraction`` x the sphere radius at quantile
     ``numerics.verlet_radius_quantile``.  At quantile 0 it is YADE's own relative form (a negative value:
@@ -570,7 +547,6 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             ph.isOnJoint = True
             ph.jointNormal = Vector3(*layout.bond_normal[k], 0.0)
         interactions.append(inter)
-    links = _create_links(utils, specimen, layout, params, sphere_body)
     if per_cell_masks:
         for m, body in enumerate(sphere_body):
             O.bodies[int(body)].mask = cell_mask(int(layout.sphere_cell[m]))
@@ -588,4 +564,4 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
     O.dt = params.numerics.timestep_safety * dt_crit
     return GrainScene(specimen=specimen, layout=layout, props=props, params=params, O=O,
                       cell_body=cell_body, cell_bodies=cell_bodies, sphere_body=sphere_body,
-                      interactions=interactions, law=law, newton=newton, links=links, dt_critical=dt_crit)
+                      interactions=interactions, law=law, newton=newton, dt_critical=dt_crit)
