@@ -19,8 +19,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from grainfrac_yade.dem_step import critical_dem_step  # noqa: E402
-from grainfrac_yade.layout import layout_for  # noqa: E402
+from grainfrac_yade.grains import critical_dem_step, layout_for  # noqa: E402
 from grainfrac_yade.params import PARAMS_DIR, load_parameters  # noqa: E402
 from grainfrac_yade.specimen import build_specimen  # noqa: E402
 

@@ -12,7 +12,7 @@ import json
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.dem_step import critical_dem_step
+from grainfrac_yade.grains import critical_dem_step
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
 

@@ -12,7 +12,8 @@ import pytest
 
 from conftest import needs_yade
 from grainfrac_yade.errors import GrainfracError
-from grainfrac_yade.layout import build_layout, layout_for
+from grainfrac_yade.grains import layout_for
+from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
 
@@ -30,9 +31,9 @@ def fem():
 
 
 def test_scene_takes_its_layout_from_layout_for():
-    from grainfrac_yade import layout
+    from grainfrac_yade import grains
     from grainfrac_yade.yade_adapter import scene
-    assert scene.layout_for is layout.layout_for
+    assert scene.layout_for is grains.layout_for
 
 
 def test_specimen_command_counts_and_draws_fem_bonds(tmp_path, fem):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.layout import build_layout
+from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
 from grainfrac_yade.tessellation import tessellate_seeds
@@ -53,7 +53,7 @@ def test_rigid_default_scene_is_unchanged(params):
     assert params.resolution.grain_model == "rigid"
     s = grid_specimen(params, 2, 1)
     sc = build_scene(s, params)
-    assert sc.layout.rigid_cells and len(sc.O.bodies) == 2
+    assert sc.layout.model == "rigid" and len(sc.O.bodies) == 2
     g, c = params.grains["quartz"], params.contact("quartz", "quartz")
     e_plane, area, half = g.young / (1 - g.poisson**2), SIZE * THICKNESS, SIZE / 2
     scale = params.calibration.stiffness_scale
@@ -73,5 +73,5 @@ def test_rigid_layout_comes_from_layout_for(params):
     from grainfrac_yade.yade_adapter.scene import layout_for
     s = build_specimen(load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3"]), 1)
     a, b = layout_for(s, params), build_layout(s, params.resolution.spheres_per_cell)
-    assert a.rigid_cells and a.n_bonds == b.n_bonds
+    assert a.model == "rigid" and a.n_bonds == b.n_bonds
     np.testing.assert_array_equal(a.bond_spheres, b.bond_spheres)

@@ -214,3 +214,12 @@ def test_params_json_older_than_grain_model_loads_as_rigid_cells(tmp_path, param
     old = load_run_parameters(tmp_path, fill_missing=True)
     assert set(old.filled) == {"resolution.grain_model", "resolution.nodes_per_face"}
     assert old.params.resolution.grain_model == "rigid" and old.params == params
+
+
+def test_grain_model_choices_are_the_registered_grain_models():
+    import dataclasses
+    from grainfrac_yade.grains import GRAIN_MODEL_NAMES, grain_model
+    from grainfrac_yade.params import ResolutionParams
+    spec = {f.name: f for f in dataclasses.fields(ResolutionParams)}["grain_model"].metadata
+    assert tuple(spec["choices"]) == GRAIN_MODEL_NAMES
+    assert [grain_model(n).name for n in GRAIN_MODEL_NAMES] == list(GRAIN_MODEL_NAMES)

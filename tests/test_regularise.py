@@ -13,7 +13,7 @@ import pytest
 
 from grainfrac_yade.disc import build_disc_specimen, voronoi_disc
 from grainfrac_yade.errors import GrainfracError
-from grainfrac_yade.layout import layout_for
+from grainfrac_yade.grains import layout_for
 from grainfrac_yade.minerals import allocate_minerals
 from grainfrac_yade.params import PARAMS_DIR, load_parameters, migrate_tree
 from grainfrac_yade.regularise import regularise

@@ -71,6 +71,7 @@ def run_elastic_to_folder(params, seed, out, grains="mesh", nodes_per_face=2, co
     """
     from ..analysis.figures import contact_stress_histograms
     from ..elastic import contact_ratios, elastic_summary
+    from ..grains import grain_model
     from ..runio import code_version, commit_run_dir, prepare_run_dir, write_json
     from ..specimen import build_specimen
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
@@ -79,7 +80,8 @@ def run_elastic_to_folder(params, seed, out, grains="mesh", nodes_per_face=2, co
     # the YADE cells are always compared with the mesh reference at the same contact nodes per face
     names = [grains, "rigid"] + (["mesh"] if grains in CLUSTER_MODELS else [])
     for name in dict.fromkeys(names):
-        s, net, sol = elastic_summary(specimen, params, name, nodes_per_face, contacts, rings,
+        layout = None if name == "mesh" else grain_model(name).build_layout(specimen, params)
+        s, net, sol = elastic_summary(specimen, params, name, layout, nodes_per_face, contacts, rings,
                                       platens=platens if name != "rigid" else "cells")
         models[name] = s
         ratios[name] = contact_ratios(net, sol)

@@ -5,8 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dem_step import critical_dem_step
-from ..layout import layout_for
+from ..grains import critical_dem_step, layout_for
 from ..plotting import specimen_figure
 from ..runio import commit_run_dir, prepare_run_dir, write_json
 from ..specimen import build_specimen

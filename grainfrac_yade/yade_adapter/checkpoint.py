@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GrainfracError
+from ..grains import grain_model
 from ..runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
 
 #: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
@@ -290,17 +291,10 @@ def restore_platens(pl, p: dict):
     pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]
 
 
-#: Why a resumed run of finite-element cells is not bit-identical (measured: 3 x 6 mm fem UCS resumed at
-#: DEM step 20,179: E -6e-5, crack initiation -4e-5, peak +5e-7 relative, the same 26 bonds broken in the
-#: same modes, up to 17 DEM steps apart; docs/resuming.md).
-FEM_INEXACT = ("finite-element cells: YADE keys an element's nodes by their memory address, which O.load changes, "
-               "so the element sums its nodes in another order: the resumed run differs from an uninterrupted one "
-               "by rounding that grows (measured: E within 1e-4 relative)")
-
 
 def inexact_note(params) -> str:
     """"" if a resume of a run with ``params`` is bit-identical to the uninterrupted run (one thread), else why not."""
-    return FEM_INEXACT if params.resolution.grain_model == "fem" else ""
+    return grain_model(params.resolution.grain_model).resume_note
 
 
 def resume_record(state: dict) -> dict:

@@ -66,7 +66,7 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         return done
     if scene.O.iter != 0:
         raise GrainfracError("levers: the scene has already run; fix: apply levers right after build_scene")
-    if not scene.layout.rigid_cells:
+    if scene.model.name != "rigid":
         raise GrainfracError("levers: built for rigid cells; fix: use resolution.grain_model = \"rigid\"")
     rng = np.random.default_rng([int(seed), LEVER_STREAM])
     n = scene.n_bonds

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..layout import build_layout
+from ..grains.rigid import build_layout
 from ..specimen import specimen_from_tessellation
 from ..tessellation import tessellate_seeds
 from .corrosion_engine import StressCorrosion
