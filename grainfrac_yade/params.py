@@ -23,6 +23,7 @@ from itertools import combinations_with_replacement
 from pathlib import Path
 from typing import Any, Mapping
 
+from .atomic import write_text_atomically
 from .errors import GrainfracError, ParameterError
 from .law import LAW_NAMES
 
@@ -560,14 +561,13 @@ def parameter_file_text(values: Mapping[str, Any], header=(), notes: Mapping[str
 
 def write_parameter_file(path, values: Mapping[str, Any], header=(), notes: Mapping[str, str] | None = None):
     """Write :func:`parameter_file_text` to ``path`` (atomically) and check that it loads; return the path."""
-    from .runio import _write_atomically
     text = parameter_file_text(values, header, notes)
     loaded = tomllib.loads(text)
     for dotted, value in values.items():
         section, key = dotted.split(".", 1)
         if loaded[section][key] != value:
             raise GrainfracError(f"{path}: {dotted} would read back as {loaded[section][key]!r}, not {value!r}")
-    return _write_atomically(path, lambda tmp: Path(tmp).write_text(text))
+    return write_text_atomically(path, text)
 
 
 def parse_override(text: str) -> tuple:

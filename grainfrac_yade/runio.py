@@ -23,6 +23,7 @@ import sys
 from pathlib import Path
 
 from . import __version__
+from .atomic import write_atomically, write_text_atomically
 from .errors import GrainfracError
 
 #: Files whose presence marks a folder as holding a finished or running run.
@@ -85,28 +86,17 @@ def _clean(value):
     return value
 
 
-def _write_atomically(path, write) -> Path:
-    """Call ``write(tmp)`` on a temporary name beside ``path``, flush it to disk, rename it to ``path``."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    write(tmp)
-    with open(tmp, "rb+") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
-    return path
-
-
 def write_json(path, data) -> Path:
     """Write ``data`` as indented JSON atomically."""
     text = json.dumps(_clean(data), indent=2, sort_keys=False) + "\n"
-    return _write_atomically(path, lambda tmp: Path(tmp).write_text(text))
+    return write_text_atomically(path, text)
 
 
 def write_csv(path, frame) -> Path:
     """Write a pandas DataFrame (or dict of columns) as CSV atomically."""
     import pandas as pd
     frame = frame if isinstance(frame, pd.DataFrame) else pd.DataFrame(frame)
-    return _write_atomically(path, lambda tmp: frame.to_csv(tmp, index=False))
+    return write_atomically(path, lambda tmp: frame.to_csv(tmp, index=False))
 
 
 #: A run that replaces another (``--overwrite``) is written into ``.<name>.replacing`` beside the old one and

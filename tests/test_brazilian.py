@@ -10,10 +10,10 @@ import pytest
 from conftest import ROOT, needs_yade
 from grainfrac_yade.brazilian_analysis import (central_band_area_fraction, crack_location, hondros_centre_factor,
                                                in_central_band, tensile_stress)
-from grainfrac_yade.disc import (DiscTessellation, build_disc_specimen, clip_polygon_to_disc, tessellate_disc,
-                                 voronoi_disc)
+from grainfrac_yade.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
+from grainfrac_yade.specimen import build_disc_specimen
 from grainfrac_yade.tessellation import SIDES
 
 #: Tiny disc for the YADE runs: 8 mm, 1 mm grains (64 cells, 2-5 s a run); the CLI test runs 5 mm.

@@ -36,9 +36,10 @@ import time
 
 import numpy as np
 
+from ..brazilian_analysis import SPLIT_DROP_RATIO, tensile_stress
 from ..disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
-from .checkpoint import LoadingCheckpoints
+from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays
 from .levers import Levers, apply_levers, new_breaks
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
@@ -55,7 +56,7 @@ class DiscJaws:
         t = scene.specimen.tessellation
         if not isinstance(t, DiscTessellation):
             raise GrainfracError("Brazilian test: the specimen is not a disc; fix: build it with "
-                                 "grainfrac_yade.disc.build_disc_specimen")
+                                 "grainfrac_yade.specimen.build_disc_specimen")
         self.scene = scene
         self.diameter, self.centre = t.diameter, t.centre
         half = 0.5 * loading_arc
@@ -168,7 +169,6 @@ class BrazilianRun(LoadingCheckpoints):
 
     def run(self):
         """Load to the end of the test; (history columns, result dict, scene, snapshot at the failure load)."""
-        from ..brazilian_analysis import SPLIT_DROP_RATIO, tensile_stress
         scene, jaws, bz, cols = self.scene, self.jaws, self.params.brazilian, self.cols
         numerical, peak_reached = False, False
         try:
@@ -224,7 +224,6 @@ class BrazilianRun(LoadingCheckpoints):
 
 def capture(run, phase, loop, run_values, version="") -> tuple:
     """(state.json, arrays.npz) of Brazilian test ``run`` at a safe point."""
-    from .checkpoint import base_state, scene_arrays
     state = {**base_state("brazilian", run, phase, loop, run_values, version),
              "run": {"peak": run.peak, "broken_at_peak": run.broken_at_peak, "applied": run.applied,
                      "split": run.split_snapshot is not None, "rows": len(run.cols["dem_step"]),
@@ -240,7 +239,6 @@ def capture(run, phase, loop, run_values, version="") -> tuple:
 def restore(run, where, state, arrays):
     """Load the checkpoint ``where`` into ``run`` (a :class:`BrazilianRun` freshly built from the same
     specimen and parameters, levers not applied: the checkpoint's scene holds them)."""
-    from .checkpoint import resume_record, restore_scene
     restore_scene(run.scene, where, state, arrays)
     run.jaws.rebind(state["jaws"])
     r = state["run"]
@@ -277,7 +275,6 @@ def resume_brazilian(specimen, params, run_folder, progress=None):
     """Go on with the Brazilian test whose checkpoint is in ``run_folder`` (same specimen and parameters as
     the test that wrote it); returns what :func:`run_brazilian` returns.  GrainfracError if there is no
     usable checkpoint."""
-    from .checkpoint import read
     where, state, arrays = read(run_folder, "brazilian")
     run = BrazilianRun(specimen, params, progress, checkpoint_folder=run_folder, run_values=state.get("run_values"),
                        apply=False)

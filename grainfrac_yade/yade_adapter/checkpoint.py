@@ -50,9 +50,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..clocks import EventClock, PaperClock
 from ..errors import GrainfracError
 from ..grains import grain_model
 from ..runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
+from .corrosion_engine import StressCorrosion, add_stiffness_restorer
+from .platens import StressServo
 
 #: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
 SCENE_FILE = "scene.yade.gz"
@@ -311,10 +314,6 @@ def restore(run, where, state: dict, arrays: dict):
 
     Returns (phase, loop counters) for the driver to go on from.
     """
-    from ..clocks import EventClock, PaperClock
-    from .corrosion_engine import StressCorrosion
-    from .creep_test import add_stiffness_restorer
-    from .platens import StressServo
     sc, pl = run.scene, run.platens
     restore_scene(sc, where, state, arrays, run.confinement)
     restore_platens(pl, state["platens"])

@@ -41,10 +41,12 @@ from ..clocks import EventClock, PaperClock
 from ..errors import NumericalFailure
 from ..law import creep_step, shear_strength
 from ..params import unbalanced_threshold
+from .checkpoint import Checkpointer, inexact_note, read, restore
 from .confinement import Confinement, consolidate, young_estimate
-from .corrosion_engine import ContactStiffnessRestorer, StressCorrosion
+from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
 from .scene import broken_counts, build_scene, check_value, resultant_forces
+from .vtk_output import Series, write_creep_snapshot
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
 #: is per metre of thickness; it is scaled by the layer thickness here.
@@ -170,7 +172,6 @@ class CreepRun:
         #: writes checkpoints into ``checkpoint_folder`` (a run folder), None: no checkpoints
         self.checkpointer = None
         if checkpoint_folder is not None:
-            from .checkpoint import Checkpointer
             self.checkpointer = Checkpointer(checkpoint_folder, params.numerics.checkpoint_interval, run_values or {},
                                              self.progress)
         #: (phase, loop counters) to go on from after :func:`resume_creep`; None: a run from the start
@@ -344,7 +345,6 @@ class CreepRun:
     def write_vtk(self, creep_time):
         """Snapshot of the current state, unless the last one was taken at this same history row
         (only reads the scene)."""
-        from .vtk_output import Series, write_creep_snapshot
         if self.corr is not None and self._vtk_rows != len(self.rows):
             write_creep_snapshot(Series(self.vtk_folder, times=self.vtk_written), self, creep_time)
             self.vtk_written.append(creep_time)
@@ -399,12 +399,6 @@ class CreepRun:
 
 def _no_checkpoint(phase, loop):
     """Stand-in for :meth:`CreepRun.safe_point` for holders without checkpoints."""
-
-
-def add_stiffness_restorer(scene, corr):
-    """For a law that changes stiffness: broken bonds get their contact stiffness back before the next step."""
-    if not corr.law.exact_jump:
-        scene.drivers.append(ContactStiffnessRestorer(corr))
 
 
 def event_clock_loop(holder, corr, clock, resume=None) -> int:
@@ -558,7 +552,6 @@ def resume_creep(specimen, params, target_stress, run_folder, progress=None, **o
     driver's state is restored (:func:`.checkpoint.restore`).  GrainfracError if the folder holds
     no usable checkpoint.
     """
-    from .checkpoint import inexact_note, read, restore
     where, state, arrays = read(run_folder)
     outputs.setdefault("run_values", state.get("run_values"))
     run = CreepRun(specimen, params, target_stress, progress, checkpoint_folder=run_folder, **outputs)

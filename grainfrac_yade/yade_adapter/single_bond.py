@@ -13,7 +13,7 @@ from ..grains.rigid import build_layout
 from ..specimen import specimen_from_tessellation
 from ..tessellation import tessellate_seeds
 from .corrosion_engine import StressCorrosion
-from .creep_test import add_stiffness_restorer
+from .corrosion_engine import add_stiffness_restorer
 from .scene import build_scene
 
 #: Relative unbalanced force on the loaded cell at which the pair counts as relaxed.

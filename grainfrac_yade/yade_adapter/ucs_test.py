@@ -21,7 +21,8 @@ import time
 import numpy as np
 
 from ..errors import NumericalFailure
-from .checkpoint import LoadingCheckpoints
+from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_state, read, restore_platens,
+                         restore_scene, resume_record, scene_arrays)
 from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
 from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
@@ -121,7 +122,6 @@ class UcsRun(LoadingCheckpoints):
 
 def capture(run, phase, loop, run_values, version="") -> tuple:
     """(state.json, arrays.npz) of UCS test ``run`` at a safe point."""
-    from .checkpoint import base_state, platen_state, scene_arrays
     state = {**base_state("ucs", run, phase, loop, run_values, version),
              "run": {"peak": run.peak, "broken_at_peak": run.broken_at_peak, "consolidation": run.consolidation,
                      "confined": run.confinement is not None, "rows": len(run.cols["dem_step"]),
@@ -135,7 +135,6 @@ def capture(run, phase, loop, run_values, version="") -> tuple:
 def restore(run, where, state, arrays):
     """Load the checkpoint ``where`` into ``run`` (a :class:`UcsRun` freshly built from the same specimen
     and parameters)."""
-    from .checkpoint import resume_record, restore_platens, restore_scene
     r = state["run"]
     if r["confined"]:
         run.confinement = Confinement(run.scene, run.confining)   # its forces, set again after O.load
@@ -168,7 +167,6 @@ def resume_ucs(specimen, params, run_folder, progress=None, run_values=None):
     """Go on with the UCS test whose checkpoint is in ``run_folder`` (same specimen and parameters as the
     test that wrote it); returns what :func:`run_ucs` returns.  GrainfracError if there is no usable
     checkpoint."""
-    from .checkpoint import inexact_note, read
     where, state, arrays = read(run_folder, "ucs")
     run = UcsRun(specimen, params, progress, checkpoint_folder=run_folder,
                  run_values=run_values if run_values is not None else state.get("run_values"))
