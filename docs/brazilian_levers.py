@@ -12,7 +12,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from grainfrac_yade.commands.brazilian import run_brazilian_to_folder, tensile_scale_overrides  # noqa: E402
 from grainfrac_yade.params import load_parameters  # noqa: E402
-from grainfrac_yade.runio import prepare_run_dir, summary_header, write_json  # noqa: E402
+from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json  # noqa: E402
 from grainfrac_yade.specimen import build_specimen  # noqa: E402
 from grainfrac_yade.ucs_analysis import ucs_summary  # noqa: E402
 from grainfrac_yade.yade_adapter.levers import Levers, apply_levers  # noqa: E402
@@ -25,7 +25,7 @@ BLOCK = [("specimen.width", 10e-3), ("specimen.height", 20e-3)]
 def ucs_with_levers(params, seed, out, levers):
     """A UCS test whose scene gets ``levers`` before loading (as the brazilian command does)."""
     from grainfrac_yade.yade_adapter.scene import build_scene
-    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=True)
     specimen = build_specimen(params, seed)
     scene = build_scene(specimen, params)

@@ -147,7 +147,7 @@ def fake_scene(specimen, layout):
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):
     from grainfrac_yade.commands.creep import run_creep_to_folder
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
-    from grainfrac_yade.yade_adapter import creep_test, ucs_test
+    from grainfrac_yade.yade_adapter import creep_protocol, ucs_protocol
     params, specimen, lay = fem
     scene = fake_scene(specimen, lay)
     strain = np.linspace(0.0, 5e-3, 26)
@@ -158,14 +158,14 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
                "broken_tensile": zeros, "broken_shear": zeros, "broken_inter": zeros, "broken_intra": zeros}
     result = {"dem_steps": 1000, "wall_s": 0.1, "dem_timestep_s": 1e-9, "n_bonds": lay.n_bonds,
               "numerical_failure": False, "peak_reached": True, "end_reason": "post-peak"}
-    monkeypatch.setattr(ucs_test, "run_ucs", lambda specimen, params, progress=None, **outputs:
+    monkeypatch.setattr(ucs_protocol, "run_ucs", lambda specimen, params, progress=None, **outputs:
                         (history, result, scene, (scene.broken, scene.break_mode)))
     rows = [{"creep_time_s": t, "axial_strain": 2e-3 + 1e-9 * t, "lateral_strain": -4e-4, "axial_stress_pa": 200e6,
              "broken_total": 3, "macrocracks": 0, "dem_steps": 1000, "wall_s": 0.1} for t in (0.0, 10.0, 20.0)]
     run = SimpleNamespace(rows=rows, ramp_broken=3, failed=False, failure_reason="", failed_on_loading=False,
                           numerical_failure=False, n_events=2, scene=scene, vtk_written=[], initial_bond_stresses=None,
                           break_time=np.full(lay.n_bonds, np.nan), macro_time=np.full(lay.n_bonds, np.nan))
-    monkeypatch.setattr(creep_test, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
+    monkeypatch.setattr(creep_protocol, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     run_ucs_to_folder(params, SEED, tmp_path / "ucs")
     run_creep_to_folder(params, SEED, tmp_path / "creep", 200e6, 0.7, 285e6)
     for name in ("ucs", "creep"):
@@ -178,7 +178,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
 @pytest.mark.yade
 def test_batch_row_sets_the_grain_model(tmp_path, monkeypatch):
     """YADE's table reader (no simulation): a quoted text cell and an integer cell become overrides."""
-    from grainfrac_yade.batchrun import write_table
+    from grainfrac_yade.runs.batchrun import write_table
     from grainfrac_yade.yade_adapter.batch import read_table, run_folder_name
     table = write_table(tmp_path / "grains.table", [
         {"resolution.grain_model": "rigid", "resolution.nodes_per_face": 2, "seed": 1},

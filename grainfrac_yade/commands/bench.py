@@ -96,7 +96,7 @@ def register(sub, common):
 
 
 def cmd_bench(args) -> int:
-    from ..runio import write_json
+    from ..runs.runio import write_json
     settings = QUICK if args.quick else FULL
     out = Path(args.out or ("results/bench_quick.json" if args.quick else DEFAULT_OUT))
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -113,7 +113,7 @@ def run_bench(settings: BenchSettings, seed=1, ratio=DEFAULT_RATIO, extra_files=
               progress=None) -> dict:
     """Every measurement of the bench, as the JSON stores it."""
     from ..errors import GrainfracError
-    from ..runio import code_version
+    from ..runs.runio import code_version
     progress = progress or (lambda msg: None)
     if not 0 < ratio < 1:
         raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")

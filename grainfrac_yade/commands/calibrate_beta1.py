@@ -63,7 +63,7 @@ def cmd_calibrate_beta1(args) -> int:
     from ..analysis.collect import collect_runs
     from ..analysis.labdata import paper_reference
     from ..errors import GrainfracError
-    from ..runio import code_version
+    from ..runs.runio import code_version
     folder = Path(args.folder)
     if not folder.is_dir():
         raise GrainfracError(f"{folder}: study folder not found; fix: give the folder of the creep study")

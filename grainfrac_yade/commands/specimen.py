@@ -7,7 +7,7 @@ import numpy as np
 
 from ..grains import critical_dem_step, layout_for
 from ..plotting import specimen_figure
-from ..runio import commit_run_dir, prepare_run_dir, write_json
+from ..runs.runio import commit_run_dir, prepare_run_dir, write_json
 from ..specimen import build_specimen
 
 

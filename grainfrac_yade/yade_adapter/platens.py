@@ -171,6 +171,14 @@ class StressServo:
         self.clipped = 0
         self.closing_clipped_steps = 0
 
+    @classmethod
+    def restored(cls, platens: Platens, target: float, gain: float, max_speed: float, stress: float) -> "StressServo":
+        """A servo as a checkpoint saved it: its own ``gain`` [m/Pa] and last measured ``stress`` [Pa]."""
+        servo = cls.__new__(cls)
+        servo.platens, servo.target, servo.gain, servo.max_speed = platens, target, gain, max_speed
+        servo.stress, servo.clipped, servo.closing_clipped_steps = stress, 0, 0
+        return servo
+
     def before_step(self, scene):
         self.stress = self.platens.axial_stress()
         speed = (self.target - self.stress) * self.gain / scene.O.dt

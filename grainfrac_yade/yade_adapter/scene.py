@@ -76,6 +76,7 @@ class GrainScene:
     #: to step with a larger ``O.dt`` (an unstable step blows up or, before it does, gives nonsense)
     dt_critical: float = math.inf
     _cracks_seen: int = 0
+    _tens_seen: int = 0
 
     def __post_init__(self):
         nb = self.layout.n_bonds
@@ -140,7 +141,7 @@ class GrainScene:
         candidates = np.flatnonzero(~self.broken)
         new = [k for k in candidates if not self.interactions[k].phys.isCohesive]
         new = np.asarray(new, dtype=np.int64)
-        prev_tens = getattr(self, "_tens_seen", 0)
+        prev_tens = self._tens_seen
         tens_new = n_tens - prev_tens
         for k in new:
             phys = self.interactions[k].phys

@@ -16,7 +16,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
 
 #: Seconds between checks of the run folders while a batch runs.
 POLL_S = 5.0

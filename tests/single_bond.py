@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..grains.rigid import build_layout
-from ..specimen import specimen_from_tessellation
-from ..tessellation import tessellate_seeds
-from .corrosion_engine import StressCorrosion
-from .corrosion_engine import add_stiffness_restorer
-from .scene import build_scene
+from grainfrac_yade.grains.rigid import build_layout
+from grainfrac_yade.specimen import specimen_from_tessellation
+from grainfrac_yade.tessellation import tessellate_seeds
+from grainfrac_yade.yade_adapter.corrosion_engine import StressCorrosion, add_stiffness_restorer
+from grainfrac_yade.yade_adapter.scene import build_scene
 
 #: Relative unbalanced force on the loaded cell at which the pair counts as relaxed.
 BOND_EQUILIBRIUM_TOLERANCE = 1e-9
@@ -32,7 +31,10 @@ def two_cell_specimen(params, mineral="quartz", thickness=1e-3, size=1e-3):
 
 
 class BondUnderForce:
-    """Holder for the creep-clock loops: constant force on cell 1, equilibrium by damped steps."""
+    """Holder for the creep-clock loops (:mod:`grainfrac_yade.creep_loops`): constant force on cell 1,
+    equilibrium by damped steps; no stress servo, no checkpoints."""
+
+    servo = None
 
     def __init__(self, params, normal_stress, shear_stress, mineral="quartz"):
         """``normal_stress`` tension positive, ``shear_stress`` >= 0 [Pa] on the face."""
@@ -65,6 +67,9 @@ class BondUnderForce:
 
     def progress(self, msg):
         pass
+
+    def safe_point(self, phase, counters):
+        """No checkpoints."""
 
     def unbalanced(self, mean_bond_force):
         res = self.scene.O.forces.f(self._body.id).norm()

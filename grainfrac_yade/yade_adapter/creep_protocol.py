@@ -39,7 +39,8 @@ import numpy as np
 
 from ..clocks import EventClock, PaperClock
 from ..errors import NumericalFailure
-from ..law import creep_step, shear_strength
+from ..creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
+from ..law import shear_strength
 from ..params import unbalanced_threshold
 from .checkpoint import Checkpointer, inexact_note, read, restore
 from .confinement import Confinement, consolidate, young_estimate
@@ -48,16 +49,9 @@ from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
 from .scene import broken_counts, build_scene, check_value, resultant_forces
 from .vtk_output import Series, write_creep_snapshot
 
-#: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
-#: is per metre of thickness; it is scaled by the layer thickness here.
-UDEC_UNIT_THICKNESS = 1.0
-#: Events between progress lines.
-PROGRESS_EVERY = 20
 #: History rows between writes of the partial history (an interrupted run keeps what it measured).
 HISTORY_FLUSH_ROWS = 50
-#: Event clock: creep intervals of length 0 in a row that break no bond (a bond handed over at its
-#: failure point that the contact law does not break) before the run ends as a numerical failure.
-MAX_STALLED_INTERVALS = 10
+
 
 
 #: The ramp fails on loading when the platen stress falls below RAMP_DROP_FRACTION of its peak, once
@@ -67,68 +61,19 @@ MAX_STALLED_INTERVALS = 10
 #: fraction of the load fails on loading at ``creep.failure_strain`` instead.
 RAMP_DROP_FRACTION = 0.7
 RAMP_DROP_MIN_PEAK = 0.5
-
-
-class CollapseWatch:
-    """Collapse of a specimen under the held load, recognised from the stress servo.
-
-    A servo saturated closing (its command clipped at +max speed) drives the platens together as
-    fast as it may because the specimen carries less than the target stress; when that lasts while
-    the axial strain grows by more than ``strain_increment``, the specimen is shortening without
-    regaining the load: it has collapsed.  A transient stress drop after a break that the specimen
-    recovers from ends the saturation before that, and any interruption starts the count again.
-
-    Fed once per check with ``saturated`` (the servo was clipped closing on every DEM step since the
-    previous check) and the axial strain at the check; :meth:`update` says whether collapse is
-    reached.  A saturated stretch is measured from the strain at the check before its first
-    saturated one (where the saturated DEM steps began).  ``strain_increment`` 0: criterion off.
-    """
-
-    def __init__(self, strain_increment: float, strain: float):
-        self.strain_increment = float(strain_increment)
-        #: axial strain at the previous check [1]
-        self.previous = float(strain)
-        #: axial strain where the current saturated stretch began [1]; None: not saturated
-        self.start = None
-        #: saturated checks in a row
-        self.checks = 0
-
-    @property
-    def growth(self) -> float:
-        """Axial strain gained in the current saturated stretch [1] (0 when not saturated)."""
-        return 0.0 if self.start is None else self.previous - self.start
-
-    def update(self, saturated: bool, strain: float) -> bool:
-        """One check; True when the saturated stretch has gained more than ``strain_increment``."""
-        if saturated:
-            if self.start is None:
-                self.start = self.previous
-            self.checks += 1
-        else:
-            self.start, self.checks = None, 0
-        self.previous = float(strain)
-        return self.strain_increment > 0 and self.start is not None and self.growth > self.strain_increment
-
-    def reason(self, steps_per_check: int) -> str:
-        """The failure reason once collapse is reached."""
-        return (f"collapse: servo at its closing speed limit for {self.checks * steps_per_check} DEM steps while "
-                f"the axial strain grew by {self.growth:.6g} > collapse_strain_increment {self.strain_increment:g}")
-
-    def state_dict(self) -> dict:
-        return {"previous": self.previous, "start": self.start, "checks": self.checks}
-
-    @classmethod
-    def from_state(cls, strain_increment: float, state: dict) -> "CollapseWatch":
-        watch = cls(strain_increment, state["previous"])
-        watch.start, watch.checks = state["start"], int(state["checks"])
-        return watch
-
-
-def collapsing(servo, steps: int, stress_ratio: float) -> bool:
-    """One check of :class:`CollapseWatch`: the servo closed the platens at its speed limit on each of the
-    last ``steps`` DEM steps and the held stress is below ``stress_ratio`` x its target (the specimen
-    carries a fraction of the load; a cascade it arrests keeps more)."""
-    return servo.closing_clipped_steps >= steps and servo.stress < stress_ratio * servo.target
+#: Axial strain between the ramp's checks of stress, target and failure [1]: the DEM steps of one
+#: check at ``creep.ramp_strain_rate``.  Small against a ramp to the target (about 3e-3 at 0.7 x the
+#: UCS), so the load overshoots the target by at most 1e-5 x E (0.7 MPa at 70 GPa); checks cost a
+#: platen read each, nothing more.
+RAMP_CHECK_STRAIN = 1e-5
+#: The servo's guess of the specimen's axial modulus is the held stress over the axial strain (the
+#: secant modulus at the end of the ramp); this floor on the strain [1] keeps it finite at a zero
+#: strain (a target of 0), far below any strain a ramp ends at (about 1e-3).
+SERVO_STRAIN_FLOOR = 1e-6
+#: Floor on that modulus guess [Pa]: 1 GPa, 70 x below the granite's E, so that a tiny or zero
+#: target (secant 0) still gives the servo a finite gain; the gain only sets how fast the servo
+#: removes its error (``creep.servo_response_steps``), not where it holds.
+SERVO_MODULUS_FLOOR = 1e9
 
 
 class CreepRun:
@@ -164,6 +109,12 @@ class CreepRun:
         self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
         self.numerical_failure = False   # NaN/inf or a stalled clock: no result (failure_reason says why)
         self.corr = None
+        #: the stress servo that holds the load (:meth:`hold_servo`) and the creep clock (:meth:`creep`);
+        #: None before the ramp ends
+        self.servo = None
+        self.clock = None
+        #: DEM steps of the last relaxation to equilibrium
+        self.last_relaxation_steps = 0
         self.n_events = 0
         self.initial_bond_stresses = None
         self.break_time = np.full(self.scene.n_bonds, np.nan)
@@ -233,7 +184,7 @@ class CreepRun:
         cp = self.params.creep
         if resume is None:
             self.platens.set_axial_velocity(cp.ramp_strain_rate * self.platens.height)
-        steps = max(1, int(round(1e-5 / (cp.ramp_strain_rate * self.scene.O.dt))))
+        steps = max(1, int(round(RAMP_CHECK_STRAIN / (cp.ramp_strain_rate * self.scene.O.dt))))
         peak = 0.0 if resume is None else float(resume["peak"])
         while True:
             if self.scene.O.iter > 0:   # not before the first step: the bonds' reference state is set by it
@@ -259,7 +210,7 @@ class CreepRun:
         cp = self.params.creep
         if cp.relaxation_damping > 0:
             self.scene.newton.damping = cp.relaxation_damping
-        young = max(self.target / max(self.platens.axial_strain(), 1e-6), 1e9)
+        young = max(self.target / max(self.platens.axial_strain(), SERVO_STRAIN_FLOOR), SERVO_MODULUS_FLOOR)
         self.servo = StressServo(self.platens, self.target, young, cp.servo_response_steps,
                                  cp.servo_max_strain_rate * self.platens.height)
         self.scene.drivers.append(self.servo)
@@ -395,143 +346,6 @@ class CreepRun:
         if self.vtk_folder is not None:
             self.write_vtk(self.rows[-1]["creep_time_s"])
         return self
-
-
-def _no_checkpoint(phase, loop):
-    """Stand-in for :meth:`CreepRun.safe_point` for holders without checkpoints."""
-
-
-def event_clock_loop(holder, corr, clock, resume=None) -> int:
-    """Event clock (ours): at equilibrium, one :func:`~grainfrac_yade.law.creep_step` under the frozen
-    stresses (to the next bond failure, or the law's loss cap); write, hand over, relax; repeat.
-
-    ``holder`` relaxes the scene (``relax(creep_time) -> bool``), records rows (``record_now``) and
-    reports progress. Returns the number of events (intervals that ended in a failure).  Each pass
-    starts at a safe point (``holder.safe_point("event", counters)``, a checkpoint if due);
-    ``resume``: the counters of such a point, to go on from it (scene and clock restored).
-    """
-    safe_point = getattr(holder, "safe_point", _no_checkpoint)
-    if resume is None:
-        n_events = stalled = 0
-        ok = holder.relax(0.0)
-        holder.record_now(0.0)   # also when that first relaxation fails: its cracks belong to the run
-        if not ok:
-            return n_events
-    else:
-        n_events, stalled = int(resume["n_events"]), int(resume["stalled"])
-    while True:
-        safe_point("event", {"n_events": n_events, "stalled": stalled})
-        broken_before = int(corr.scene.broken.sum())
-        idx = corr.intact()
-        stresses = corr.stresses(idx)
-        step = creep_step(corr.law, clock, corr.state, stresses)
-        if step.stalled:
-            break
-        corr.state = step.state
-        corr.write(idx)
-        if len(step.failing):
-            corr.hand_over_failures(step.failing, stresses.normal[step.positions], stresses.shear[step.positions],
-                                    step.modes)
-            n_events += 1
-        clock.advance(step.dt, step.failing)
-        corr.creep_time = clock.creep_time
-        ok = holder.relax(clock.creep_time)
-        holder.record_now(clock.creep_time)
-        if n_events % PROGRESS_EVERY == 0 and len(step.failing):
-            holder.progress(f"t {clock.creep_time:.4g} s  events {n_events}  broken "
-                            f"{int(corr.scene.broken.sum())}  relaxation {holder.last_relaxation_steps} steps")
-        if not ok or clock.finished:
-            break
-        stalled = stalled + 1 if step.dt == 0 and int(corr.scene.broken.sum()) == broken_before else 0
-        if stalled >= MAX_STALLED_INTERVALS:
-            raise NumericalFailure(f"{stalled} creep intervals of length 0 in a row broke no bond (creep time "
-                                   f"{clock.creep_time:.6g} s): a bond at its failure point that the contact law "
-                                   "does not break")
-    return n_events
-
-
-
-def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
-    """Paper clock (Eq. 8): every ``engine_period`` DEM steps advance creep time by the doubled or
-    reset step and degrade all intact bonds for it (the law's degrade, paper Eq. 7 by default).
-
-    Each pass starts at a safe point (``holder.safe_point("paper", counters)``, a checkpoint if
-    due); ``resume``: the counters of such a point, to go on from it (scene and clock restored).
-
-    One notion of balance: F_u below the clock's threshold (:meth:`PaperClock.balanced`) both
-    doubles the step and resets the count of DEM steps without balance; more than
-    ``creep.max_relaxation_steps`` such steps in a row is the failure "no equilibrium".  Before
-    that, collapse (:class:`CollapseWatch`, checked every ``engine_period`` DEM steps) ends the run
-    when ``creep.collapse_strain_increment`` > 0 and the holder has a stress servo.
-
-    F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
-    thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
-    the mean bond force.  With ``engine_period`` k > 1 the k steps share the F_u of the last one.
-    While F_u is at or above the threshold the law is applied every ``unbalanced_engine_period`` DEM
-    steps instead (the step then sits at dt_min: the steps add k x dt_min of creep time).
-    """
-    scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
-    safe_point = getattr(holder, "safe_point", _no_checkpoint)
-    increment = getattr(cp, "collapse_strain_increment", 0.0)
-    unbalanced_period = getattr(sc, "unbalanced_engine_period", sc.engine_period)
-    servo = getattr(holder, "servo", None)
-    if resume is None:
-        holder.record_now(0.0)
-        applications, not_balanced_steps = 0, 0
-        period = sc.engine_period
-    else:
-        applications, not_balanced_steps = int(resume["applications"]), int(resume["not_balanced_steps"])
-        period = int(resume.get("period", sc.engine_period))
-    watch = None
-    if increment > 0 and servo is not None:
-        saved = (resume or {}).get("collapse")
-        watch = (CollapseWatch.from_state(increment, saved) if saved
-                 else CollapseWatch(increment, holder.platens.axial_strain()))
-    while True:
-        counters = {"applications": applications, "not_balanced_steps": not_balanced_steps}
-        if period != sc.engine_period:
-            counters["period"] = period
-        if watch is not None:
-            counters["collapse"] = watch.state_dict()
-        safe_point("paper", counters)
-        corr.scene.run(period)
-        # a bond breaks in these DEM steps because the last creep step took it past its failure point
-        # (or its neighbours' did): it broke at the creep time that step reached, not at the next one;
-        # the steps run after the last creep step too, so no bond ends the run past its failure point
-        holder.mark_breaks(clock.creep_time)
-        idx = corr.intact()
-        if not len(idx):   # nothing left to corrode, and no bond force for the relative F_u
-            if not holder.check_failure():
-                holder.failed, holder.failure_reason = True, "every bond broken"
-            break
-        if clock.creep_time >= sc.creep_time_limit:
-            break
-        stresses = corr.stresses(idx)
-        mean_force = float(np.mean(np.hypot(stresses.normal, stresses.shear) * corr.area0[idx]))
-        f_max, rel = holder.unbalanced(mean_force)
-        f_u = f_max / scale if sc.unbalanced_force_reference == "absolute" else rel
-        dt_b = clock.advance_many([f_u] * period)
-        corr.degrade(dt_b, stresses)
-        applications += 1
-        balanced = clock.balanced(f_u)
-        not_balanced_steps = 0 if balanced else not_balanced_steps + period
-        if applications % cp.record_period == 0:
-            holder.record_now(clock.creep_time)
-        if applications % (PROGRESS_EVERY * 100) == 0:
-            holder.progress(f"t {clock.creep_time:.4g} s  step {clock.dt:.3g} s  F_u {f_u:.3g}  broken "
-                            f"{int(corr.scene.broken.sum())}  applications {applications}")
-        collapsed = watch is not None and watch.update(collapsing(servo, period, cp.collapse_stress_ratio),
-                                                       holder.platens.axial_strain())
-        if not holder.check_failure() and collapsed:
-            holder.failed, holder.failure_reason = True, watch.reason(period)
-        elif not holder.failed and not_balanced_steps > cp.max_relaxation_steps:
-            holder.failed, holder.failure_reason = True, (
-                f"no equilibrium at the held load (strain runs away): F_u at or above the paper clock's "
-                f"threshold {clock.unbalanced_force_threshold:g} for {not_balanced_steps} DEM steps")
-        if holder.failed:
-            break
-        period = sc.engine_period if balanced else unbalanced_period
-    holder.record_now(clock.creep_time)
 
 
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:

@@ -10,7 +10,7 @@ A study NAME submitted from a yade-batch table lives in ``results/NAME/`` (relat
   yade -n -x <script>`` and writes ``results/NAME/<row name>/`` exactly as a local batch row;
 - ``slurm/submit_<k>.sbatch``: the script of submission k; ``slurm/logs/row<R>_job<J>.log``: output;
 - ``slurm/tasks/row<R>.json``: the task's own record (state, job, node, times, run folder, error),
-  written by :mod:`grainfrac_yade.slurmtask`; ``slurm/tasks/row<R>_folder.json``: the run folder the
+  written by :mod:`grainfrac_yade.runs.slurmtask`; ``slurm/tasks/row<R>_folder.json``: the run folder the
   row chose (written by the YADE script as soon as it knows it).
 
 A row whose run ends without a summary.json writes ``failed.json`` (its error line) into its run
@@ -31,7 +31,7 @@ import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
 from .runio import SUMMARY, write_json
 
 #: Row states reported by ``status``.
@@ -270,7 +270,7 @@ def render_sbatch(*, study_dir: Path, options: SubmitOptions, rows, all_rows, fr
         f"# Written by: python3 -m grainfrac_yade submit {source_table} --study {options.study}",
         "# Task k runs table row k as one local yade-batch row does:",
         f"#   YADE_BATCH={rel(frozen_table)}:<line of row k> yade -n -x {rel(script)}",
-        f"# through grainfrac_yade.slurmtask, which records the task in {rel(slurm_dir(study_dir) / 'tasks')}/ and",
+        f"# through grainfrac_yade.runs.slurmtask, which records the task in {rel(slurm_dir(study_dir) / 'tasks')}/ and",
         "# writes failed.json (the error line) into the run folder if the row ends without a summary.json.",
         f"#SBATCH --job-name=grainfrac-{options.study}",
         f"#SBATCH --array={array}",
@@ -288,7 +288,7 @@ def render_sbatch(*, study_dir: Path, options: SubmitOptions, rows, all_rows, fr
         f"export YADE_BATCH=\"{rel(frozen_table)}:${{LINES[$SLURM_ARRAY_TASK_ID]}}\"",
         "export OMP_NUM_THREADS=1   # one thread per run: deterministic; a study runs in parallel across rows",
         f"export PYTHONPATH=\"{repo.resolve()}${{PYTHONPATH:+:$PYTHONPATH}}\"",
-        f"exec {DEBIAN_PYTHON} -m grainfrac_yade.slurmtask {rel(study_dir)} \"$SLURM_ARRAY_TASK_ID\" {command} -- "
+        f"exec {DEBIAN_PYTHON} -m grainfrac_yade.runs.slurmtask {rel(study_dir)} \"$SLURM_ARRAY_TASK_ID\" {command} -- "
         f"yade -n -x {rel(script)}",
     ]
     return "\n".join(head) + "\n"

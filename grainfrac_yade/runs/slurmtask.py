@@ -1,6 +1,6 @@
 """One SLURM array task: run one table row's YADE command, record the task, mark a failed row.
 
-    python3 -m grainfrac_yade.slurmtask STUDY_DIR ROW COMMAND -- yade -n -x yade_scripts/creep.py
+    python3 -m grainfrac_yade.runs.slurmtask STUDY_DIR ROW COMMAND -- yade -n -x yade_scripts/creep.py
 
 The sbatch script written by ``submit`` calls this with YADE_BATCH naming the row's table line. The
 YADE command runs exactly as one local yade-batch row (its output goes to the task's log); this
@@ -54,7 +54,7 @@ def error_line(lines, status: int | None, terminated: str | None, command) -> st
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if "--" not in argv or argv.index("--") != 3 or len(argv) < 5:
-        print("usage: python3 -m grainfrac_yade.slurmtask STUDY_DIR ROW COMMAND -- yade -n -x SCRIPT", file=sys.stderr)
+        print("usage: python3 -m grainfrac_yade.runs.slurmtask STUDY_DIR ROW COMMAND -- yade -n -x SCRIPT", file=sys.stderr)
         return 2
     study_dir, row, command_name, cmd = Path(argv[0]), int(argv[1]), argv[2], argv[4:]
     env = os.environ
