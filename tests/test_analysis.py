@@ -357,7 +357,7 @@ def test_rescaling_event_clock_study_divides_every_time_by_k(tmp_path):
 
 
 @pytest.mark.parametrize("clock,mode,reason", [("paper", "strength", "paper clock"),
-                                               ("event", "area", "only the strength laws")])
+                                               ("event", "area", "only the laws whose times scale with 1/beta1")])
 def test_rescaling_refuses_paper_clock_and_area_runs(tmp_path, clock, mode, reason):
     from grainfrac_yade.analysis.study import analyze_study
     study = make_study(tmp_path / "study", ratios=(0.7, 0.8), extra=False)
