@@ -26,7 +26,7 @@ declare -A WHAT=(
   [lifetime_small]="docs/studies/lifetime.md 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
   [lifetime_ldb]="docs/studies/lifetime.md paper size, docs/studies/creep.md 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
   [creep_numerics]="docs/studies/creep.md creep numerics (params/creep_numerics_small.table): about 1 h"
-  [brazilian]="docs/studies/brazilian.md (params/brazilian_ldb.table, docs/brazilian_study.sh)"
+  [brazilian]="docs/studies/brazilian.md (params/brazilian_ldb.table, studies/brazilian_study.sh)"
   [accuracy_cost]="docs/studies/accuracy_cost.md, docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
   [accuracy_cost_paper_size]="docs/studies/accuracy_cost.md paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
@@ -37,7 +37,7 @@ declare -A WHAT=(
 
 run_target() {
   case "$1" in
-    elastic) bash docs/elastic_study.sh
+    elastic) bash studies/elastic_study.sh
              cp results/elastic_study/w31.7e-3_s2_mesh_k2_r1_cells/contact_stress_histogram.png docs/figures/elastic_contact_stress_ldb_seed2.png ;;
     bench) $PY -m grainfrac_yade bench ;;
     calibration) $PY -m grainfrac_yade calibrate --seeds 1 2 3 4 5 --rounds 2 --jobs 2 ;;
@@ -61,7 +61,7 @@ run_target() {
                   cp results/lifetime_ldb_beta2x3/report/lifetime.png docs/figures/lifetime_ldb_beta2x3_seed1.png
                   $PY -m grainfrac_yade calibrate-beta1 results/lifetime_ldb ;;
     creep_numerics) batch params/creep_numerics_small.table creep.py creep_numerics ;;
-    brazilian) if [ -f docs/brazilian_study.sh ]; then bash docs/brazilian_study.sh
+    brazilian) if [ -f studies/brazilian_study.sh ]; then bash studies/brazilian_study.sh
                else batch params/brazilian_ldb.table brazilian.py brazilian_ldb; fi ;;
     confined) batch params/confined_ucs_small.table ucs.py confined_ucs
               $PY -m grainfrac_yade analyze-ucs results/confined_ucs
@@ -72,9 +72,9 @@ run_target() {
     accuracy_cost) $PY -m grainfrac_yade accuracy-cost --jobs 2
                    cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
-    step_floor) $PY docs/step_floor_steps.py ;;
-    regularisation) $PY docs/regularisation_steps.py
-                    $PY docs/regularisation_ucs.py ;;
+    step_floor) $PY -m studies.step_floor_steps ;;
+    regularisation) $PY -m studies.regularisation_steps
+                    $PY -m studies.regularisation_ucs ;;
     threshold) for s in 1 2; do $PY -m grainfrac_yade ucs --width 4e-3 --height 8e-3 --seed $s \
                    --out results/threshold_tiny/ucs_seed$s --overwrite; done
                batch params/threshold_study_tiny.table creep.py threshold_tiny

@@ -3,7 +3,7 @@
 Each lever changes the bonds or the cells of a scene built by :func:`.scene.build_scene` before
 the first DEM step; with every lever off (:class:`Levers` defaults) nothing is touched, so results
 are bit-identical to a scene without levers.  They are options of the ``brazilian`` command and of
-the lever study (``docs/brazilian_levers.py``, which applies them to UCS tests too), recorded in
+the lever study (``studies/brazilian_levers.py``, which applies them to UCS tests too), recorded in
 each summary.json under ``levers``; they are not model parameters (``params/``) yet, so the other
 commands (ucs, creep) do not know them.  The tensile strength of the contacts alone is a parameter
 already: ``brazilian --tensile-scale`` (contact rows' J^T).

@@ -1,6 +1,6 @@
 #!/bin/bash
 # elastic reference table: 10x20 mm seeds 1,3,5 and paper size seed 2, Tables 1 and 2 as printed
-# Regenerates docs/elastic_reference.md's table (about 2 min on one core): bash docs/elastic_study.sh
+# Regenerates docs/elastic_reference.md's table (about 2 min on one core): bash studies/elastic_study.sh
 cd "$(dirname "$0")/.."
 out=results/elastic_study; mkdir -p $out
 for spec in "10e-3 20e-3 1" "10e-3 20e-3 3" "10e-3 20e-3 5" "31.7e-3 63.4e-3 2"; do
@@ -14,7 +14,7 @@ for spec in "10e-3 20e-3 1" "10e-3 20e-3 3" "10e-3 20e-3 5" "31.7e-3 63.4e-3 2";
 done
 /usr/bin/python3 - > docs/elastic_reference.md <<'PY'
 import glob, json, os
-print("# Static elastic reference: every run of `bash docs/elastic_study.sh`\n")
+print("# Static elastic reference: every run of `bash studies/elastic_study.sh`\n")
 print("Tables 1 and 2 as printed (stiffness factor 1), uniaxial compression between smooth platens.")
 print("Run name: specimen width, seed, model, contact nodes per face (k), radial rings (r), platens.")
 print("Ratios are contact stress over the applied stress; `per face` sums the forces of a face's")

@@ -1,7 +1,7 @@
 #!/bin/bash
 # Brazilian disc study: the calibrated model's tensile strength and the levers a grain-based model has.
 # One YADE run at a time, OMP_NUM_THREADS=1; a finished run (summary.json) is skipped, so rerunning resumes.
-#   bash docs/brazilian_study.sh          # about 70 min on one core of this shared machine
+#   bash studies/brazilian_study.sh          # about 70 min on one core of this shared machine
 # Writes results/brazilian_study/<variant>/seed<N>/ and docs/brazilian_study.md (table of every variant).
 # The paper-width discs (31.7 mm, seeds 1-5) come from the yade-batch table params/brazilian_ldb.table
 # (results/brazilian_ldb/), run first here if missing.
@@ -39,10 +39,10 @@ for s in 1 2 3; do
   run ucs ucs10x20_tensile0.25 $s --width 10e-3 --height 20e-3 $(tensile 0.25)
   run ucs ucs10x20_resfric1 $s --width 10e-3 --height 20e-3 $resfric
 done
-$py docs/brazilian_levers.py $out     # slits, strength scatter, no rotation, J^T x 0.1, UCS of 8 spheres per cell
+$py -m studies.brazilian_levers $out     # slits, strength scatter, no rotation, J^T x 0.1, UCS of 8 spheres per cell
 # the most effective lever pair on one paper-width disc (about 5 min)
 [ -f results/brazilian_study_paper/d31.7_spc8_tensile0.25/seed1/summary.json ] || \
   $py -m grainfrac_yade brazilian --seed 1 --spheres-per-cell 8 --tensile-scale 0.25 --overwrite \
     --out results/brazilian_study_paper/d31.7_spc8_tensile0.25/seed1 | tail -1
-$py docs/brazilian_table.py results/brazilian_ldb $out results/brazilian_study_paper > docs/brazilian_study.md
+$py -m studies.brazilian_table results/brazilian_ldb $out results/brazilian_study_paper > docs/brazilian_study.md
 cat docs/brazilian_study.md

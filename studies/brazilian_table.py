@@ -1,6 +1,6 @@
-"""Markdown tables of the Brazilian disc study (docs/brazilian_study.sh): every variant, every seed.
+"""Markdown tables of the Brazilian disc study (studies/brazilian_study.sh): every variant, every seed.
 
-    python3 docs/brazilian_table.py results/brazilian_ldb results/brazilian_study > docs/brazilian_study.md
+    python3 -m studies.brazilian_table results/brazilian_ldb results/brazilian_study > docs/brazilian_study.md
 
 A folder holding seed*/summary.json is one variant (results/brazilian_ldb: the paper-width disc);
 a folder of such folders holds several (results/brazilian_study/<variant>/).  Brazilian and UCS
@@ -13,8 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from grainfrac_yade.brazilian_analysis import split_peak_index  # noqa: E402
+from grainfrac_yade.brazilian_analysis import split_peak_index
 
 LAB_TENSILE, LAB_UCS = 9.0e6, 200e6   # shared/reference/ldb_lab_properties.csv
 
@@ -46,7 +45,7 @@ def main(roots):
     vs = variants(roots)
     bz = {k: v for k, v in vs.items() if all("tensile_strength_pa" in s for s in v.values())}
     ucs = {k: v for k, v in vs.items() if all("ucs_pa" in s for s in v.values())}
-    print("# Brazilian disc study (`bash docs/brazilian_study.sh`)\n")
+    print("# Brazilian disc study (`bash studies/brazilian_study.sh`)\n")
     print("Calibrated parameters (shipped defaults: rigid cells, 1 sphere per cell, params/calibration.toml) "
           "unless the variant says; 1 mm grains; jaws over 10 deg, fixed across the diameter; "
           "sigma_t = 2 P / (pi D t). Central share: broken bonds within |x - x_c| <= D/6 (0.42 of the area) "

@@ -1,7 +1,7 @@
 """Is a finite-element UCS test quasi-static?  Table of the runs of params/fem_quasi_static_small.table
 (and any other UCS folders given), grouped by platen strain rate and mass scaling.
 
-    /usr/bin/python3 docs/fem_quasi_static.py results/fem_quasi_static [more folders] [--csv RUNS.csv]
+    /usr/bin/python3 -m studies.fem_quasi_static results/fem_quasi_static [more folders] [--csv RUNS.csv]
 
 Per (strain rate, density scale): the UCS, E, CI/UCS and CD/UCS of each seed, their mean, the change of
 the mean UCS against the next faster setting of the same density scale (paired seeds only), the

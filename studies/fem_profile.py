@@ -1,7 +1,7 @@
 """Where a DEM step of finite-element cells goes: per-engine timings of a loading ramp, one thread.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 docs/fem_profile.py --size small --seed 3 [--set KEY=VALUE ...]
-    OMP_NUM_THREADS=1 /usr/bin/python3 docs/fem_profile.py --size paper --seed 3
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.fem_profile --size small --seed 3 [--set KEY=VALUE ...]
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.fem_profile --size paper --seed 3
 
 Builds the specimen with ``params/presets/fem.toml`` (plus ``--params``/``--set``), moves the
 platens at ``ucs.strain_rate`` as a UCS test does, takes ``--warmup`` DEM steps, then ``--steps``
@@ -14,15 +14,13 @@ script: run them back to back (the machine is shared).
 import argparse
 import json
 import os
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from grainfrac_yade.params import load_parameters  # noqa: E402
+from grainfrac_yade.params import load_parameters
 
 SIZES = {"small": (10e-3, 20e-3), "mid": (20e-3, 40e-3), "paper": (31.7e-3, 63.4e-3)}
 FEM_PRESET = ROOT / "params" / "presets" / "fem.toml"

@@ -3,7 +3,7 @@
 docs/studies/regularisation.md.  Pure numpy (grainfrac_yade.dem_step.critical_dem_step, the YADE scene's bound),
 no YADE.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 docs/regularisation_steps.py [--table-only]
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.regularisation_steps [--table-only]
 
 Rigid cells: the shipped defaults.  Finite-element cells: params/presets/fem_calibrated.toml.
 """
@@ -11,17 +11,15 @@ from __future__ import annotations
 
 import argparse
 import csv
-import sys
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from grainfrac_yade.grains import critical_dem_step, layout_for  # noqa: E402
-from grainfrac_yade.params import PARAMS_DIR, load_parameters  # noqa: E402
-from grainfrac_yade.specimen import build_specimen  # noqa: E402
+from grainfrac_yade.grains import critical_dem_step, layout_for
+from grainfrac_yade.params import PARAMS_DIR, load_parameters
+from grainfrac_yade.specimen import build_specimen
 
 CSV = ROOT / "docs" / "regularisation_steps.csv"
 FRACTIONS = (0.0, 0.01, 0.02, 0.05, 0.10)

@@ -6,23 +6,21 @@ and a short loading ramp of ``--steps`` DEM steps timed in CPU seconds (one thre
 quasi-static test scales as 1 / DEM step at a given number of steps per second, so the gain of a
 floor is the ratio of DEM steps; the timing shows that the steps themselves cost the same.
 
-    /usr/bin/python3 docs/step_floor_steps.py [--steps 200] [--out docs/step_floor_steps.csv]
-    /usr/bin/python3 docs/step_floor_steps.py --summary-only     # the markdown summary of an existing CSV
+    /usr/bin/python3 -m studies.step_floor_steps [--steps 200] [--out docs/step_floor_steps.csv]
+    /usr/bin/python3 -m studies.step_floor_steps --summary-only     # the markdown summary of an existing CSV
 """
 from __future__ import annotations
 
 import argparse
 import csv
 import os
-import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from grainfrac_yade.params import load_parameters  # noqa: E402
-from grainfrac_yade.specimen import build_specimen  # noqa: E402
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.specimen import build_specimen
 
 #: (model label, parameter files) of the scenes measured.
 MODELS = (("rigid, 1 sphere per cell (default)", []),

@@ -1,21 +1,20 @@
 """Lever study beyond the parameters: Brazilian 15 mm discs and UCS 10 x 20 mm with the levers of
 grainfrac_yade.yade_adapter.levers (slits, strength scatter, blocked rotation), the contacts' J^T at 0.1,
-the face-lined clumps' UCS (8 spheres per cell), and rotational resistance with J^T x 0.25 and 0.1.  Run by docs/brazilian_study.sh (one YADE run at a
+the face-lined clumps' UCS (8 spheres per cell), and rotational resistance with J^T x 0.25 and 0.1.  Run by studies/brazilian_study.sh (one YADE run at a
 time, in this process); a finished run (summary.json) is skipped.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 docs/brazilian_levers.py results/brazilian_study
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.brazilian_levers results/brazilian_study
 """
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from grainfrac_yade.commands.brazilian import run_brazilian_to_folder, tensile_scale_overrides  # noqa: E402
-from grainfrac_yade.params import load_parameters  # noqa: E402
-from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json  # noqa: E402
-from grainfrac_yade.specimen import build_specimen  # noqa: E402
-from grainfrac_yade.ucs_analysis import ucs_summary  # noqa: E402
-from grainfrac_yade.yade_adapter.levers import Levers, apply_levers  # noqa: E402
+from grainfrac_yade.commands.brazilian import run_brazilian_to_folder, tensile_scale_overrides
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json
+from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.ucs_analysis import ucs_summary
+from grainfrac_yade.yade_adapter.levers import Levers, apply_levers
 
 SEEDS = (1, 2, 3)
 DISC = [("brazilian.diameter", 15e-3)]

@@ -2,7 +2,7 @@
 (``specimen.min_edge_fraction`` 0, 2 %, 5 %; seeds 1-3; params/presets/fem_calibrated.toml; one thread):
 docs/regularisation_ucs.csv and its table in docs/studies/regularisation.md.  Each run about 1-3 min.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 docs/regularisation_ucs.py [--runs DIR] [--table-only]
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.regularisation_ucs [--runs DIR] [--table-only]
 
 Runs missing in DIR (default results/regularisation_ucs, one folder f<threshold>_s<seed>) are made with
 ``python3 -m grainfrac_yade ucs``; the differences are paired: same seed, threshold against 0.

@@ -6,8 +6,8 @@
 # ratios 0.7 and 0.85 of calibration.reference_ucs, creep-time limit 1e13 s (slow runs end by failure).
 # One YADE run at a time, OMP_NUM_THREADS=1; a finished run (summary.json) is skipped, so rerunning
 # resumes; the table is rewritten after every setting (partial results).
-#   bash docs/collapse_study.sh            # about 1 h on one core of this shared machine
-#   bash docs/collapse_study.sh table      # only the table, from the runs there are
+#   bash studies/collapse_study.sh            # about 1 h on one core of this shared machine
+#   bash studies/collapse_study.sh table      # only the table, from the runs there are
 # Writes results/collapse_study/<setting>/s<seed>_r<ratio>/ (10 x 20 mm), .../small4x8/ (the 4 x 8 mm
 # reference runs of tests/test_reference_creep.py), .../paper_tiny/ and docs/collapse_study.md.
 cd "$(dirname "$0")/.."
@@ -140,7 +140,7 @@ def tables(d, title):
 d = frame(root)
 if d is None:
     sys.exit("no runs yet")
-print("# Collapse criterion study (docs/collapse_study.sh)\n")
+print("# Collapse criterion study (studies/collapse_study.sh)\n")
 print("Calibrated defaults, event clock, creep-time limit 1e13 s. Setting `off_mN`: the old criterion alone "
       "(collapse_strain_increment 0) with max_relaxation_steps N; `incX_mN`: collapse_strain_increment X with "
       "max_relaxation_steps N as backstop. Relative change: lifetime / lifetime of `off_m30000` (the old default) "
