@@ -20,7 +20,7 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
     K nodes of a face at equal spacing including both ends, each carrying its
     trapezoid share (K = 2: UDEC's corner sub-contacts, each half the face);
     ``contacts="midpoints"`` puts them at the centres of K equal sub-segments,
-    each carrying 1/K of the face (as the DEM's deformable cells do).
+    each carrying 1/K of the face.
 ``fem``
     The YADE finite-element cells (:mod:`grainfrac_yade.grains.fem`) solved
     statically: every sphere a body (translation only), bonds as YADE springs,

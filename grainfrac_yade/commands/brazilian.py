@@ -130,7 +130,7 @@ def require_disc_model(params):
     require_plane(params, "brazilian")
     if params.resolution.grain_model != "rigid":
         raise GrainfracError(f"resolution.grain_model = {params.resolution.grain_model!r}: the Brazilian disc is "
-                             "built for rigid cells only (deformable and fem cells mesh straight box walls, not the "
+                             "built for rigid cells only (fem cells mesh straight box walls, not the "
                              "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
 
 

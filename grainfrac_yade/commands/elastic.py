@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 
-#: Static models of the YADE deformable cells and the grain model each one solves.
+#: Static models of the YADE fem cells and the grain model each one solves.
 CLUSTER_MODELS = {"fem": "fem"}
 #: Names ``--grains`` no longer takes, and the fix.
 RETIRED_GRAINS = {"deformable": "the triangle-mesh reference is called mesh now; fix: --grains mesh",

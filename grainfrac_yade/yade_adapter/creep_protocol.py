@@ -56,8 +56,8 @@ HISTORY_FLUSH_ROWS = 50
 
 #: The ramp fails on loading when the platen stress falls below RAMP_DROP_FRACTION of its peak, once
 #: that peak exceeds RAMP_DROP_MIN_PEAK of the target: at the start of the ramp the stress of a
-#: specimen set in motion from rest oscillates (6 x 12 mm deformable cells: 6.8 then 4.3 MPa at
-#: axial strains of 3e-5 and 5e-5), which must not read as a failure.  A specimen weaker than that
+#: specimen set in motion from rest oscillates (6 x 12 mm, cells of the retired spring lattice: 6.8
+#: then 4.3 MPa at axial strains of 3e-5 and 5e-5), which must not read as a failure.  A specimen weaker than that
 #: fraction of the load fails on loading at ``creep.failure_strain`` instead.
 RAMP_DROP_FRACTION = 0.7
 RAMP_DROP_MIN_PEAK = 0.5
@@ -133,7 +133,7 @@ class CreepRun:
     # ------------------------------------------------------------------ measures
     def unbalanced(self, mean_bond_force):
         """Largest resultant force on a free body [N], and mean / mean_bond_force (bodies: cells, or the
-        spheres of deformable cells)."""
+        spheres of fem cells)."""
         largest, mean = resultant_forces(self.scene, self._free_ids)
         rel = mean / mean_bond_force if mean_bond_force > 0 else math.inf
         return largest, rel

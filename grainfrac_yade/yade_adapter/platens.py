@@ -6,7 +6,7 @@ platen face stays flat), and their lateral motion is free (smooth platen,
 ``platen_lateral = "free"``) or blocked (rough platen, ``"fixed"``).  The axial
 stress is the platens' reaction over the specimen cross-section (width x
 thickness); lateral strain comes from the cells on the side walls.  With
-deformable cells all bodies (spheres) of those cells take part: a platen cell's
+fem cells all bodies (spheres) of those cells take part: a platen cell's
 spheres all move at the platen's speed, and the side-wall positions are the
 means over the side cells' spheres.
 """
