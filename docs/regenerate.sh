@@ -23,11 +23,10 @@ declare -A WHAT=(
   [resolution]="docs/studies/ucs_calibration.md resolution (params/resolution_small.table): about 20 min"
   [fem_ucs]="docs/studies/deformable_grains.md fem UCS table (params/fem_ucs_small.table): about 30 min"
   [fem_creep]="docs/studies/deformable_grains.md fem creep table and the fem beta1 (params/fem_creep_small.table): about 20 min on 2 cores"
-  [lattice]="docs/studies/spring_lattice.md (params/deformable_*.table): about 3 h"
   [lifetime_small]="docs/studies/lifetime.md 10 x 20 mm (params/lifetime_small*.table, lifetime_spread_small): about 1 h"
   [lifetime_ldb]="docs/studies/lifetime.md paper size, docs/studies/creep.md 160 MPa table, beta1 calibration (params/lifetime_ldb*.table): 5-8 h"
   [creep_numerics]="docs/studies/creep.md creep numerics (params/creep_numerics_small.table): about 1 h"
-  [brazilian]="docs/studies/brazilian.md (params/brazilian_ldb.table, docs/brazilian_study.sh)"
+  [brazilian]="docs/studies/brazilian.md (params/brazilian_ldb.table, studies/brazilian_study.sh)"
   [accuracy_cost]="docs/studies/accuracy_cost.md, docs/accuracy_cost.{csv,md}, docs/figures/accuracy_cost.png (params/accuracy_cost.toml): about 70 min on 2 cores"
   [accuracy_cost_paper_size]="docs/studies/accuracy_cost.md paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
@@ -38,8 +37,8 @@ declare -A WHAT=(
 
 run_target() {
   case "$1" in
-    elastic) bash docs/elastic_study.sh
-             cp results/elastic_study/w31.7e-3_s2_deformable_k2_r1_cells/contact_stress_histogram.png docs/figures/elastic_contact_stress_ldb_seed2.png ;;
+    elastic) bash studies/elastic_study.sh
+             cp results/elastic_study/w31.7e-3_s2_mesh_k2_r1_cells/contact_stress_histogram.png docs/figures/elastic_contact_stress_ldb_seed2.png ;;
     bench) $PY -m grainfrac_yade bench ;;
     calibration) $PY -m grainfrac_yade calibrate --seeds 1 2 3 4 5 --rounds 2 --jobs 2 ;;
     calibration_check) batch params/calibration_check_ldb.table ucs.py calibration_check
@@ -51,12 +50,6 @@ run_target() {
     fem_creep) batch params/fem_creep_small.table creep.py fem_creep
                $PY -m grainfrac_yade analyze results/fem_creep
                $PY -m grainfrac_yade calibrate-beta1 results/fem_creep --out params/presets/fem_stress_corrosion_calibrated.toml ;;
-    lattice) batch params/deformable_ucs_small.table ucs.py deformable_ucs
-             batch params/deformable_creep_small.table creep.py deformable_creep
-             batch params/deformable_scaled_small.table ucs.py deformable_scaled
-             batch params/deformable_scaled_creep.table creep.py deformable_scaled
-             $PY -m grainfrac_yade analyze-ucs results/deformable_ucs
-             $PY -m grainfrac_yade analyze results/deformable_creep ;;
     lifetime_small) batch params/lifetime_small.table creep.py lifetime_small
                     batch params/lifetime_small_beta2x3.table creep.py lifetime_small_beta2x3
                     batch params/lifetime_spread_small.table creep.py lifetime_spread_small
@@ -68,7 +61,7 @@ run_target() {
                   cp results/lifetime_ldb_beta2x3/report/lifetime.png docs/figures/lifetime_ldb_beta2x3_seed1.png
                   $PY -m grainfrac_yade calibrate-beta1 results/lifetime_ldb ;;
     creep_numerics) batch params/creep_numerics_small.table creep.py creep_numerics ;;
-    brazilian) if [ -f docs/brazilian_study.sh ]; then bash docs/brazilian_study.sh
+    brazilian) if [ -f studies/brazilian_study.sh ]; then bash studies/brazilian_study.sh
                else batch params/brazilian_ldb.table brazilian.py brazilian_ldb; fi ;;
     confined) batch params/confined_ucs_small.table ucs.py confined_ucs
               $PY -m grainfrac_yade analyze-ucs results/confined_ucs
@@ -79,9 +72,9 @@ run_target() {
     accuracy_cost) $PY -m grainfrac_yade accuracy-cost --jobs 2
                    cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
-    step_floor) $PY docs/step_floor_steps.py ;;
-    regularisation) $PY docs/regularisation_steps.py
-                    $PY docs/regularisation_ucs.py ;;
+    step_floor) $PY -m studies.step_floor_steps ;;
+    regularisation) $PY -m studies.regularisation_steps
+                    $PY -m studies.regularisation_ucs ;;
     threshold) for s in 1 2; do $PY -m grainfrac_yade ucs --width 4e-3 --height 8e-3 --seed $s \
                    --out results/threshold_tiny/ucs_seed$s --overwrite; done
                batch params/threshold_study_tiny.table creep.py threshold_tiny
@@ -98,7 +91,7 @@ if [ $# -eq 0 ] || [ "$1" = list ]; then
   exit 0
 fi
 targets=("$@")
-[ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lattice lifetime_small
+[ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
                            regularisation)
 for t in "${targets[@]}"; do

@@ -329,32 +329,3 @@ def _inside_convex(poly: np.ndarray, point) -> bool:
     d = np.roll(poly, -1, axis=0) - poly
     rel = np.asarray(point) - poly
     return bool(np.all(d[:, 0] * rel[:, 1] - d[:, 1] * rel[:, 0] >= 0.0))
-
-
-def build_disc_specimen(params, seed: int, diameter: float | None = None):
-    """A disc specimen of ``params`` (diameter ``params.brazilian.diameter`` unless given).
-
-    Grain size, Lloyd iterations, edge collapse (``specimen.min_edge_fraction``), composition and mineral
-    allocation as
-    :func:`grainfrac_yade.specimen.build_specimen` (the same rng sequence: seeds, then minerals);
-    deterministic for a seed.  Plane (2D) specimens only.
-    """
-    from .minerals import allocate_minerals, mineral_clumps
-    from .regularise import regularise
-    from .specimen import Specimen
-    sp = params.specimen
-    if sp.dimension != 2:
-        raise GrainfracError(f"specimen.dimension = {sp.dimension}: discs are plane (2D) specimens; fix: set "
-                             "specimen.dimension = 2")
-    diameter = params.brazilian.diameter if diameter is None else diameter
-    check_disc_size(diameter, sp.grain_size)
-    from .specimen import check_cell_count
-    check_cell_count(n_cells_for_disc(diameter, sp.grain_size), f"the {diameter * 1e3:g} mm disc", sp.grain_size)
-    rng = np.random.default_rng(seed)
-    tess, reg = regularise(voronoi_disc(diameter, sp.grain_size, rng, sp.lloyd_iterations), sp.min_edge_fraction,
-                           sp.grain_size)
-    names = params.minerals
-    mineral = allocate_minerals(tess.cell_measure, [params.composition[m] for m in names], rng)
-    return Specimen(tessellation=tess, mineral=mineral, mineral_names=names,
-                    clump_label=mineral_clumps(tess.face_cells, mineral), thickness=sp.thickness, seed=seed,
-                    edges_collapsed=reg.edges_collapsed, edges_kept_short=reg.edges_kept_short)

@@ -8,11 +8,11 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
 
 ``rigid``
     The project's rigid cells: one body per cell (translation + rotation) and
-    the YADE bonds of :func:`~grainfrac_yade.layout.build_layout` with their
+    the YADE bonds of :mod:`grainfrac_yade.grains.rigid` with their
     series stiffness, with YADE's contact kinematics (normal along the line of
     sphere centres; rotations act on lever arms equal to the sphere radii, as
     ``Ig2_Sphere_Sphere_ScGeom`` with ``avoidGranularRatcheting``).
-``deformable``
+``mesh``
     The paper's deformable UDEC blocks: each cell a fan of linear (constant
     strain) triangles from its centroid, plane strain with its mineral's
     Table 1 moduli; cells joined at face nodes by Table 2 springs (k_n, k_s
@@ -20,12 +20,12 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
     K nodes of a face at equal spacing including both ends, each carrying its
     trapezoid share (K = 2: UDEC's corner sub-contacts, each half the face);
     ``contacts="midpoints"`` puts them at the centres of K equal sub-segments,
-    each carrying 1/K of the face (as the DEM's deformable cells do).
-``lattice`` and ``fem``
-    The YADE deformable cells (:mod:`grainfrac_yade.deformable`) solved
+    each carrying 1/K of the face.
+``fem``
+    The YADE finite-element cells (:mod:`grainfrac_yade.grains.fem`) solved
     statically: every sphere a body (translation only), bonds as YADE springs,
-    and the cell's interior as links (``grain_model = "deformable"``) or as
-    the constant-strain triangles on which the spheres sit (``"fem"``).
+    and the cell's interior as the constant-strain triangles on which the
+    spheres sit.
 
 Loading: the cells with a face on the top (bottom) wall form rigid-in-y
 platens closing by ``strain`` x height (rotation blocked, lateral motion free,
@@ -42,6 +42,7 @@ import scipy.sparse.linalg as spla
 
 from .errors import GrainfracError
 from .grainmesh import grain_mesh
+from .layout import ClumpLayout, bond_properties, mineral_pair_table
 from .params import Parameters
 from .specimen import Specimen
 
@@ -300,12 +301,10 @@ def _spring_geometry(center_a, radius_a, center_b, radius_b, body_a, body_b):
         (radius_a + radius_b) / dist
 
 
-def rigid_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
-    """Rigid cells with the project's bonds (``resolution.spheres_per_cell``) and series springs."""
-    from .layout import bond_properties, build_layout
+def rigid_network(specimen: Specimen, params: Parameters, layout: ClumpLayout) -> Network:
+    """Rigid cells of ``layout`` with the project's bonds and series springs."""
     t = specimen.tessellation
     _require_2d(t)
-    layout = layout or build_layout(specimen, params.resolution.spheres_per_cell)
     props = bond_properties(specimen, layout, params)
     s = layout.bond_spheres
     cells = layout.sphere_cell[s]
@@ -321,43 +320,29 @@ def rigid_network(specimen: Specimen, params: Parameters, layout=None) -> Networ
                    spring_torque_arm=torque_arm, spring_shear_translation_scale=shear_scale)
 
 
-def cluster_network(specimen: Specimen, params: Parameters, layout=None) -> Network:
-    """The YADE deformable cells: every sphere a body that translates only (rotations blocked, see
-    :mod:`grainfrac_yade.deformable`), bonds and links as YADE springs, finite elements as
-    constant-strain triangles of the cell's mineral (plane strain, Table 1)."""
-    from .layout import bond_properties, layout_for
+def cluster_network(specimen: Specimen, params: Parameters, layout) -> Network:
+    """The YADE finite-element cells of ``layout`` (a :class:`grainfrac_yade.grains.fem.FemLayout`):
+    every sphere a body that translates only (rotations blocked, see :mod:`grainfrac_yade.grains.fem`),
+    bonds as YADE springs acting on their faces' planes, finite elements as constant-strain triangles of
+    the cell's mineral (plane strain, Table 1)."""
     _require_2d(specimen.tessellation)
-    layout = layout or layout_for(specimen, params)
-    if layout.rigid_cells:
-        raise GrainfracError("elastic --grains lattice|fem needs resolution.grain_model = \"deformable\" or "
-                             "\"fem\"; fix: add --set resolution.grain_model=deformable (or fem)")
     props = bond_properties(specimen, layout, params)
     c2, r = layout.sphere_center[:, :2], layout.sphere_radius
-    link_spheres = layout.link_spheres if layout.n_links else np.empty((0, 2), dtype=np.int64)
-    link_kn = layout.link_normal_stiffness if layout.n_links else np.empty(0)
-    link_ks = layout.link_shear_stiffness if layout.n_links else np.empty(0)
-    pairs = np.concatenate([layout.bond_spheres, link_spheres])
+    pairs = layout.bond_spheres
     # spheres translate only and the scene takes the plain relative displacement (no ratcheting
     # guard): the arms play no part
     normal, arm, _, _ = _spring_geometry(c2[pairs[:, 0]], r[pairs[:, 0]], c2[pairs[:, 1]], r[pairs[:, 1]],
                                          c2[pairs[:, 0]], c2[pairs[:, 1]])
-    if layout.bond_normal is not None:       # bonds acting on their face's plane
-        normal[:layout.n_bonds] = layout.bond_normal
-    n_links = layout.n_links
-    if layout.n_elements:
-        tri = layout.element_spheres
-        names = specimen.mineral_names
-        d_min = plane_strain_matrix([params.grains[m].young for m in names],
-                                    [params.grains[m].poisson for m in names]) * specimen.thickness
-        tri_stiffness = d_min[specimen.mineral[layout.sphere_cell[tri[:, 0]]]]
-    else:
-        tri, tri_stiffness = np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3, 3))
+    normal[:layout.n_bonds] = layout.bond_normal      # bonds acting on their face's plane
+    tri = layout.element_spheres
+    names = specimen.mineral_names
+    d_min = plane_strain_matrix([params.grains[m].young for m in names],
+                                [params.grains[m].poisson for m in names]) * specimen.thickness
+    tri_stiffness = d_min[specimen.mineral[layout.sphere_cell[tri[:, 0]]]]
     return Network(node_pos=c2.copy(), node_rotates=np.zeros(layout.n_spheres, dtype=bool),
                    node_cell=layout.sphere_cell.copy(), spring_nodes=pairs, spring_normal=normal, spring_arm=arm,
-                   spring_kn=np.concatenate([props.normal_stiffness, link_kn]),
-                   spring_ks=np.concatenate([props.shear_stiffness, link_ks]),
-                   spring_area=np.concatenate([layout.bond_area, np.full(n_links, np.nan)]),
-                   spring_face=np.concatenate([layout.bond_face, np.full(n_links, -1)]),
+                   spring_kn=props.normal_stiffness, spring_ks=props.shear_stiffness,
+                   spring_area=layout.bond_area.copy(), spring_face=layout.bond_face.copy(),
                    tri_nodes=tri, tri_stiffness=tri_stiffness)
 
 
@@ -378,7 +363,7 @@ def _require_2d(t):
         raise GrainfracError("elastic reference: built for 2D specimens only; fix: use specimen.dimension = 2")
 
 
-def deformable_network(specimen: Specimen, params: Parameters, nodes_per_face: int = 2,
+def mesh_network(specimen: Specimen, params: Parameters, nodes_per_face: int = 2,
                        contacts: str = "corners", rings: int = 1) -> Network:
     """The deformable-block reference: triangles with their mineral's Table 1 moduli (plane strain),
     cells joined at face nodes by Table 2 springs (k_n, k_s [Pa/m] x the node's share of the face)."""
@@ -401,38 +386,42 @@ def deformable_network(specimen: Specimen, params: Parameters, nodes_per_face: i
 def contact_stiffness(specimen: Specimen, params: Parameters, faces: np.ndarray):
     """Table 2 normal and shear stiffness [Pa/m] of the mineral pair of each face (mixed pairs
     averaged), times ``calibration.stiffness_scale``."""
-    from .layout import mineral_pair_table
     kn, ks = (mineral_pair_table(specimen.mineral_names, params, a) for a in ("normal_stiffness", "shear_stiffness"))
     fm = specimen.mineral[specimen.tessellation.face_cells[faces]]
     scale = params.calibration.stiffness_scale
     return kn[fm[:, 0], fm[:, 1]] * scale, ks[fm[:, 0], fm[:, 1]] * scale
 
 
-GRAIN_MODELS = ("rigid", "deformable", "lattice", "fem")
+#: The static models: the mesh reference, and the DEM grain models whose layouts are solved statically.
+GRAIN_MODELS = ("rigid", "mesh", "fem")
+#: The static network of a DEM grain model's layout, by ``ClumpLayout.model``.
+LAYOUT_NETWORKS = {"rigid": rigid_network, "fem": cluster_network}
 
 
-def build_network(specimen: Specimen, params: Parameters, grains: str, nodes_per_face: int = 2,
-                  contacts: str = "corners", rings: int = 1) -> Network:
-    """The network of one grain model (see module doc)."""
-    if grains == "rigid":
-        return rigid_network(specimen, params)
-    if grains == "deformable":
-        return deformable_network(specimen, params, nodes_per_face, contacts, rings)
-    if grains in ("lattice", "fem"):
-        return cluster_network(specimen, params)
-    raise GrainfracError(f"elastic: grains {grains!r} unknown; fix: use one of {list(GRAIN_MODELS)}")
+def build_network(specimen: Specimen, params: Parameters, grains: str, layout: ClumpLayout | None = None,
+                  nodes_per_face: int = 2, contacts: str = "corners", rings: int = 1) -> Network:
+    """The network of one model (see module doc): the mesh reference, or the layout of a DEM grain model
+    (``layout``, built by :mod:`grainfrac_yade.grains`; required for ``rigid`` and ``fem``)."""
+    if grains == "mesh":
+        return mesh_network(specimen, params, nodes_per_face, contacts, rings)
+    if grains not in LAYOUT_NETWORKS:
+        raise GrainfracError(f"elastic: grains {grains!r} unknown; fix: use one of {list(GRAIN_MODELS)}")
+    if layout is None or layout.model != grains:
+        raise ValueError(f"elastic: the {grains} network needs a {grains} layout (grainfrac_yade.grains)")
+    return LAYOUT_NETWORKS[grains](specimen, params, layout)
 
 
-def elastic_summary(specimen: Specimen, params: Parameters, grains: str, nodes_per_face: int = 2,
-                    contacts: str = "corners", rings: int = 1, strain: float = DEFAULT_STRAIN,
-                    platens: str = "cells"):
-    """(summary dict, network, solution) of one grain model in uniaxial compression."""
-    net = build_network(specimen, params, grains, nodes_per_face, contacts, rings)
+def elastic_summary(specimen: Specimen, params: Parameters, grains: str, layout: ClumpLayout | None = None,
+                    nodes_per_face: int = 2, contacts: str = "corners", rings: int = 1,
+                    strain: float = DEFAULT_STRAIN, platens: str = "cells"):
+    """(summary dict, network, solution) of one model in uniaxial compression (``layout``: see
+    :func:`build_network`)."""
+    net = build_network(specimen, params, grains, layout, nodes_per_face, contacts, rings)
     sol = solve_uniaxial(net, specimen, strain, platens)
     summary = {"grains": grains, "young_pa": sol.young, "poisson": sol.poisson,
                "applied_stress_pa": sol.applied_stress, "axial_strain": strain,
                "n_nodes": net.n_nodes, "n_triangles": int(len(net.tri_nodes)),
                **contact_statistics(net, sol)}
-    if grains == "deformable":
+    if grains == "mesh":
         summary.update(nodes_per_face=nodes_per_face, contacts=contacts, rings=rings)
     return summary, net, sol

@@ -12,7 +12,7 @@ deformable blocks, each carrying half the face); ``contacts="midpoints"`` puts
 them at the centres of K equal sub-segments, each carrying 1/K.
 
 Used by the static elastic reference (:mod:`grainfrac_yade.elastic`) and by the
-DEM's deformable cells (:mod:`grainfrac_yade.deformable`), so both discretise a
+DEM's fem cells (:mod:`grainfrac_yade.grains.fem`), so both discretise a
 face alike.
 """
 from __future__ import annotations

@@ -1,38 +1,30 @@
-"""Spheres that realise each Voronoi cell, and the bonds between them (pure numpy).
+"""The data of a grain model's spheres and bonds, and what every model derives from it (pure numpy).
 
-Two layouts, chosen by ``resolution.spheres_per_cell`` (N):
-
-* N = 1: one sphere per cell at its centroid, radius = distance from the
-  centroid to the nearest face (the sphere lies inside its cell, so no two
-  cells' spheres overlap).  One bond per interior face.
-* N > 1 (2D only): a *face-lined clump*.  Sphere size s = mean cell perimeter / N;
-  each interior face of length L carries k = max(1, round(L/s)) sphere pairs
-  at the centres of k equal sub-segments, one sphere on each side, tangent to
-  the face at that point (radius L/(2k), reduced where a neighbouring face of
-  the cell is closer), so the pair touches exactly on the face and its bond
-  normal is the face normal.  Each pair carries one bond of area A_face/k.
-  The cell interior holds no spheres: members of one clump never interact,
-  and the clump's mass and inertia are those of the polygon (set by the adapter).
-  The realised spheres per cell are therefore ~ n_faces * k (about 6 per
-  face pair level), reported as ``mean_spheres_per_cell``.
-
-Both layouts give, for every face, bonds whose areas sum to the face area.
+:class:`ClumpLayout` holds the spheres that realise the Voronoi cells (grouped by cell) and the bonds
+between them (grouped by face); the grain models of :mod:`grainfrac_yade.grains` build it (the
+subclass :class:`grainfrac_yade.grains.fem.FemLayout` adds the finite elements).  Every face's bonds
+have areas that sum to the face area.  :func:`bond_properties` gives every bond its Table 2 stiffness
+(with the grain in series) and strengths, :func:`cell_mass_inertia` every cell its mass and inertia,
+:func:`step_floor_factors` the per-cell density scaling of ``numerics.step_floor_quantile``.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from .errors import GrainfracError
 from .params import Parameters
 from .specimen import Specimen
 
 
 @dataclass(frozen=True)
 class ClumpLayout:
-    """Spheres (grouped by cell) and bonds (grouped by face)."""
+    """Spheres (grouped by cell) and bonds (grouped by face) of rigid cells; the base of every layout.
+
+    ``model`` (a class attribute, not a field) names the grain model of :mod:`grainfrac_yade.grains`
+    that builds and runs this kind of layout."""
     sphere_cell: np.ndarray     # (s,) cell of each sphere
     sphere_center: np.ndarray   # (s, 3) [m]; 2D specimens lie in the plane z = thickness/2
     sphere_radius: np.ndarray   # (s,) [m]
@@ -40,31 +32,10 @@ class ClumpLayout:
     bond_face: np.ndarray       # (b,) face index
     bond_area: np.ndarray       # (b,) [m^2]
     bond_point: np.ndarray      # (b, 3) contact point on the face [m]
-    #: False for deformable cells (``resolution.grain_model = "deformable"``): every sphere is a
-    #: body of its own, and the spheres of one cell are held together by the links below
-    rigid_cells: bool = True
-    link_spheres: np.ndarray | None = None           # (m, 2) sphere pairs of unbreakable intra-cell links
-    link_normal_stiffness: np.ndarray | None = None  # (m,) [N/m]
-    link_shear_stiffness: np.ndarray | None = None   # (m,) [N/m]
-    sphere_area: np.ndarray | None = None            # (s,) cell area lumped on each sphere [m^2] (mass share)
-    #: (e, 3) sphere triangles of finite-element cells (``grain_model = "fem"``): each a constant-strain
-    #: element of its cell's mineral (plane strain, Table 1), the mesh on which the spheres sit
-    element_spheres: np.ndarray | None = None
-    #: (b, 2) unit normal of each bond's face (from the face's cell a to b) where bonds act on their
-    #: face's plane (YADE's smooth-joint kinematics: opening and sliding measured along and across the
-    #: face, as the reference's contacts); None: along the line of the two sphere centres
-    bond_normal: np.ndarray | None = None
     #: fraction of the centroid-to-face distance of grain in series with each bond (1: rigid cells,
-    #: whose elasticity lives in the bonds; the inset of deformable cells, whose links carry the rest)
+    #: whose elasticity lives in the bonds; the inset of fem cells, whose elements carry the rest)
     series_fraction: float = 1.0
-
-    @property
-    def n_links(self) -> int:
-        return 0 if self.link_spheres is None else len(self.link_spheres)
-
-    @property
-    def n_elements(self) -> int:
-        return 0 if self.element_spheres is None else len(self.element_spheres)
+    model: ClassVar[str] = "rigid"
 
     @property
     def n_spheres(self) -> int:
@@ -73,99 +44,6 @@ class ClumpLayout:
     @property
     def n_bonds(self) -> int:
         return len(self.bond_face)
-
-
-def build_layout(specimen: Specimen, spheres_per_cell: int) -> ClumpLayout:
-    """Sphere layout of ``specimen`` at resolution ``spheres_per_cell`` (see module doc)."""
-    t = specimen.tessellation
-    if spheres_per_cell == 1:
-        return _single_sphere_layout(specimen)
-    if t.dim != 2:
-        raise GrainfracError("resolution.spheres_per_cell: clumps of several spheres are built for "
-                             "2D specimens only; fix: use spheres_per_cell = 1 with specimen.dimension = 3")
-    return _face_lined_layout(specimen, spheres_per_cell)
-
-
-def layout_for(specimen: Specimen, params: Parameters) -> ClumpLayout:
-    """The layout of ``params.resolution``: rigid cells (``spheres_per_cell``) or deformable cells."""
-    if params.resolution.grain_model == "deformable":
-        from .deformable import build_deformable_layout
-        return build_deformable_layout(specimen, params)
-    if params.resolution.grain_model == "fem":
-        from .deformable import build_fem_layout
-        return build_fem_layout(specimen, params)
-    return build_layout(specimen, params.resolution.spheres_per_cell)
-
-
-def _to3d(points: np.ndarray, z: float) -> np.ndarray:
-    if points.shape[1] == 3:
-        return points
-    return np.column_stack([points, np.full(len(points), z)])
-
-
-def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Distance from points p (..., 2) to segments a-b (..., 2)."""
-    ab = b - a
-    u = np.clip(((p - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-300), 0.0, 1.0)
-    return np.linalg.norm(p - (a + u[..., None] * ab), axis=-1)
-
-
-def _cell_face_distance(t, cell: int, point: np.ndarray) -> float:
-    """Distance from ``point`` to the nearest edge (2D) or face plane (3D) of ``cell``."""
-    verts = t.cell_vertices[cell]
-    if t.dim == 2:
-        return float(_segment_distance(point, verts, np.roll(verts, -1, axis=0)).min())
-    from scipy.spatial import ConvexHull
-    eq = ConvexHull(verts).equations  # n.x + d <= 0 inside
-    return float(np.min(-(eq[:, :3] @ point + eq[:, 3])))
-
-
-def _single_sphere_layout(specimen: Specimen) -> ClumpLayout:
-    t = specimen.tessellation
-    z = specimen.thickness / 2.0
-    radius = np.array([_cell_face_distance(t, i, t.cell_centroid[i]) for i in range(t.n_cells)])
-    return ClumpLayout(
-        sphere_cell=np.arange(t.n_cells), sphere_center=_to3d(t.cell_centroid, z), sphere_radius=radius,
-        bond_spheres=t.face_cells.copy(), bond_face=np.arange(t.n_faces),
-        bond_area=specimen.face_area.copy(), bond_point=_to3d(t.face_midpoint, z))
-
-
-def _face_lined_layout(specimen: Specimen, spheres_per_cell: int) -> ClumpLayout:
-    t = specimen.tessellation
-    z = specimen.thickness / 2.0
-    perimeter = np.bincount(t.face_cells.ravel(), weights=np.repeat(t.face_measure, 2), minlength=t.n_cells)
-    perimeter += np.bincount(t.boundary_cell, weights=t.boundary_measure, minlength=t.n_cells)
-    size = perimeter.mean() / spheres_per_cell
-    sphere_cell, centers, radii, pairs, faces, areas, points = [], [], [], [], [], [], []
-    face_area = specimen.face_area
-    for f, (a, b) in enumerate(t.face_cells):
-        v0, v1 = t.face_vertices[f]
-        length = t.face_measure[f]
-        k = max(1, int(round(length / size)))
-        n = t.face_normal[f]
-        for j in range(k):
-            x = v0 + (j + 0.5) / k * (v1 - v0)
-            r = length / (2 * k)
-            # keep both spheres inside their cells: r <= half the distance from x to the cell's other edges
-            for cell in (a, b):
-                verts = t.cell_vertices[cell]
-                d = _segment_distance(x, verts, np.roll(verts, -1, axis=0))
-                others = d[d > 1e-9 * length]
-                if len(others):
-                    r = min(r, 0.5 * others.min())
-            ia = len(sphere_cell)
-            sphere_cell += [a, b]
-            centers += [x - r * n, x + r * n]
-            radii += [r, r]
-            pairs.append((ia, ia + 1))
-            faces.append(f)
-            areas.append(face_area[f] / k)
-            points.append(x)
-    return ClumpLayout(
-        sphere_cell=np.array(sphere_cell), sphere_center=_to3d(np.array(centers), z),
-        sphere_radius=np.array(radii), bond_spheres=np.array(pairs, dtype=np.int64),
-        bond_face=np.array(faces, dtype=np.int64), bond_area=np.array(areas),
-        bond_point=_to3d(np.array(points), z))
 
 
 def mineral_pair_table(names, params: Parameters, attr: str) -> np.ndarray:

@@ -33,7 +33,9 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy.spatial import cKDTree
 
+from .disc import SAME_POINT_FRACTION, _arc_points, _quadrant_side, _segment_area_moment, _shoelace
 from .errors import GrainfracError
 from .tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _polygon_area_centroid
 
@@ -328,8 +330,6 @@ def _disc_mesh(tess, grain_size: float) -> _PlaneMesh:
 
     End points closer than the disc's same-point tolerance are one vertex (the two cells of a face clip
     it separately, so its end points agree only to rounding)."""
-    from scipy.spatial import cKDTree
-    from .disc import SAME_POINT_FRACTION
     centre, radius = tess.centre, tess.radius
     pieces = []   # (cell, p_start, p_end, is_arc, mid)
     for f, (a, b) in enumerate(tess.face_cells):
@@ -392,7 +392,6 @@ def _disc_mesh(tess, grain_size: float) -> _PlaneMesh:
 
 
 def _rebuild_disc(tess, mesh: _PlaneMesh, grain_size: float):
-    from .disc import _arc_points, _quadrant_side, _segment_area_moment, _shoelace
     centre, radius = tess.centre, tess.radius
     cell_vertices = list(tess.cell_vertices)
     measure, centroid = tess.cell_measure.copy(), tess.cell_centroid.copy()

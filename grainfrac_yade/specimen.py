@@ -9,10 +9,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .disc import check_disc_size, n_cells_for_disc, voronoi_disc
+from .errors import GrainfracError
 from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
 from .params import Parameters
 from .regularise import regularise
-from .tessellation import Tessellation, voronoi_box
+from .tessellation import Tessellation, n_cells_for, voronoi_box
 
 
 @dataclass(frozen=True)
@@ -103,7 +105,6 @@ def check_cell_count(n_cells: int, what: str, grain_size: float, flags: str = ""
     """Refuse, before anything is allocated, a specimen of more cells than this machine's memory holds
     (:data:`BYTES_PER_CELL` each): one line with the cell count (``flags``: the shortcut flags that gave the
     size, named first)."""
-    from .errors import GrainfracError
     limit = memory_bytes() / BYTES_PER_CELL
     if n_cells > limit:
         raise GrainfracError(f"{flags + ': ' if flags else ''}specimen.grain_size = {grain_size:g} m: {what} would have {n_cells:.3g} cells, more than "
@@ -114,7 +115,6 @@ def check_cell_count(n_cells: int, what: str, grain_size: float, flags: str = ""
 def build_specimen(params: Parameters, seed: int) -> Specimen:
     """Tessellate the specimen of ``params.specimen``, collapse its short edges
     (``specimen.min_edge_fraction``, :mod:`grainfrac_yade.regularise`) and allocate minerals (seeded)."""
-    from .tessellation import n_cells_for
     sp = params.specimen
     box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
     check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
@@ -125,6 +125,31 @@ def build_specimen(params: Parameters, seed: int) -> Specimen:
     names = params.minerals
     fractions = [params.composition[m] for m in names]
     mineral = allocate_minerals(tess.cell_measure, fractions, rng)
+    return Specimen(tessellation=tess, mineral=mineral, mineral_names=names,
+                    clump_label=mineral_clumps(tess.face_cells, mineral), thickness=sp.thickness, seed=seed,
+                    edges_collapsed=reg.edges_collapsed, edges_kept_short=reg.edges_kept_short)
+
+
+def build_disc_specimen(params, seed: int, diameter: float | None = None):
+    """A disc specimen of ``params`` (diameter ``params.brazilian.diameter`` unless given).
+
+    Grain size, Lloyd iterations, edge collapse (``specimen.min_edge_fraction``), composition and mineral
+    allocation as
+    :func:`build_specimen` (the same rng sequence: seeds, then minerals);
+    deterministic for a seed.  Plane (2D) specimens only.
+    """
+    sp = params.specimen
+    if sp.dimension != 2:
+        raise GrainfracError(f"specimen.dimension = {sp.dimension}: discs are plane (2D) specimens; fix: set "
+                             "specimen.dimension = 2")
+    diameter = params.brazilian.diameter if diameter is None else diameter
+    check_disc_size(diameter, sp.grain_size)
+    check_cell_count(n_cells_for_disc(diameter, sp.grain_size), f"the {diameter * 1e3:g} mm disc", sp.grain_size)
+    rng = np.random.default_rng(seed)
+    tess, reg = regularise(voronoi_disc(diameter, sp.grain_size, rng, sp.lloyd_iterations), sp.min_edge_fraction,
+                           sp.grain_size)
+    names = params.minerals
+    mineral = allocate_minerals(tess.cell_measure, [params.composition[m] for m in names], rng)
     return Specimen(tessellation=tess, mineral=mineral, mineral_names=names,
                     clump_label=mineral_clumps(tess.face_cells, mineral), thickness=sp.thickness, seed=seed,
                     edges_collapsed=reg.edges_collapsed, edges_kept_short=reg.edges_kept_short)

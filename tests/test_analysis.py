@@ -357,7 +357,7 @@ def test_rescaling_event_clock_study_divides_every_time_by_k(tmp_path):
 
 
 @pytest.mark.parametrize("clock,mode,reason", [("paper", "strength", "paper clock"),
-                                               ("event", "area", "only the strength laws")])
+                                               ("event", "area", "only the laws whose times scale with 1/beta1")])
 def test_rescaling_refuses_paper_clock_and_area_runs(tmp_path, clock, mode, reason):
     from grainfrac_yade.analysis.study import analyze_study
     study = make_study(tmp_path / "study", ratios=(0.7, 0.8), extra=False)
@@ -399,7 +399,7 @@ SMALL = ["specimen.width=6e-3", "specimen.height=12e-3"]
 @pytest.fixture(scope="module")
 def real_run():
     """A real parameter set (small specimen), its specimen and layout as the run would build them."""
-    from grainfrac_yade.layout import build_layout
+    from grainfrac_yade.grains.rigid import build_layout
     from grainfrac_yade.params import load_parameters
     from grainfrac_yade.specimen import build_specimen
     params = load_parameters(overrides=SMALL)
@@ -424,7 +424,7 @@ def write_real_run(root, real_run, name="real_run", n_bonds=None):
 
 def test_parameters_from_json_round_trips_and_fills_older_files(tmp_path, real_run):
     from grainfrac_yade.analysis.runparams import load_run_parameters, parameters_from_json, rebuild_specimen
-    from grainfrac_yade.layout import build_layout
+    from grainfrac_yade.grains.rigid import build_layout
     params, seed, specimen, layout = real_run
     d = write_real_run(tmp_path, real_run)
     assert parameters_from_json(d / "params.json") == params      # contacts "a/b", friction in degrees

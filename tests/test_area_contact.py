@@ -1,6 +1,6 @@
 """Area law in YADE: a broken or corroded-away bond becomes a contact of the full stiffness k_n0, k_s0 that
 carries its compression, instead of keeping the corroded stiffness (down to 1e-9 k_n0), through which the
-grains would pass.  One bond between two cells under a constant force (grainfrac_yade.yade_adapter.single_bond);
+grains would pass.  One bond between two cells under a constant force (tests/single_bond.py);
 about 1 s per case.  (A bond the area law breaks in shear cannot be checked this way: under a constant shear
 force that beat full friction, residual friction cannot hold it and the cell slides away.)"""
 import pytest
@@ -19,8 +19,8 @@ def _corrode(normal_stress, shear_stress, restore=True, monkeypatch=None):
     """Corrode one bond under a constant force to its break; then AFTER_STEPS more DEM steps.
     Returns (holder, penetration at a = 1, at the break, after the steps, normal force after [N])."""
     from grainfrac_yade.clocks import EventClock
-    from grainfrac_yade.yade_adapter.creep_test import event_clock_loop
-    from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
+    from grainfrac_yade.creep_loops import event_clock_loop
+    from single_bond import BondUnderForce
     p = load_parameters(overrides=AREA)
     holder = BondUnderForce(p, normal_stress, shear_stress)
     if not restore:

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from conftest import ROOT, needs_yade
-from grainfrac_yade.batchrun import run_batch, write_table
+from grainfrac_yade.runs.batchrun import run_batch, write_table
 
 pytestmark = [needs_yade, pytest.mark.yade]
 

@@ -55,13 +55,12 @@ def test_quick_bench_writes_every_key(quick_bench):
     assert set(data) == {"bench", "machine", "scenes", "peak_rss_mb"}   # no runs to failure in --quick
     assert data["bench"]["quick"] is True
     assert MACHINE_KEYS <= set(data["machine"])
-    assert set(data["scenes"]) == {"rigid_1", "rigid_8", "deformable", "fem"}
+    assert set(data["scenes"]) == {"rigid_1", "rigid_8", "fem"}
     for key, scene in data["scenes"].items():
         assert SCENE_KEYS <= set(scene), key
         assert EVENT_KEYS <= set(scene["events"]), key
         assert scene["equilibrium_at_hold"] is True and scene["held_after_events"] is True, key
     assert [s["spheres_per_cell"] for s in data["scenes"].values()][:2] == [1, 8]
-    assert data["scenes"]["deformable"]["grain_model"] == "deformable"
     assert data["scenes"]["fem"]["grain_model"] == "fem"
 
 

@@ -10,10 +10,10 @@ import pytest
 from conftest import ROOT, needs_yade
 from grainfrac_yade.brazilian_analysis import (central_band_area_fraction, crack_location, hondros_centre_factor,
                                                in_central_band, tensile_stress)
-from grainfrac_yade.disc import (DiscTessellation, build_disc_specimen, clip_polygon_to_disc, tessellate_disc,
-                                 voronoi_disc)
+from grainfrac_yade.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
+from grainfrac_yade.specimen import build_disc_specimen
 from grainfrac_yade.tessellation import SIDES
 
 #: Tiny disc for the YADE runs: 8 mm, 1 mm grains (64 cells, 2-5 s a run); the CLI test runs 5 mm.
@@ -171,7 +171,7 @@ def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack():
     ends at 0.44 (0.73 at the peak) after post-peak cracking, and a 6 mm disc (36 cells) ends at 0.46-0.60.
     """
     from grainfrac_yade.brazilian_analysis import brazilian_summary
-    from grainfrac_yade.yade_adapter.brazilian_test import run_brazilian
+    from grainfrac_yade.yade_adapter.brazilian_protocol import run_brazilian
     p = load_parameters(overrides=TINY)
     for seed in (1, 2, 3):
         sp = build_disc_specimen(p, seed)
@@ -194,7 +194,7 @@ def test_tensile_scale_lowers_the_strength():
     measured 37.7 -> 31.0 MPa, -18 %: the split's zigzag faces fail in shear as well as in tension)."""
     from grainfrac_yade.brazilian_analysis import brazilian_summary
     from grainfrac_yade.commands.brazilian import check_tensile_scale, tensile_scale_overrides
-    from grainfrac_yade.yade_adapter.brazilian_test import run_brazilian
+    from grainfrac_yade.yade_adapter.brazilian_protocol import run_brazilian
     base = load_parameters(overrides=TINY)
     half = load_parameters(overrides=TINY + tensile_scale_overrides(base, 0.5))
     check_tensile_scale(base, half, 0.5)
@@ -257,7 +257,7 @@ def test_params_json_written_before_the_brazilian_section_still_loads(tmp_path):
 def test_levers_off_change_nothing_and_slits_are_not_cracks():
     """Levers() leaves a run bit-identical; slits start broken (mode PRE_EXISTING), are left out of the crack
     counts, and lower the strength; blocked rotation blocks every cell's Z rotation (8 mm disc, seed 1)."""
-    from grainfrac_yade.yade_adapter.brazilian_test import run_brazilian
+    from grainfrac_yade.yade_adapter.brazilian_protocol import run_brazilian
     from grainfrac_yade.yade_adapter.levers import PRE_EXISTING, Levers, apply_levers
     from grainfrac_yade.yade_adapter.scene import build_scene
     p = load_parameters(overrides=TINY)
@@ -282,7 +282,7 @@ def test_levers_off_change_nothing_and_slits_are_not_cracks():
 def test_batch_row_runs_a_disc_and_a_rerun_skips_it(tmp_path):
     """yade_scripts/brazilian.py through yade-batch (one job): a 5 mm row writes its run folder; run again, the
     finished row is skipped."""
-    from grainfrac_yade.batchrun import run_batch, write_table
+    from grainfrac_yade.runs.batchrun import run_batch, write_table
     out = tmp_path / "row"
     table = write_table(tmp_path / "bz.table", [{"brazilian.diameter": 5e-3, "seed": 2, "out": str(out)}])
     script = ROOT / "yade_scripts" / "brazilian.py"

@@ -15,9 +15,9 @@ from conftest import needs_yade
 from grainfrac_yade.clocks import PaperClock
 from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.yade_adapter.creep_test import CollapseWatch, collapsing
+from grainfrac_yade.creep_loops import CollapseWatch, collapsing
 from grainfrac_yade.yade_adapter.platens import StressServo
-from test_reliability import JC, JT, StandInBonds, StandInHolder
+from test_reliability import JC, JT, StandInBonds, StandInHolder, loop_params
 
 
 def _feed(watch, checks):
@@ -133,11 +133,12 @@ class CollapsingHolder(StandInHolder):
 
 
 def _paper(holder, increment, max_relaxation_steps=1000):
-    from grainfrac_yade.yade_adapter.creep_test import paper_clock_loop
+    from grainfrac_yade.creep_loops import paper_clock_loop
     clock = PaperClock(1e-5, 1e4, 1e-2)
-    sc = SimpleNamespace(creep_time_limit=1e9, engine_period=1, unbalanced_force_reference="relative")
-    cp = SimpleNamespace(record_period=10**9, max_relaxation_steps=max_relaxation_steps,
-                         collapse_strain_increment=increment, collapse_stress_ratio=0.25)
+    sc, cp = loop_params({"creep_time_limit": 1e9, "engine_period": 1, "unbalanced_engine_period": 1,
+                          "unbalanced_force_reference": "relative"},
+                         {"record_period": 10**9, "max_relaxation_steps": max_relaxation_steps,
+                          "collapse_strain_increment": increment, "collapse_stress_ratio": 0.25})
     paper_clock_loop(holder, StandInBonds([1e6], [5e6], JT, JC), clock, sc, cp)
     return holder, clock
 
@@ -199,7 +200,7 @@ def test_a_tiny_specimen_ends_by_collapse_early_with_the_lifetime_of_the_criteri
     ``max_relaxation_steps``; with the criterion off the same run waits for the backstop.  Everything
     before the final relaxation is the same, so the lifetime is the same to the last bit."""
     from grainfrac_yade.specimen import build_specimen
-    from grainfrac_yade.yade_adapter.creep_test import run_creep
+    from grainfrac_yade.yade_adapter.creep_protocol import run_creep
     base = ["specimen.width=3e-3", "specimen.height=6e-3", "stress_corrosion.creep_time_limit=1e13",
             "numerics.checkpoint_interval=0"]
     runs = {}

@@ -28,8 +28,8 @@ def _closed_form_shear(c0, tau, s_n, tan_phi):
 
 def _run(clock, sigma, tau, extra=()):
     from grainfrac_yade.clocks import EventClock, PaperClock
-    from grainfrac_yade.yade_adapter.creep_test import event_clock_loop, paper_clock_loop
-    from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
+    from grainfrac_yade.creep_loops import event_clock_loop, paper_clock_loop
+    from single_bond import BondUnderForce
     p = _params(clock, extra)
     holder = BondUnderForce(p, sigma, tau)
     sc = p.stress_corrosion
@@ -83,7 +83,7 @@ def test_engine_state_round_trip():
     """The corrosion engine's whole state (the law's strengths, creep time) saves and restores."""
     import json
     from grainfrac_yade.clocks import EventClock
-    from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
+    from single_bond import BondUnderForce
     p = _params("event")
     a = BondUnderForce(p, 5e6, 0.0)
     a.corr.degrade(1e6, a.corr.stresses([0]))

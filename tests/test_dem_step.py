@@ -1,7 +1,7 @@
 """Critical DEM step without YADE (grainfrac_yade/dem_step.py) against the YADE scene's ``dt_critical``.
 
 The scene sets its masses and step with the same functions, so the two are equal to the last bit for
-bodies whose positions the core knows exactly (one sphere per cell, deformable and fem spheres: YADE
+bodies whose positions the core knows exactly (one sphere per cell, fem spheres: YADE
 stores the given centres).  Clumps: YADE sums its members' masses and positions itself; the core's
 weighted mean agrees to rounding (1e-12 relative: a few additions of float64).
 """
@@ -12,7 +12,7 @@ import json
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.dem_step import critical_dem_step
+from grainfrac_yade.grains import critical_dem_step
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
 
@@ -22,7 +22,6 @@ CLUMP_REL = 1e-12   # see module doc
 MODELS = {
     "rigid": [],
     "rigid_clumps": ["resolution.spheres_per_cell=8"],
-    "deformable": ["resolution.grain_model=deformable"],
     "fem": ["resolution.grain_model=fem"],
     "fem_regularised_floor": ["resolution.grain_model=fem", "specimen.min_edge_fraction=0.05",
                               "numerics.step_floor_quantile=0.3"],

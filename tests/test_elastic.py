@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.elastic import (deformable_network, elastic_summary, plane_strain_matrix, rigid_network,
+from grainfrac_yade.elastic import (mesh_network, elastic_summary, plane_strain_matrix, rigid_network,
                                     solve_uniaxial)
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grainmesh import face_node_positions, grain_mesh
+from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
 
@@ -27,7 +28,7 @@ def test_patch_test_one_mineral_with_stiff_contacts_gives_table_1(nodes_per_face
     p = load_parameters(overrides=SMALL + ["calibration.stiffness_scale=1e4"])
     s = _one_mineral(p)
     g = p.grains[s.mineral_names[0]]
-    sol = solve_uniaxial(deformable_network(s, p, nodes_per_face, "corners", rings), s, platens="wall")
+    sol = solve_uniaxial(mesh_network(s, p, nodes_per_face, "corners", rings), s, platens="wall")
     assert sol.young == pytest.approx(g.young / (1 - g.poisson**2), rel=0.01)
     assert sol.poisson == pytest.approx(g.poisson / (1 - g.poisson), rel=0.01)
 
@@ -69,19 +70,19 @@ def test_face_node_positions_refuse_one_corner_node():
         face_node_positions(1, "corners")
 
 
-def test_deformable_cells_concentrate_shear_more_than_rigid_cells(small_params):
+def test_mesh_cells_concentrate_shear_more_than_rigid_cells(small_params):
     """The reason deformable grains matter: at the same load the contact shear tail is higher."""
     s = build_specimen(small_params, 1)
-    rigid, _, _ = elastic_summary(s, small_params, "rigid")
-    deformable, _, _ = elastic_summary(s, small_params, "deformable")
-    assert deformable["shear_stress_ratio_p99"] > 1.3 * rigid["shear_stress_ratio_p99"]
-    assert deformable["young_pa"] > rigid["young_pa"]
+    rigid, _, _ = elastic_summary(s, small_params, "rigid", build_layout(s, 1))
+    mesh, _, _ = elastic_summary(s, small_params, "mesh")
+    assert mesh["shear_stress_ratio_p99"] > 1.3 * rigid["shear_stress_ratio_p99"]
+    assert mesh["young_pa"] > rigid["young_pa"]
 
 
 def test_ratios_do_not_depend_on_the_applied_strain(small_params):
     s = build_specimen(small_params, 1)
-    a, _, _ = elastic_summary(s, small_params, "deformable", strain=1e-4)
-    b, _, _ = elastic_summary(s, small_params, "deformable", strain=3e-3)
+    a, _, _ = elastic_summary(s, small_params, "mesh", strain=1e-4)
+    b, _, _ = elastic_summary(s, small_params, "mesh", strain=3e-3)
     for key in ("young_pa", "poisson", "shear_stress_ratio_p99", "tension_stress_ratio_max"):
         assert a[key] == pytest.approx(b[key], rel=1e-9)
 
@@ -95,7 +96,7 @@ def test_elastic_command_writes_summary_and_histogram(tmp_path):
                 "tension_stress_ratio_p50", "tension_stress_ratio_p99", "tension_stress_ratio_max"):
         assert np.isfinite(summary[key])
         assert np.isfinite(summary["models"]["rigid"][key])
-    assert summary["grains"] == "deformable"
+    assert summary["grains"] == "mesh"
     assert (out / "contact_stress_histogram.png").stat().st_size > 10_000
     assert (out / "params.json").exists() and (out / "run.json").exists()
 
@@ -135,15 +136,3 @@ def _assert_yade_ramp_matches_static_solve(p, network, relax_steps):
     assert platens.axial_stress() == pytest.approx(sol.applied_stress, rel=1e-3)
     assert np.abs(fn - sol.normal_force[:nb]).max() < 1e-3 * scale
     assert np.abs(fs - np.abs(sol.shear_force[:nb])).max() < 1e-3 * scale
-
-
-@needs_yade
-@pytest.mark.yade
-def test_deformable_scene_agrees_with_the_lattice_solve_after_a_small_elastic_ramp():
-    """The YADE scene of deformable cells is the spring lattice that the static solve models:
-    after a slow ramp to a strain of 2e-4 and relaxation, the platen stress and every bond's
-    forces agree with :func:`cluster_network`'s solution (the same check as for rigid cells)."""
-    from grainfrac_yade.elastic import cluster_network
-    p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.damping=0.7",
-                                   "resolution.grain_model=deformable"])
-    _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=40000)

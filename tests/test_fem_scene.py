@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.deformable import build_fem_layout, element_apex
-from grainfrac_yade.elastic import (cluster_network, contact_statistics, deformable_network, node_stiffness,
+from grainfrac_yade.grains.fem import build_fem_layout, element_apex
+from grainfrac_yade.elastic import (cluster_network, contact_statistics, mesh_network, node_stiffness,
                                     solve_uniaxial, stiffness_matrix)
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
@@ -43,7 +43,7 @@ def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes():
     10 x 20 mm seed 1: E -3.0 / -1.0 / -0.1 % at insets 0.03 / 0.01 / 0.001, nu within 0.3 %)."""
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 1)
-    ref = solve_uniaxial(deformable_network(s, p, p.resolution.nodes_per_face), s)
+    ref = solve_uniaxial(mesh_network(s, p, p.resolution.nodes_per_face), s)
     errors = []
     for inset in (0.03, 0.01, 0.001):
         q = _with_inset(p, inset)
@@ -55,7 +55,7 @@ def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes():
 
 
 def test_contact_radii_leave_unbonded_spheres_of_different_cells_apart():
-    from grainfrac_yade.deformable import CONTACT_RADIUS_FRACTION, contact_radii
+    from grainfrac_yade.grains.fem import CONTACT_RADIUS_FRACTION, contact_radii
     from scipy.spatial.distance import cdist
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 1)
@@ -105,7 +105,7 @@ def test_yade_element_material_gives_an_exact_linear_tetrahedron():
     """One Lin4NodeTetra with :func:`fem_element_material`: nodal forces = -K u of a tetrahedron
     built by hand from the shape-function gradients and the 3D isotropic elasticity matrix."""
     from grainfrac_yade.yade_adapter import load_yade
-    from grainfrac_yade.yade_adapter.scene import fem_element_material
+    from grainfrac_yade.yade_adapter.fem_cells import fem_element_material
     load_yade()
     from yade import O, utils, Vector3
     from yade import wrapper as w
@@ -210,8 +210,8 @@ def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
     scene.run(1)
     assert scene.law.smoothJoint and not scene.bond_separated(range(scene.n_bonds)).any()
     assert all(i.phys.isOnJoint for i in scene.interactions)
-    # plain deformable scenes carry no element engine
-    q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=deformable"])
+    # rigid scenes carry no element engine
+    q = load_parameters(overrides=SMALL[:2] + ["resolution.grain_model=rigid"])
     assert "FEInternalForceEngine" not in build_scene(build_specimen(q, 1), q).engine_names()
 
 

@@ -20,14 +20,14 @@ import pandas as pd
 import pytest
 
 from conftest import ROOT, needs_yade
-from test_reliability import StandInBonds, StandInHolder
+from test_reliability import StandInBonds, StandInHolder, loop_params
 from grainfrac_yade.law import degrade_step, failed_now, hillig_charles
 from grainfrac_yade.clocks import EventClock, PaperClock
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
 
 TINY = ["specimen.width=4e-3", "specimen.height=8e-3"]
-DEFORMABLE = [str(ROOT / "params" / "presets" / "deformable.toml")]
+FEM = [str(ROOT / "params" / "presets" / "fem.toml")]
 
 
 # ------------------------------------------------------------------ checks shared by every run
@@ -77,7 +77,7 @@ def no_negative_strength(scene, corr=None):
 @pytest.fixture
 def captured(monkeypatch):
     """The scene (and corrosion engine) of the next UCS or creep run made through the run-folder functions."""
-    from grainfrac_yade.yade_adapter import creep_test, ucs_test
+    from grainfrac_yade.yade_adapter import creep_protocol, ucs_protocol
     got = {}
 
     def keep(module, name, pick):
@@ -88,8 +88,8 @@ def captured(monkeypatch):
             got["scene"], got["corr"] = pick(result)
             return result
         monkeypatch.setattr(module, name, wrapper)
-    keep(creep_test, "run_creep", lambda run: (run.scene, run.corr))
-    keep(ucs_test, "run_ucs", lambda result: (result[2], None))
+    keep(creep_protocol, "run_creep", lambda run: (run.scene, run.corr))
+    keep(ucs_protocol, "run_ucs", lambda result: (result[2], None))
     return got
 
 
@@ -123,7 +123,7 @@ def outcome_in_analysis(folder) -> list:
 def step_ten_times_critical(monkeypatch):
     """Scenes built for UCS and creep runs step at 10 x their critical DEM step (timestep_safety <= 1
     cannot ask for it: the step is set after the scene is built)."""
-    from grainfrac_yade.yade_adapter import creep_test, ucs_test
+    from grainfrac_yade.yade_adapter import creep_protocol, ucs_protocol
 
     def stepping_up(build):
         def build_then_step_up(*args, **kwargs):
@@ -131,7 +131,7 @@ def step_ten_times_critical(monkeypatch):
             scene.O.dt = 10 * scene.dt_critical
             return scene
         return build_then_step_up
-    for module in (creep_test, ucs_test):
+    for module in (creep_protocol, ucs_protocol):
         monkeypatch.setattr(module, "build_scene", stepping_up(module.build_scene))
 
 
@@ -171,7 +171,7 @@ def rigid_ucs():
     """UCS of the 4 x 8 mm specimen, seed 1 (measured 251.8 MPa; 3 s)."""
     from grainfrac_yade.specimen import build_specimen
     from grainfrac_yade.ucs_analysis import ucs_summary
-    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=TINY)
     return ucs_summary(run_ucs(build_specimen(p, 1), p)[0])["ucs_pa"]
 
@@ -200,9 +200,9 @@ def test_b_a_load_above_the_ucs_fails_on_loading_with_lifetime_0(tmp_path, rigid
 @needs_yade
 @pytest.mark.yade
 @pytest.mark.slow
-def test_b_deformable_grains_above_their_ucs_fail_on_loading(tmp_path, captured):
-    """Deformable preset, 4 x 8 mm: UCS (measured 513 MPa; 13 s), then 1.001 x it (10 s)."""
-    p = load_parameters(overrides=TINY, extra_files=DEFORMABLE)
+def test_b_fem_grains_above_their_ucs_fail_on_loading(tmp_path, captured):
+    """Fem preset, 4 x 8 mm: UCS, then 1.001 x it."""
+    p = load_parameters(overrides=TINY, extra_files=FEM)
     ucs = ucs_folder(p, tmp_path / "ucs", captured)["ucs_pa"]
     _fails_on_loading(creep_folder(p, tmp_path / "creep", 1.001 * ucs, ucs, captured, NO_LIFETIME[1:]))
 
@@ -353,7 +353,7 @@ def test_f_a_strict_one_cell_column_ends_at_the_strain_cap_as_a_lower_bound(sphe
     elastic to the 2 % strain cap (1.8 GPa).  Neither breaks a bond.  Before, the first run 'failed'
     post-peak at 3.4 MPa after 376 DEM steps (the ringing read as softening).  1-2 s each."""
     from grainfrac_yade.ucs_analysis import ucs_summary
-    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=["specimen.width=2e-3", "specimen.height=8e-3", "specimen.grain_size=1.9e-3",
                                    f"resolution.spheres_per_cell={spheres_per_cell}"])
     history, result, scene, _ = run_ucs(column_specimen(p), p)
@@ -401,10 +401,10 @@ def test_g_the_same_seed_twice_gives_identical_creep_results(tmp_path):
 @needs_yade
 @pytest.mark.yade
 @pytest.mark.slow
-def test_g_the_same_seed_twice_gives_identical_deformable_ucs_results(tmp_path):
-    """Deformable preset, 4 x 8 mm, seed 1, two CLI processes (15 s each)."""
+def test_g_the_same_seed_twice_gives_identical_fem_ucs_results(tmp_path):
+    """Fem preset, 4 x 8 mm, seed 1, two CLI processes."""
     for name in ("a", "b"):
-        _cli_run("ucs", "--params", DEFORMABLE[0], "--width", 4e-3, "--height", 8e-3, "--seed", 1,
+        _cli_run("ucs", "--params", FEM[0], "--width", 4e-3, "--height", 8e-3, "--seed", 1,
                  "--out", tmp_path / name)
     assert_same_runs(tmp_path / "a", tmp_path / "b")
 
@@ -469,14 +469,14 @@ def bonds_left_whole(holder):
 
 
 def _clocked_breaks(clock_name, dt_max=1e8, limit=1e12):
-    from grainfrac_yade.yade_adapter.creep_test import event_clock_loop, paper_clock_loop
+    from grainfrac_yade.creep_loops import event_clock_loop, paper_clock_loop
     bonds = FrozenBonds(*frozen_bonds())
     if clock_name == "paper":
         clock = PaperClock(1e-5, dt_max, 1e-2)
         holder = BreakRecorder(bonds, clock)
-        paper_clock_loop(holder, bonds, clock, SimpleNamespace(creep_time_limit=limit, engine_period=1,
-                                                               unbalanced_force_reference="relative"),
-                         SimpleNamespace(record_period=10**9, max_relaxation_steps=20))
+        paper_clock_loop(holder, bonds, clock, *loop_params(
+            {"creep_time_limit": limit, "engine_period": 1, "unbalanced_engine_period": 1,
+             "unbalanced_force_reference": "relative"}, {"record_period": 10**9, "max_relaxation_steps": 20}))
     else:
         clock = EventClock(0.1, limit)
         holder = BreakRecorder(bonds, clock)

@@ -241,3 +241,15 @@ def test_failed_now_at_the_failure_point():
     state, stresses = one_bond(law, -100e6, 150e6)
     clock, state, step = run_to_failure(law, state, stresses)
     assert failed_now(state["tensile_strength"], state["cohesion"], -100e6, 150e6, TAN55)[1][0]
+
+
+def test_the_laws_own_flag_decides_time_scaling():
+    """Which laws rescale exactly with beta1 (the analysis, calibrate-beta1, calibrate-lifetimes) is read
+    from each built law's ``time_scales_with_beta1``, not from a list of names."""
+    import dataclasses
+    from grainfrac_yade.law import build_law, scales_with_beta1, time_scaling_laws
+    from grainfrac_yade.params import load_parameters
+    sc = load_parameters().stress_corrosion
+    for name in LAW_NAMES:
+        assert scales_with_beta1(name) == build_law(dataclasses.replace(sc, law=name)).time_scales_with_beta1
+    assert time_scaling_laws() == ("hillig_charles", "normalised") and not scales_with_beta1("no_such_law")

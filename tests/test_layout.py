@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from grainfrac_yade.layout import bond_properties, build_layout, cell_mass_inertia
+from grainfrac_yade.grains.rigid import build_layout
+from grainfrac_yade.layout import bond_properties, cell_mass_inertia
 from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
 from grainfrac_yade.tessellation import tessellate_seeds
 

@@ -208,7 +208,7 @@ def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_p
     """Three 3 x 6 mm UCS rows (about 5 s each with YADE's start): line 3 runs; line 4's folder holds a finished
     run of other parameters, line 5's a specimen run (the issue's take-over), so both stop with their one line;
     the batch names lines 4 and 5 and exits 1; the specimen folder is left as it was."""
-    from grainfrac_yade.runio import prepare_run_dir, write_json
+    from grainfrac_yade.runs.runio import prepare_run_dir, write_json
     taken = tmp_path / "taken"
     prepare_run_dir(taken, "ucs", load_parameters(), 1)
     write_json(taken / "summary.json", {"seed": 1, "ucs_pa": 1.0})
@@ -233,7 +233,7 @@ def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_p
 
 # ------------------------------------------------------------------ no folder taken over or mixed
 def test_a_folder_of_another_kind_of_run_is_refused_even_with_overwrite(tmp_path):
-    from grainfrac_yade.runio import prepare_run_dir
+    from grainfrac_yade.runs.runio import prepare_run_dir
     params = load_parameters(overrides=TINY)
     out = prepare_run_dir(tmp_path / "r", "specimen", params, 1)
     for overwrite in (False, True):
@@ -243,7 +243,7 @@ def test_a_folder_of_another_kind_of_run_is_refused_even_with_overwrite(tmp_path
 
 
 def test_a_folder_of_other_files_is_refused(tmp_path):
-    from grainfrac_yade.runio import prepare_run_dir
+    from grainfrac_yade.runs.runio import prepare_run_dir
     (tmp_path / "r").mkdir()
     (tmp_path / "r" / "history.csv").write_text("a\n1\n")
     with pytest.raises(GrainfracError, match="holds files of something else than a run"):
@@ -251,7 +251,7 @@ def test_a_folder_of_other_files_is_refused(tmp_path):
 
 
 def test_an_unfinished_run_with_a_checkpoint_is_refused_naming_resume(tmp_path):
-    from grainfrac_yade.runio import prepare_run_dir
+    from grainfrac_yade.runs.runio import prepare_run_dir
     params = load_parameters(overrides=TINY)
     out = prepare_run_dir(tmp_path / "r", "creep", params, 1)
     (out / "checkpoint").mkdir()
@@ -321,7 +321,7 @@ def test_a_row_with_a_missing_cell_is_one_line_in_the_row_script_too(tmp_path):
     """yade-batch run by hand (no pre-check): YADE's own table reader would end in an IndexError."""
     table = tmp_path / "short.table"
     table.write_text("specimen.width specimen.height seed\n3e-3 6e-3 1\n3e-3 6e-3\n")
-    from grainfrac_yade.batchrun import read_table_rows
+    from grainfrac_yade.runs.batchrun import read_table_rows
     columns, rows, problems = read_table_rows(table)
     assert list(rows) == [2] and len(problems) == 1 and "short.table:3: 2 cells for 3 columns" in problems[0]
 
@@ -399,8 +399,8 @@ def test_a_creep_run_records_its_reference_ucs_and_the_phase_of_each_crack(tmp_p
 def test_row_outcomes_judge_a_row_by_its_finished_run_not_by_yade_batch(tmp_path):
     """yade-batch reports a row that printed "Yade: normal exit." as done whatever its status: the batch and the
     demo judge each row by the summary.json of the folder it recorded, else by the reason in its log."""
-    from grainfrac_yade.batchrun import ROW_RECORDS, row_outcomes
-    from grainfrac_yade.runio import write_json
+    from grainfrac_yade.runs.batchrun import ROW_RECORDS, row_outcomes
+    from grainfrac_yade.runs.runio import write_json
     logs = tmp_path / "logs"
     (logs / ROW_RECORDS).mkdir(parents=True)
     done, broken = tmp_path / "done", tmp_path / "broken"

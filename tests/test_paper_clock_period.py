@@ -4,13 +4,12 @@ k x dt_min whether the law is applied after each or once for all k; only the cos
 creep loop's stand-ins (test_reliability): the same creep time per DEM step, k times fewer applications, the
 period back to every step once balanced, and the same no-equilibrium failure."""
 import itertools
-from types import SimpleNamespace
 
 import pytest
 
 from grainfrac_yade.clocks import PaperClock
-from grainfrac_yade.yade_adapter.creep_test import paper_clock_loop
-from test_reliability import JC, JT, StandInBonds, StandInHolder
+from grainfrac_yade.creep_loops import paper_clock_loop
+from test_reliability import JC, JT, StandInBonds, StandInHolder, loop_params
 
 
 class CountingBonds(StandInBonds):
@@ -27,9 +26,9 @@ def _run(forces, unbalanced_period, max_relaxation_steps=10**9, time_limit=1e5):
     holder = StandInHolder(forces)
     bonds = CountingBonds([1e6, 2e6], [5e6, 5e6], JT, JC)
     clock = PaperClock(1e-5, 1e4, 1e-2)
-    sc = SimpleNamespace(creep_time_limit=time_limit, engine_period=1, unbalanced_engine_period=unbalanced_period,
-                         unbalanced_force_reference="relative")
-    cp = SimpleNamespace(record_period=10**9, max_relaxation_steps=max_relaxation_steps)
+    sc, cp = loop_params({"creep_time_limit": time_limit, "engine_period": 1,
+                          "unbalanced_engine_period": unbalanced_period, "unbalanced_force_reference": "relative"},
+                         {"record_period": 10**9, "max_relaxation_steps": max_relaxation_steps})
     paper_clock_loop(holder, bonds, clock, sc, cp)
     return holder, bonds, clock
 

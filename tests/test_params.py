@@ -108,7 +108,9 @@ def test_bad_file_gives_one_clear_line(tmp_path, old, new, key, words):
 
 
 @pytest.mark.parametrize("old,new,key,words", [
-    ('grain_model = "rigid"', 'grain_model = "soft"', "resolution.grain_model", "not one of ['rigid', 'deformable', 'fem']"),
+    ('grain_model = "rigid"', 'grain_model = "soft"', "resolution.grain_model", "not one of ['rigid', 'fem']"),
+    ('grain_model = "rigid"', 'grain_model = "deformable"', "resolution.grain_model",
+     "(the spring lattice) was retired: fem cells superseded it"),
     ("nodes_per_face = 2", "nodes_per_face = 0", "resolution.nodes_per_face", "must be >= 1"),
 ])
 def test_bad_grain_model_gives_one_clear_line(tmp_path, old, new, key, words):
@@ -122,8 +124,24 @@ def test_bad_grain_model_gives_one_clear_line(tmp_path, old, new, key, words):
 
 def test_grain_model_defaults_to_rigid_cells(params):
     assert params.resolution.grain_model == "rigid" and params.resolution.nodes_per_face == 2
-    p = load_parameters(overrides=["resolution.grain_model=deformable", "resolution.nodes_per_face=3"])
-    assert p.resolution.grain_model == "deformable" and p.resolution.nodes_per_face == 3
+    p = load_parameters(overrides=["resolution.grain_model=fem", "resolution.nodes_per_face=3"])
+    assert p.resolution.grain_model == "fem" and p.resolution.nodes_per_face == 3
+
+
+def test_the_retired_lattice_gives_one_line_from_set_and_from_a_batch_table(tmp_path):
+    with pytest.raises(ParameterError) as err:
+        load_parameters(overrides=["resolution.grain_model=deformable"])
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("--set: resolution.grain_model:") and "retired" in msg
+    assert 'use resolution.grain_model = "fem"' in msg
+    from grainfrac_yade.commands.batch import check_table
+    from grainfrac_yade.errors import GrainfracError
+    table = tmp_path / "lattice.table"
+    table.write_text("resolution.grain_model seed ratio\n'deformable' 1 0.8\n")
+    with pytest.raises(GrainfracError) as err:
+        check_table(table, "creep")
+    rows = str(err.value).splitlines()[1:]
+    assert len(rows) == 1 and f"{table}:2" in rows[0] and "retired" in rows[0] and '"fem"' in rows[0]
 
 
 def test_missing_file_and_bad_syntax(tmp_path):
@@ -196,3 +214,12 @@ def test_params_json_older_than_grain_model_loads_as_rigid_cells(tmp_path, param
     old = load_run_parameters(tmp_path, fill_missing=True)
     assert set(old.filled) == {"resolution.grain_model", "resolution.nodes_per_face"}
     assert old.params.resolution.grain_model == "rigid" and old.params == params
+
+
+def test_grain_model_choices_are_the_registered_grain_models():
+    import dataclasses
+    from grainfrac_yade.grains import GRAIN_MODEL_NAMES, grain_model
+    from grainfrac_yade.params import ResolutionParams
+    spec = {f.name: f for f in dataclasses.fields(ResolutionParams)}["grain_model"].metadata
+    assert tuple(spec["choices"]) == GRAIN_MODEL_NAMES
+    assert [grain_model(n).name for n in GRAIN_MODEL_NAMES] == list(GRAIN_MODEL_NAMES)

@@ -4,6 +4,7 @@ bounded zero-length intervals, no stale or half-written results, bad input as on
 The creep loops run here on stand-in scenes (plain Python objects with the methods the loops call),
 so their logic is tested exactly and fast; the tests marked ``yade`` inject a NaN into a real scene.
 """
+import dataclasses
 import itertools
 import json
 import math
@@ -72,8 +73,18 @@ class StandInBonds:
             self.scene.broken[idx] = True
 
 
+def loop_params(sc=None, cp=None) -> tuple:
+    """The shipped ``[stress_corrosion]`` and ``[creep]`` parameters, with the changes ``sc`` and ``cp``
+    (dicts), for the clock loops."""
+    p = load_parameters()
+    return dataclasses.replace(p.stress_corrosion, **(sc or {})), dataclasses.replace(p.creep, **(cp or {}))
+
+
 class StandInHolder:
-    """The creep run's interface: relative unbalanced forces from ``forces``, relaxation always succeeds."""
+    """The creep run's interface: relative unbalanced forces from ``forces``, relaxation always succeeds;
+    no stress servo, no checkpoints."""
+
+    servo = None
 
     def __init__(self, forces=()):
         self.forces = iter(forces)
@@ -98,17 +109,21 @@ class StandInHolder:
     def check_failure(self):
         return self.failed
 
+    def safe_point(self, phase, counters):
+        """No checkpoints."""
+
     def progress(self, msg):
         pass
 
 
 def _paper_loop(f_u, max_relaxation_steps=20, time_limit=1e5):
-    from grainfrac_yade.yade_adapter.creep_test import paper_clock_loop
+    from grainfrac_yade.creep_loops import paper_clock_loop
     holder = StandInHolder(itertools.repeat(f_u))
     bonds = StandInBonds([1e6, 2e6], [5e6, 5e6], JT, JC)
     clock = PaperClock(1e-5, 1e4, 1e-2)
-    sc = SimpleNamespace(creep_time_limit=time_limit, engine_period=1, unbalanced_force_reference="relative")
-    cp = SimpleNamespace(record_period=10**9, max_relaxation_steps=max_relaxation_steps, equilibrium_tolerance=1e-3)
+    sc, cp = loop_params({"creep_time_limit": time_limit, "engine_period": 1, "unbalanced_engine_period": 1,
+                          "unbalanced_force_reference": "relative"},
+                         {"record_period": 10**9, "max_relaxation_steps": max_relaxation_steps})
     paper_clock_loop(holder, bonds, clock, sc, cp)
     return holder, clock
 
@@ -134,14 +149,14 @@ def test_paper_clock_unbalanced_above_its_threshold_fails_after_the_set_steps():
 def test_paper_clock_loop_with_every_bond_broken_is_a_failure_not_an_infinite_force():
     """No intact bond: the relative F_u (mean resultant / mean bond force) would be inf, which the clock
     reads as a blown-up DEM; the loop ends the run as failed instead."""
-    from grainfrac_yade.yade_adapter.creep_test import paper_clock_loop
+    from grainfrac_yade.creep_loops import paper_clock_loop
     holder = StandInHolder(itertools.repeat(0.0))
     bonds = StandInBonds([1e6], [5e6], JT, JC)
     bonds.scene.broken[:] = True
     clock = PaperClock(1e-5, 1e4, 1e-2)
-    paper_clock_loop(holder, bonds, clock, SimpleNamespace(creep_time_limit=1e5, engine_period=1,
-                                                           unbalanced_force_reference="relative"),
-                     SimpleNamespace(record_period=10**9, max_relaxation_steps=20))
+    paper_clock_loop(holder, bonds, clock, *loop_params(
+        {"creep_time_limit": 1e5, "engine_period": 1, "unbalanced_engine_period": 1,
+         "unbalanced_force_reference": "relative"}, {"record_period": 10**9, "max_relaxation_steps": 20}))
     assert holder.failed and holder.failure_reason == "every bond broken" and clock.n_steps == 0
 
 
@@ -151,7 +166,7 @@ def test_paper_clock_loop_on_a_nan_unbalanced_force_raises_numerical_failure():
 
 
 def _event_loop(bonds, holder=None):
-    from grainfrac_yade.yade_adapter.creep_test import event_clock_loop
+    from grainfrac_yade.creep_loops import event_clock_loop
     holder = holder or StandInHolder()
     clock = EventClock(0.1)
     n = event_clock_loop(holder, bonds, clock)
@@ -161,7 +176,7 @@ def _event_loop(bonds, holder=None):
 def test_repeated_zero_intervals_that_break_nothing_end_after_a_bounded_number():
     """sigma = 0 with J^T = 0: failed by the law (>=) at dt = 0, but a contact law that breaks only
     on F > FnMax never breaks it; the loop used to hand it over and relax forever."""
-    from grainfrac_yade.yade_adapter.creep_test import MAX_STALLED_INTERVALS
+    from grainfrac_yade.creep_loops import MAX_STALLED_INTERVALS
     bonds = StandInBonds([0.0], [0.0], 0.0, JC, breaks=False)
     holder = StandInHolder()
     with pytest.raises(NumericalFailure) as err:
@@ -202,7 +217,7 @@ def test_event_loop_on_nan_stresses_raises_instead_of_ending_not_failed():
 # ------------------------------------------------------------------ the run folder of a numerical failure
 @pytest.fixture(scope="module")
 def tiny():
-    from grainfrac_yade.layout import layout_for
+    from grainfrac_yade.grains import layout_for
     from grainfrac_yade.specimen import build_specimen
     params = load_parameters(overrides=TINY)
     specimen = build_specimen(params, 1)
@@ -238,8 +253,8 @@ def _no_nan(path):
 
 def _creep_folder(tmp_path, monkeypatch, tiny, run):
     from grainfrac_yade.commands.creep import run_creep_to_folder
-    from grainfrac_yade.yade_adapter import creep_test
-    monkeypatch.setattr(creep_test, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
+    from grainfrac_yade.yade_adapter import creep_protocol
+    monkeypatch.setattr(creep_protocol, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     out = tmp_path / "run"
     run_creep_to_folder(tiny[0], 1, out, 200e6, 0.7, 285e6)
     return out
@@ -309,7 +324,7 @@ def test_the_analysis_lists_numerical_failures_apart(tmp_path):
 # ------------------------------------------------------------------ atomic writers, no stale summary
 @pytest.mark.parametrize("writer, data", [("write_json", {"new": 2}), ("write_csv", {"new": [2]})])
 def test_a_write_killed_before_the_rename_leaves_the_old_file_whole(tmp_path, monkeypatch, writer, data):
-    import grainfrac_yade.runio as runio
+    import grainfrac_yade.runs.runio as runio
     target = tmp_path / "file"
     target.write_text("old content\n")
 
@@ -323,7 +338,7 @@ def test_a_write_killed_before_the_rename_leaves_the_old_file_whole(tmp_path, mo
 
 
 def test_a_replacing_run_is_written_beside_the_old_one_and_swapped_in_when_finished(tmp_path):
-    from grainfrac_yade.runio import commit_run_dir, prepare_run_dir, write_json
+    from grainfrac_yade.runs.runio import commit_run_dir, prepare_run_dir, write_json
     params = load_parameters(overrides=TINY)
     out = prepare_run_dir(tmp_path / "r", "creep", params, 1)
     write_json(out / "summary.json", {"failed": True})
@@ -339,7 +354,7 @@ VALUES = {"seed": 1, "stress_pa": 2e8}
 
 
 def finished_folder(path, params, values=VALUES, drop=()):
-    from grainfrac_yade.runio import prepare_run_dir, write_json
+    from grainfrac_yade.runs.runio import prepare_run_dir, write_json
     out = prepare_run_dir(path, "creep", params, values["seed"])
     stored = json.loads((out / "params.json").read_text())
     for dotted in drop:
@@ -369,7 +384,7 @@ def test_a_finished_row_is_skipped_only_with_equal_parameters(tmp_path):
 
 
 def test_on_change_new_folder_runs_into_a_folder_named_by_the_parameters(tmp_path):
-    from grainfrac_yade.runio import run_digest
+    from grainfrac_yade.runs.runio import run_digest
     from grainfrac_yade.yade_adapter.batch import row_folder
     params = load_parameters(overrides=TINY)
     out = finished_folder(tmp_path / "row", params)
@@ -465,8 +480,8 @@ def test_the_specimen_command_still_builds_3d(tmp_path):
 # ------------------------------------------------------------------ in YADE: a real NaN
 def _inject_nan(monkeypatch, method, after):
     """Before or ``after`` CreepRun.<method>, give one free body a NaN velocity: the DEM steps spread it."""
-    from grainfrac_yade.yade_adapter import creep_test
-    original = getattr(creep_test.CreepRun, method)
+    from grainfrac_yade.yade_adapter import creep_protocol
+    original = getattr(creep_protocol.CreepRun, method)
 
     def poison(run):
         from yade import Vector3
@@ -479,7 +494,7 @@ def _inject_nan(monkeypatch, method, after):
         if after:
             poison(self)
         return result
-    monkeypatch.setattr(creep_test.CreepRun, method, poisoned)
+    monkeypatch.setattr(creep_protocol.CreepRun, method, poisoned)
 
 
 @needs_yade
@@ -512,7 +527,7 @@ def test_yade_bond_never_gets_a_nan_strength():
     """write() and hand_over_failures() refuse non-finite values before touching YADE (Python's
     max(nan, 0) is nan, which hand_over_failures would have written as FsMax)."""
     from grainfrac_yade.law import MODE_SHEAR
-    from grainfrac_yade.yade_adapter.single_bond import BondUnderForce
+    from single_bond import BondUnderForce
     holder = BondUnderForce(load_parameters(), 1e6, 0.0)
     phys = holder.scene.interactions[0].phys
     before = (phys.FnMax, phys.FsMax)
@@ -530,7 +545,7 @@ def test_yade_bond_never_gets_a_nan_strength():
 def test_every_batch_script_reports_a_misspelt_column_in_one_line(tmp_path, script):
     import os
     import shutil
-    from grainfrac_yade.batchrun import write_table
+    from grainfrac_yade.runs.batchrun import write_table
     table = write_table(tmp_path / "t.table", [{"specimen.widht": 3e-3, "ratio": 0.7, "seed": 1,
                                                 "out": str(tmp_path / "x")}])
     res = subprocess.run([shutil.which("yade"), "-n", "-x", str(ROOT / "yade_scripts" / f"{script}.py")],
@@ -561,7 +576,7 @@ class _RampPlatens:
 
 
 def _ramp(stresses, target):
-    from grainfrac_yade.yade_adapter.creep_test import CreepRun
+    from grainfrac_yade.yade_adapter.creep_protocol import CreepRun
     run = CreepRun.__new__(CreepRun)
     platens = _RampPlatens(stresses)
     run.platens, run.target = platens, target

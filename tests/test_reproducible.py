@@ -117,7 +117,7 @@ def test_analysis_warns_when_a_study_mixes_code_versions():
 
 def test_code_version_is_read_once_per_process(monkeypatch):
     """A run's summary names the code its process imported, even if the checkout changes meanwhile."""
-    from grainfrac_yade import runio
+    from grainfrac_yade.runs import runio
     first = runio.code_version()
     calls = []
     monkeypatch.setattr(runio.subprocess, "run", lambda *a, **k: calls.append(a) or (_ for _ in ()).throw(OSError))

@@ -44,7 +44,7 @@ def _creep_args(spec, out, *extra):
 
 def _state(folder):
     """The state of the checkpoint a resume would use (also between the renames of a rewrite)."""
-    from grainfrac_yade.runio import read_checkpoint_state
+    from grainfrac_yade.runs.runio import read_checkpoint_state
     return read_checkpoint_state(folder)
 
 
@@ -125,7 +125,7 @@ def test_a_run_killed_mid_creep_resumes_to_the_uninterrupted_result(tmp_path):
 @needs_yade
 @pytest.mark.yade
 def test_a_yade_batch_rerun_resumes_an_unfinished_row(tmp_path):
-    from grainfrac_yade.batchrun import run_batch, write_table
+    from grainfrac_yade.runs.batchrun import run_batch, write_table
     ref = tmp_path / "uninterrupted"
     _reference(TINY, ref)
     out = tmp_path / "row"
@@ -148,7 +148,7 @@ VALUES = {"seed": 1, "stress_pa": 2.4e8}
 
 def _unfinished(path, params, values=VALUES, phase="event"):
     """A run folder as a killed creep run leaves it: run.json, params.json and a checkpoint's state."""
-    from grainfrac_yade.runio import prepare_run_dir
+    from grainfrac_yade.runs.runio import prepare_run_dir
     out = prepare_run_dir(path, "creep", params, values["seed"])
     (out / "checkpoint").mkdir()
     (out / "checkpoint" / "state.json").write_text(json.dumps(
@@ -158,7 +158,7 @@ def _unfinished(path, params, values=VALUES, phase="event"):
 
 
 def test_a_batch_row_skips_resumes_or_starts_by_its_folder(tmp_path):
-    from grainfrac_yade.runio import write_json
+    from grainfrac_yade.runs.runio import write_json
     from grainfrac_yade.yade_adapter.batch import row_plan
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     stop = {"on_change": "stop"}
@@ -179,7 +179,7 @@ def test_a_batch_row_skips_resumes_or_starts_by_its_folder(tmp_path):
 
 
 def test_checkpoint_folder_survives_a_kill_between_the_renames(tmp_path):
-    from grainfrac_yade.runio import checkpoint_folder, commit_run_dir, prepare_run_dir
+    from grainfrac_yade.runs.runio import checkpoint_folder, commit_run_dir, prepare_run_dir
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = _unfinished(tmp_path / "r", params)
     (out / "checkpoint.tmp").mkdir()                    # a new one half written: not used
@@ -195,7 +195,7 @@ def test_checkpoint_folder_survives_a_kill_between_the_renames(tmp_path):
 
 def test_checkpoint_interval_is_a_checked_parameter_that_no_run_comparison_sees(tmp_path):
     from grainfrac_yade.errors import ParameterError
-    from grainfrac_yade.runio import run_digest
+    from grainfrac_yade.runs.runio import run_digest
     p = load_parameters()
     assert p.numerics.checkpoint_interval == 600.0
     assert run_digest(load_parameters(overrides=["numerics.checkpoint_interval=0"]), VALUES) == run_digest(p, VALUES)
@@ -210,7 +210,7 @@ def test_the_old_interval_key_is_refused_in_one_line_and_migrated_in_older_runs(
     from grainfrac_yade.analysis.runparams import load_run_parameters
     from grainfrac_yade.errors import GrainfracError, ParameterError
     from grainfrac_yade.params import migrate_tree
-    from grainfrac_yade.runio import checkpoint_differences
+    from grainfrac_yade.runs.runio import checkpoint_differences
     from grainfrac_yade.yade_adapter.batch import check_columns
     for given in (["creep.checkpoint_interval=60"], ):
         with pytest.raises(ParameterError, match="moved to numerics.checkpoint_interval"):
@@ -241,7 +241,7 @@ def test_the_old_interval_key_is_refused_in_one_line_and_migrated_in_older_runs(
 
 def test_a_folder_holding_a_resumable_run_is_refused_naming_resume(tmp_path):
     from grainfrac_yade.errors import GrainfracError
-    from grainfrac_yade.runio import prepare_run_dir
+    from grainfrac_yade.runs.runio import prepare_run_dir
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = _unfinished(tmp_path / "killed", params)   # a creep run's folder
     with pytest.raises(GrainfracError) as exc:
@@ -260,7 +260,7 @@ def test_a_folder_holding_a_resumable_run_is_refused_naming_resume(tmp_path):
 @pytest.mark.parametrize("case", ["no folder", "no checkpoint", "finished", "conflict", "ucs run"])
 def test_a_bad_resume_is_one_line(tmp_path, case):
     """creep --resume."""
-    from grainfrac_yade.runio import prepare_run_dir, write_json
+    from grainfrac_yade.runs.runio import prepare_run_dir, write_json
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = tmp_path / "run"
     args = ["--resume", out]
@@ -290,7 +290,7 @@ def test_a_checkpoint_older_than_a_parameter_section_still_matches(tmp_path):
     before a section existed is resumed, not restarted."""
     import json as _json
     from grainfrac_yade.params import load_parameters as _load
-    from grainfrac_yade.runio import CHECKPOINT, CHECKPOINT_STATE, checkpoint_differences
+    from grainfrac_yade.runs.runio import CHECKPOINT, CHECKPOINT_STATE, checkpoint_differences
     p = _load()
     stored = p.to_dict()
     stored.pop("brazilian", None)
@@ -305,7 +305,7 @@ def test_a_checkpoint_older_than_a_parameter_section_still_matches(tmp_path):
 @pytest.mark.parametrize("command", ["ucs", "brazilian"])
 @pytest.mark.parametrize("case", ["no folder", "no checkpoint", "finished", "conflict", "creep run"])
 def test_a_bad_resume_of_a_loading_test_is_one_line(tmp_path, command, case):
-    from grainfrac_yade.runio import prepare_run_dir, write_json
+    from grainfrac_yade.runs.runio import prepare_run_dir, write_json
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     out = tmp_path / "run"
     args = [command, "--resume", out]
@@ -412,7 +412,7 @@ def test_a_creep_run_killed_in_its_ramp_resumes_to_the_uninterrupted_result(tmp_
 @needs_yade
 @pytest.mark.yade
 def test_a_yade_batch_rerun_resumes_an_unfinished_ucs_row(tmp_path):
-    from grainfrac_yade.batchrun import run_batch, write_table
+    from grainfrac_yade.runs.batchrun import run_batch, write_table
     ref = tmp_path / "uninterrupted"
     _ucs_reference(ref)
     out = tmp_path / "row"
@@ -450,5 +450,4 @@ def test_a_brazilian_test_killed_mid_loading_resumes_to_the_uninterrupted_result
 def test_only_finite_element_cells_are_flagged_as_resuming_inexactly():
     from grainfrac_yade.yade_adapter.checkpoint import inexact_note
     assert inexact_note(load_parameters()) == ""
-    assert inexact_note(load_parameters(overrides=["resolution.grain_model=deformable"])) == ""
     assert "memory address" in inexact_note(load_parameters(overrides=["resolution.grain_model=fem"]))

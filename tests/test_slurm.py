@@ -21,7 +21,7 @@ import pytest
 
 from conftest import ROOT, needs_yade
 from grainfrac_yade.errors import GrainfracError
-from grainfrac_yade.slurm import (FAILED, QueueView, SubmitOptions, compress_rows, frozen_table_text,
+from grainfrac_yade.runs.slurm import (FAILED, QueueView, SubmitOptions, compress_rows, frozen_table_text,
                                   read_batch_table, render_sbatch, row_states)
 
 PYTHON = "/usr/bin/python3"
@@ -123,7 +123,7 @@ def test_the_sbatch_script_runs_row_k_as_a_local_batch_row(tmp_path):
                  'export YADE_BATCH="results/tiny/slurm/tiny.table:${LINES[$SLURM_ARRAY_TASK_ID]}"',
                  "export OMP_NUM_THREADS=1"):
         assert line in text.splitlines() or any(ln.startswith(line) for ln in text.splitlines()), line
-    assert text.splitlines()[-1] == (f'exec {PYTHON} -m grainfrac_yade.slurmtask results/tiny "$SLURM_ARRAY_TASK_ID" '
+    assert text.splitlines()[-1] == (f'exec {PYTHON} -m grainfrac_yade.runs.slurmtask results/tiny "$SLURM_ARRAY_TASK_ID" '
                                      f"creep -- yade -n -x {ROOT}/yade_scripts/creep.py")
     # the script is valid bash and maps task ids to table lines
     check = subprocess.run(["bash", "-n"], input=text, text=True, capture_output=True)
@@ -249,7 +249,7 @@ def _wrapper(tmp_path, row, mode, **popen):
     child.write_text(CHILD)
     env = dict(os.environ, PYTHONPATH=str(ROOT), SLURM_ARRAY_JOB_ID="77", SLURM_ARRAY_TASK_ID=str(row),
                SLURM_JOB_ID="78", YADE_BATCH=f"results/s/slurm/s.table:{row + 1}")
-    cmd = [PYTHON, "-m", "grainfrac_yade.slurmtask", str(study), str(row), "creep", "--", PYTHON, str(child),
+    cmd = [PYTHON, "-m", "grainfrac_yade.runs.slurmtask", str(study), str(row), "creep", "--", PYTHON, str(child),
            str(study / f"run{row}"), mode]
     return subprocess.Popen(cmd, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             **popen), study
@@ -287,7 +287,7 @@ def test_sigterm_marks_the_row_failed_and_ends_the_yade_process(tmp_path):
 
 
 def test_a_batch_row_records_its_folder_for_the_wrapper(tmp_path, monkeypatch):
-    from grainfrac_yade import slurm
+    from grainfrac_yade.runs import slurm
     from grainfrac_yade.yade_adapter import batch
     assert batch.ROW_FOLDER_ENV == slurm.ROW_FOLDER_ENV
     target = tmp_path / "tasks" / "row1_folder.json"

@@ -49,9 +49,12 @@ def _cell_masses(scene):
 @pytest.mark.yade
 @pytest.mark.parametrize("model", ["rigid", "fem"])
 def test_scene_step_rises_to_the_quantile_and_only_cells_below_get_heavier(model):
-    from grainfrac_yade.yade_adapter.scene import (body_steps, build_scene, cell_steps, fem_node_stiffness,
-                                                   sphere_mass_inertia)
+    from grainfrac_yade.dem_step import cell_steps
+    from grainfrac_yade.elastic import cluster_network, node_stiffness
+    from grainfrac_yade.grains.fem import sphere_mass_inertia
+    from grainfrac_yade.grains.rigid import body_steps
     from grainfrac_yade.layout import cell_mass_inertia
+    from grainfrac_yade.yade_adapter.scene import build_scene
     q = 0.3
     base = load_parameters(overrides=SMALL + [f"resolution.grain_model={model}"])
     floored = load_parameters(overrides=SMALL + [f"resolution.grain_model={model}",
@@ -67,7 +70,8 @@ def test_scene_step_rises_to_the_quantile_and_only_cells_below_get_heavier(model
         own = body_steps(plain.layout, plain.props, s, mass, inertia, pos)
     else:
         mass, _ = sphere_mass_inertia(s, plain.layout, mass)
-        own = cell_steps(np.sqrt(mass / fem_node_stiffness(s, base, plain.layout)), plain.layout.sphere_cell,
+        k = node_stiffness(cluster_network(s, base, plain.layout))   # the assembly again, independently
+        own = cell_steps(np.sqrt(mass / k), plain.layout.sphere_cell,
                          s.n_cells)
     assert plain.dt_critical == pytest.approx(own.min(), rel=1e-12)
     scene = build_scene(s, floored)

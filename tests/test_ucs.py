@@ -13,7 +13,7 @@ SMALL = ["specimen.width=6e-3", "specimen.height=12e-3"]
 
 
 def _ucs(overrides, seed=1):
-    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=SMALL + overrides)
     hist, result, scene, _ = run_ucs(build_specimen(p, seed), p)
     return ucs_summary(hist), result, scene
@@ -73,7 +73,7 @@ YOUNG_BAND_PA = (71.9e9 - 3 * 1.2e9, 71.9e9 + 3 * 1.2e9)
 
 
 def test_small_specimen_ucs_regression():
-    from grainfrac_yade.yade_adapter.ucs_test import run_ucs
+    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3"])
     hist, result, _, _ = run_ucs(build_specimen(p, 1), p)
     s = ucs_summary(hist)

@@ -9,6 +9,8 @@ Columns: ratio or stress [Pa] (not both), optional ucs [Pa], seed, study, out, a
 import os
 import sys
 
+# YADE runs this file as `yade -x FILE` (``__file__`` is /usr/bin/yade, no ``-m``): the repository's
+# folder on sys.path is the only way to find the package from a checkout that is not installed.
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))))
 
 from grainfrac_yade.commands.creep import run_creep_in_yade  # noqa: E402

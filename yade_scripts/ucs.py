@@ -9,6 +9,8 @@ Each row writes results/<study>/<row name>/ (summary.json, history.csv, figures)
 import os
 import sys
 
+# YADE runs this file as `yade -x FILE` (``__file__`` is /usr/bin/yade, no ``-m``): the repository's
+# folder on sys.path is the only way to find the package from a checkout that is not installed.
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))))
 
 from grainfrac_yade.commands.ucs import run_ucs_in_yade  # noqa: E402

@@ -48,7 +48,7 @@ def _read_json(path: Path) -> dict:
 
 def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
     """One row per folder under ``root`` holding a run.json or a failed.json, plus, in a SLURM study
-    (``root/slurm/study.json``, :mod:`grainfrac_yade.slurm`), one per row without such a folder yet.
+    (``root/slurm/study.json``, :mod:`grainfrac_yade.runs.slurm`), one per row without such a folder yet.
 
     ``status`` is ``finished`` (summary.json present), ``unfinished`` (no summary.json yet),
     ``failed`` (no summary.json, and a failed.json holding the error line of a batch task that ended
@@ -57,7 +57,7 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
     run folder's path. With ``all_params`` every parameter of params.json becomes a column
     (dotted name); otherwise only :data:`PARAM_COLUMNS`.
     """
-    from ..slurm import FAILED, rows_without_runs
+    from ..runs.slurm import FAILED, rows_without_runs
     root = Path(root)
     rows = []
     folders = sorted({p.parent for p in root.rglob("run.json")} | {p.parent for p in root.rglob(FAILED)})

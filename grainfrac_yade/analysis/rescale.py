@@ -24,9 +24,8 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
+from ..law import scales_with_beta1, time_scaling_laws
 
-#: Laws whose creep times are all proportional to 1/beta1 (``time_scales_with_beta1`` in grainfrac_yade.law).
-TIME_SCALE_LAWS = ("hillig_charles", "normalised")
 #: Summary and table columns that are creep times [s] (wall_s is wall-clock time: not scaled).
 TIME_COLUMNS = ("lifetime_s", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
                 "stress_corrosion.creep_time_limit")
@@ -79,9 +78,9 @@ def not_rescalable(row: dict) -> str | None:
                 "by the unbalanced force, so its failure sequence changes with beta1")
     if form not in (None, "beta"):
         return f"rate_form = {form!r}: beta1 and beta2 both follow from Eq. 6, so beta2 is not held fixed"
-    if law not in TIME_SCALE_LAWS:
-        return (f"law = {law!r}: only the strength laws ({', '.join(TIME_SCALE_LAWS)}) are checked to scale exactly "
-                "with 1/beta1")
+    if not scales_with_beta1(law):
+        return (f"law = {law!r}: only the laws whose times scale with 1/beta1 ({', '.join(time_scaling_laws())}) "
+                "rescale exactly")
     return None
 
 

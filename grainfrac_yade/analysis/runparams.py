@@ -142,7 +142,7 @@ def rebuild_specimen(folder, seed, n_bonds=None, cracks=None) -> RebuiltSpecimen
     if params.specimen.dimension != 2:
         raise GrainfracError(f"{folder}: 3D specimen (specimen.dimension = {params.specimen.dimension}); "
                              "fix: grain maps are drawn for 2D specimens only")
-    from ..layout import layout_for
+    from ..grains import layout_for
     from ..specimen import build_specimen
     specimen = build_specimen(params, seed)
     checks = []

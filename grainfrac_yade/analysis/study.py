@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
-from ..runio import RESULT_NEUTRAL_KEYS, write_csv
+from ..runs.runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crack_phases, crackmaps, figures, rescale
 from .collect import code_version_note, collect_runs, flatten
 from .figures import MAP_FRACTIONS, Curve, LifetimeSet

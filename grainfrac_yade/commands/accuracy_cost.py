@@ -34,7 +34,7 @@ def register(sub, common):
 
 def cmd_accuracy_cost(args) -> int:
     from ..accuracy_study import creep_rows, load_study, ucs_rows
-    from ..batchrun import run_batch, write_table
+    from ..runs.batchrun import run_batch, write_table
     study = load_study(args.study, quick=args.quick, repo=REPO)
     study = replace(study, folder=Path(args.out or study.folder).resolve())
     folder = study.folder
@@ -64,7 +64,7 @@ def summarise(study) -> int:
     from ..analysis.collect import code_version_note, collect_runs
     from ..analysis.study import read_history
     from ..errors import GrainfracError
-    from ..runio import write_csv
+    from ..runs.runio import write_csv
     folder = study.folder
     runs = collect_runs(folder)
     labelled = label_runs(study, runs) if not runs.empty else runs

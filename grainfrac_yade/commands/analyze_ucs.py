@@ -100,9 +100,12 @@ def envelopes(runs, folder) -> list:
 
 
 def cells_label(grain_model, nodes_per_face) -> str:
-    """The cells column of ucs_stats.md: "rigid", "deformable, k/face" (spring lattice) or
-    "fem, k/face" (finite elements).  A run without grain_model (params.json older than the key) had
-    rigid cells, the only kind there was."""
-    if grain_model in ("deformable", "fem"):
-        return f"{grain_model}, {nodes_per_face:.0f}/face"
+    """The cells column of ucs_stats.md: "rigid" or "fem, k/face" (finite elements); a run of the
+    retired spring lattice (grain_model "deformable" in an older params.json) "lattice (retired),
+    k/face".  A run without grain_model (params.json older than the key) had rigid cells, the only
+    kind there was."""
+    if grain_model == "fem":
+        return f"fem, {nodes_per_face:.0f}/face"
+    if grain_model == "deformable":
+        return f"lattice (retired), {nodes_per_face:.0f}/face"
     return "rigid"

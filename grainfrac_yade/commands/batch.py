@@ -53,7 +53,7 @@ def row_columns(test: str) -> dict:
 def check_row(test: str, columns, cells: dict, where: str):
     """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
     (one line, naming ``where``) if the row would be refused."""
-    from ..batchrun import cell_value
+    from ..runs.batchrun import cell_value
     from ..params import load_parameters, shipped_values
     from ..yade_adapter.batch import ON_CHANGE, check_columns
     defaults, controls = shipped_values(), row_columns(test)
@@ -66,7 +66,7 @@ def check_row(test: str, columns, cells: dict, where: str):
             values[col] = cell_value(text)
         except ValueError as exc:
             raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: text cells must be quoted, e.g. "
-                                 "'deformable'") from None
+                                 "'fem'") from None
     overrides = [(k, v) for k, v in values.items() if k in defaults and v != defaults[k]]
     controls.update({k: v for k, v in values.items() if k in controls})
     if controls["on_change"] not in ON_CHANGE:
@@ -109,7 +109,7 @@ def _check_kind(test, params, controls):
 def check_table(table, test=None) -> tuple:
     """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row`;
     else GrainfracError with one line per bad row."""
-    from ..batchrun import read_table_rows
+    from ..runs.batchrun import read_table_rows
     columns, rows, problems = read_table_rows(table)
     test = test or guess_test(columns, Path(table).name)
     checked = {}
@@ -143,7 +143,7 @@ def describe(summary: dict) -> str:
 
 
 def cmd_batch(args) -> int:
-    from ..batchrun import row_outcomes, run_batch
+    from ..runs.batchrun import row_outcomes, run_batch
     table = Path(args.table)
     if args.jobs < 1:
         raise GrainfracError(f"--jobs {args.jobs}: fix: at least 1")

@@ -1,8 +1,7 @@
 """``bench``: what a creep run costs on this machine, every number from one run.
 
 Scenes: the specimen (10 x 20 mm, seed 1; ``--quick`` a smaller one) with rigid cells at 1 and at 8
-spheres per cell, with deformable cells (``params/presets/deformable.toml``) and with finite-element
-cells (``params/presets/fem.toml``), each ramped as a
+spheres per cell and with finite-element cells (``params/presets/fem.toml``), each ramped as a
 creep run ramps it to 0.7 x its own ``calibration.reference_ucs`` (``--ratio``), then held by the
 servo with the stress-corrosion engine in place and relaxed to equilibrium, as in a creep run; then
 a few events of the event clock are timed, and the scene is measured at the held load after them:
@@ -45,15 +44,12 @@ from pathlib import Path
 
 #: Where the full bench writes by default.
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
-#: The deformable-cells preset.
-DEFORMABLE_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "deformable.toml"
 #: The finite-element-cells preset.
 FEM_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "fem.toml"
 #: Benchmarked scenes: key, label, extra parameter files, overrides (applied after the user's).
 SCENES = (
     ("rigid_1", "rigid, 1 sphere/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=1")),
     ("rigid_8", "rigid, 8 spheres/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=8")),
-    ("deformable", "deformable cells (spring lattice)", (DEFORMABLE_PRESET,), ()),
     ("fem", "finite-element cells", (FEM_PRESET,), ()),
 )
 #: The scene of the clocks-to-failure comparison.
@@ -74,9 +70,9 @@ class BenchSettings:
 
 
 FULL = BenchSettings(width_m=10e-3, height_m=20e-3, window_s=0.4, repeats=25, events=5, to_failure=True)
-#: About a minute on this 2-core machine: a smaller specimen (the deformable scene's ramp and first
-#: relaxation alone take about a minute at 10 x 20 mm; at 6 x 12 mm, seed 1, its ramp takes 170k DEM
-#: steps and the load is not held), short windows, 2 events, no runs to failure.
+#: About a minute on this 2-core machine: a smaller specimen (the retired spring lattice's ramp and
+#: first relaxation alone took about a minute at 10 x 20 mm; at 6 x 12 mm, seed 1, its ramp took 170k
+#: DEM steps and the load was not held), short windows, 2 events, no runs to failure.
 QUICK = BenchSettings(width_m=5e-3, height_m=10e-3, window_s=0.2, repeats=5, events=2, to_failure=False)
 
 
@@ -100,7 +96,7 @@ def register(sub, common):
 
 
 def cmd_bench(args) -> int:
-    from ..runio import write_json
+    from ..runs.runio import write_json
     settings = QUICK if args.quick else FULL
     out = Path(args.out or ("results/bench_quick.json" if args.quick else DEFAULT_OUT))
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -117,7 +113,7 @@ def run_bench(settings: BenchSettings, seed=1, ratio=DEFAULT_RATIO, extra_files=
               progress=None) -> dict:
     """Every measurement of the bench, as the JSON stores it."""
     from ..errors import GrainfracError
-    from ..runio import code_version
+    from ..runs.runio import code_version
     progress = progress or (lambda msg: None)
     if not 0 < ratio < 1:
         raise GrainfracError(f"--ratio {ratio}: a driving-stress ratio must lie in (0, 1); fix: e.g. --ratio 0.7")

@@ -5,7 +5,7 @@ Tensile strength sigma_t = 2 P / (pi D t) (ISRM 1978 suggested method) at the pe
 disc of diameter D (``brazilian.diameter``) and thickness t (``specimen.thickness``), the disc a
 Voronoi tessellation clipped to the circle with the grain size and composition of the UCS
 specimen (:mod:`grainfrac_yade.disc`), loaded by two rigid jaws
-(:mod:`grainfrac_yade.yade_adapter.brazilian_test`).
+(:mod:`grainfrac_yade.yade_adapter.brazilian_protocol`).
 """
 from __future__ import annotations
 
@@ -131,7 +131,7 @@ def require_disc_model(params):
     require_plane(params, "brazilian")
     if params.resolution.grain_model != "rigid":
         raise GrainfracError(f"resolution.grain_model = {params.resolution.grain_model!r}: the Brazilian disc is "
-                             "built for rigid cells only (deformable and fem cells mesh straight box walls, not the "
+                             "built for rigid cells only (fem cells mesh straight box walls, not the "
                              "rim's arcs); fix: use resolution.grain_model = \"rigid\"")
 
 
@@ -148,9 +148,9 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
-    from ..disc import build_disc_specimen
-    from ..runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
-    from ..yade_adapter.brazilian_test import resume_brazilian, run_brazilian
+    from ..specimen import build_disc_specimen
+    from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
+    from ..yade_adapter.brazilian_protocol import resume_brazilian, run_brazilian
     from ..yade_adapter.levers import Levers, new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
@@ -201,7 +201,7 @@ def write_disc_cracks(path, scene):
     """cracks.csv: one row per bond broken during the test (DEM step, mode, kind, position, orientation, and
     whether it lies in the central band); slits (:mod:`~grainfrac_yade.yade_adapter.levers`) are left out."""
     from ..brazilian_analysis import in_central_band
-    from ..runio import write_csv
+    from ..runs.runio import write_csv
     from ..yade_adapter.levers import new_breaks
     from ..yade_adapter.scene import SHEAR
     idx = np.flatnonzero(new_breaks(scene))
@@ -254,7 +254,7 @@ def run_brazilian_in_yade():
     goes on from it (:mod:`grainfrac_yade.yade_adapter.batch`)."""
     from ..params import load_parameters
     from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
-    from ..runio import read_checkpoint_state
+    from ..runs.runio import read_checkpoint_state
     from ..yade_adapter.levers import Levers
     with row_errors():
         overrides, controls = read_table()

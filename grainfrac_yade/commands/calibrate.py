@@ -54,7 +54,7 @@ def register(sub, common):
 
 def cmd_calibrate(args, params) -> int:
     from ..params import load_parameters, require_plane
-    from ..runio import commit_run_dir, prepare_run_dir, write_csv
+    from ..runs.runio import commit_run_dir, prepare_run_dir, write_csv
     base = list(args.resolved_overrides)   # the overrides of ``params``, for each round's parameter set
     require_plane(params, "calibrate")
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,

@@ -40,14 +40,14 @@ def beta1_factor(lifetimes, target_s: float) -> dict:
 
 def select_reference_runs(runs, stress_pa: float):
     """Finished, failed (not on loading) event-clock creep runs of a strength law at ``stress_pa``."""
-    from ..analysis.rescale import TIME_SCALE_LAWS
+    from ..law import scales_with_beta1
     from ..errors import GrainfracError
     need = ("stress_pa", "lifetime_s", "failed", "clock", "law")
     if runs.empty or any(c not in runs for c in need):
         raise GrainfracError("no finished creep runs in the folder; fix: run params/lifetime_ldb.table first")
     sel = runs[(runs["status"] == "finished") & (runs["failed"] == True)  # noqa: E712 (pandas mask)
                & np.isclose(runs["stress_pa"].astype(float), stress_pa, rtol=STRESS_MATCH_RTOL, atol=0)
-               & (runs["clock"] == "event") & runs["law"].isin(TIME_SCALE_LAWS)]
+               & (runs["clock"] == "event") & runs["law"].map(scales_with_beta1).astype(bool)]
     if "failed_on_loading" in sel:
         sel = sel[sel["failed_on_loading"] != True]  # noqa: E712
     if len(sel) < 2:
@@ -63,7 +63,7 @@ def cmd_calibrate_beta1(args) -> int:
     from ..analysis.collect import collect_runs
     from ..analysis.labdata import paper_reference
     from ..errors import GrainfracError
-    from ..runio import code_version
+    from ..runs.runio import code_version
     folder = Path(args.folder)
     if not folder.is_dir():
         raise GrainfracError(f"{folder}: study folder not found; fix: give the folder of the creep study")

@@ -57,7 +57,7 @@ def register(sub, common):
 def _digest(tree: dict) -> str:
     """Identity of a parameter tree (params.json layout) for reuse: every key that changes results."""
     from ..analysis.study import VARIANT_IGNORE
-    from ..runio import comparable_parameters
+    from ..runs.runio import comparable_parameters
     flat = {k: v for k, v in comparable_parameters(tree).items() if k not in VARIANT_IGNORE}
     return hashlib.sha256(json.dumps(flat, sort_keys=True).encode()).hexdigest()
 
@@ -122,7 +122,7 @@ class BatchModel:
         return load_parameters(extra_files=self.args.params, overrides=list(self.args.resolved_overrides) + extra)
 
     def __call__(self, beta2, threshold):
-        from ..batchrun import run_batch, write_table
+        from ..runs.batchrun import run_batch, write_table
         params = self.trial_params(beta2, threshold)
         digest = _digest(params.to_dict())
         known = [r for r in finished_runs(self.study) if r[0] == digest]
@@ -183,14 +183,15 @@ def _fit_lines(result, trial, beta1) -> list:
 def cmd_calibrate_lifetimes(args, params) -> int:
     from ..analysis.labdata import read_lab_csv
     from ..analysis.lifetime_calibration import fit
-    from ..analysis.rescale import TIME_SCALE_LAWS
+    from ..law import scales_with_beta1, time_scaling_laws
     from ..params import require_plane, write_parameter_file
-    from ..runio import code_version, write_csv
+    from ..runs.runio import code_version, write_csv
     require_plane(params, "calibrate-lifetimes")
     sc = params.stress_corrosion
-    if sc.law not in TIME_SCALE_LAWS or sc.clock != "event":
+    if not scales_with_beta1(sc.law) or sc.clock != "event":
         raise GrainfracError(f"law {sc.law!r} with the {sc.clock} clock: beta1 is an exact time scale only for the "
-                             f"strength laws ({', '.join(TIME_SCALE_LAWS)}) with the event clock; fix: --set "
+                             f"laws whose times scale with it ({', '.join(time_scaling_laws())}) with the event "
+                             "clock; fix: --set "
                              "stress_corrosion.law=hillig_charles --set stress_corrosion.clock=event")
     if sc.rate_form != "beta":
         raise GrainfracError("stress_corrosion.rate_form = physical: beta1 and beta2 follow from paper Eq. 6; fix: "

@@ -217,7 +217,7 @@ def reference_differences(params) -> list:
     """"key: calibrated X, run Y" for each parameter in :data:`STRENGTH_KEYS` in which ``params`` differ from
     the shipped ones, with which calibration.reference_ucs was calibrated ([] if none)."""
     from ..params import load_parameters
-    from ..runio import comparable_parameters
+    from ..runs.runio import comparable_parameters
     run = comparable_parameters(params.to_dict())
     shipped = comparable_parameters(load_parameters().to_dict())
     keys = sorted(k for k in set(run) | set(shipped) if k.startswith(STRENGTH_KEYS))
@@ -302,7 +302,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     import json
 
     from ..analysis.runparams import load_run_parameters
-    from ..runio import CHECKPOINT, SUMMARY, checkpoint_folder, read_checkpoint_state
+    from ..runs.runio import CHECKPOINT, SUMMARY, checkpoint_folder, read_checkpoint_state
     folder = Path(folder)
     try:
         command = json.loads((folder / "run.json").read_text()).get("command")
@@ -355,10 +355,10 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..creep_analysis import CreepStages, damage_index, resolve_creep_stages
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
+    from ..runs.runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
     from ..specimen import build_specimen
-    from ..yade_adapter.creep_test import resume_creep, run_creep
+    from ..yade_adapter.creep_protocol import resume_creep, run_creep
     from ..yade_adapter.scene import bond_segments, broken_counts
     t0, c0 = time.time(), time.process_time()
     require_plane(params, "creep")
@@ -478,7 +478,7 @@ def write_crack_list(path, run):
     """cracks.csv: bond, creep time (empty for a crack of the ramp), phase (``ramp`` or ``creep``), mode, kind,
     position, orientation, segment end points and the creep time its cells separated (macrocrack; empty if
     never); docs/output_files.md."""
-    from ..runio import write_csv
+    from ..runs.runio import write_csv
     from ..yade_adapter.scene import SHEAR, bond_segments
     sc = run.scene
     idx = np.flatnonzero(sc.broken)

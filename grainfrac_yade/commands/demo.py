@@ -46,7 +46,7 @@ def _say(t0, msg):
 
 
 def cmd_demo(args, params) -> int:
-    from ..batchrun import run_batch, write_table
+    from ..runs.batchrun import run_batch, write_table
     from ..errors import GrainfracError
     from ..params import flat_values, require_plane
     from .specimen import run_specimen
@@ -112,7 +112,7 @@ def check_demo_arguments(args, params) -> None:
 
 def _failed_rows(table, log_dir) -> list:
     """The rows of ``table`` run into ``log_dir`` that did not finish a run (:func:`row_outcomes`)."""
-    from ..batchrun import read_table_rows, row_outcomes
+    from ..runs.batchrun import read_table_rows, row_outcomes
     _, rows, _ = read_table_rows(table)
     return [o for o in row_outcomes(table, log_dir, list(rows)) if not o.ok]
 

@@ -2,30 +2,41 @@
 from __future__ import annotations
 
 
-#: Static models of the YADE deformable cells and the grain model each one solves.
-CLUSTER_MODELS = {"lattice": "deformable", "fem": "fem"}
+#: Static models of the YADE fem cells and the grain model each one solves.
+CLUSTER_MODELS = {"fem": "fem"}
+#: Names ``--grains`` no longer takes, and the fix.
+RETIRED_GRAINS = {"deformable": "the triangle-mesh reference is called mesh now; fix: --grains mesh",
+                  "lattice": "the spring lattice was retired, fem cells superseded it; fix: --grains fem"}
 
 
 def register(sub, common):
     from ..elastic import GRAIN_MODELS
     from ..grainmesh import CONTACT_PLACEMENTS
     p = sub.add_parser("elastic", help="static elastic reference: E, nu and the contact stress tail "
-                                       "of rigid vs deformable cells (seconds, no YADE)")
+                                       "of rigid, mesh and fem cells (seconds, no YADE)")
     common(p)
-    p.add_argument("--grains", choices=GRAIN_MODELS, default="deformable",
-                   help="rigid: the project's rigid cells and bonds; deformable: triangle-mesh cells with "
-                        "Table 1 moduli (the paper's deformable blocks); lattice and fem: the YADE deformable "
-                        "cells (links or finite elements) solved statically (default: deformable)")
+    p.add_argument("--grains", type=_grains, choices=GRAIN_MODELS, default="mesh",
+                   help="rigid: the project's rigid cells and bonds; mesh: triangle-mesh cells with "
+                        "Table 1 moduli (the paper's deformable blocks, the reference); fem: the YADE "
+                        "finite-element cells solved statically (default: mesh)")
     p.add_argument("--nodes-per-face", type=int,
-                   help="deformable, lattice and fem: contact nodes per face (resolution.nodes_per_face, default 2 = "
+                   help="mesh and fem: contact nodes per face (resolution.nodes_per_face, default 2 = "
                         "UDEC's corner sub-contacts)")
     p.add_argument("--contacts", choices=CONTACT_PLACEMENTS, default="corners",
-                   help="deformable: contact nodes at the face ends (trapezoid shares) or sub-segment centres")
-    p.add_argument("--rings", type=int, default=1, help="deformable: radial mesh refinement of each cell")
+                   help="mesh: contact nodes at the face ends (trapezoid shares) or sub-segment centres")
+    p.add_argument("--rings", type=int, default=1, help="mesh: radial mesh refinement of each cell")
     p.add_argument("--platens", choices=("cells", "wall"), default="cells",
                    help="cells: the end cells move with the platens, as in the YADE tests; wall: only nodes "
                         "on the walls (triangle meshes only)")
     p.set_defaults(func=cmd_elastic, with_params=True, param_overrides=_model_overrides)
+
+
+def _grains(text: str) -> str:
+    """``--grains`` value; one line for a retired name."""
+    import argparse
+    if text in RETIRED_GRAINS:
+        raise argparse.ArgumentTypeError(f"{text!r}: {RETIRED_GRAINS[text]}")
+    return text
 
 
 def _model_overrides(args) -> list:
@@ -51,9 +62,9 @@ def cmd_elastic(args, params) -> int:
     return 0
 
 
-def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face=2, contacts="corners",
+def run_elastic_to_folder(params, seed, out, grains="mesh", nodes_per_face=2, contacts="corners",
                           rings=1, platens="cells", overwrite=False) -> dict:
-    """Solve ``grains`` and, for comparison, the rigid cells (and for the lattice the mesh reference
+    """Solve ``grains`` and, for comparison, the rigid cells (and for fem cells the mesh reference
     at the same contact nodes, with ``relative_error_vs_reference``); write summary.json and the
     histogram PNG.
 
@@ -62,21 +73,23 @@ def run_elastic_to_folder(params, seed, out, grains="deformable", nodes_per_face
     """
     from ..analysis.figures import contact_stress_histograms
     from ..elastic import contact_ratios, elastic_summary
-    from ..runio import code_version, commit_run_dir, prepare_run_dir, write_json
+    from ..grains import grain_model
+    from ..runs.runio import code_version, commit_run_dir, prepare_run_dir, write_json
     from ..specimen import build_specimen
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     models, ratios = {}, {}
     # the YADE cells are always compared with the mesh reference at the same contact nodes per face
-    names = [grains, "rigid"] + (["deformable"] if grains in CLUSTER_MODELS else [])
+    names = [grains, "rigid"] + (["mesh"] if grains in CLUSTER_MODELS else [])
     for name in dict.fromkeys(names):
-        s, net, sol = elastic_summary(specimen, params, name, nodes_per_face, contacts, rings,
+        layout = None if name == "mesh" else grain_model(name).build_layout(specimen, params)
+        s, net, sol = elastic_summary(specimen, params, name, layout, nodes_per_face, contacts, rings,
                                       platens=platens if name != "rigid" else "cells")
         models[name] = s
         ratios[name] = contact_ratios(net, sol)
     summary = dict(models[grains])
     if grains in CLUSTER_MODELS:
-        ref = models["deformable"]
+        ref = models["mesh"]
         summary["relative_error_vs_reference"] = {k: v / ref[k] - 1.0 for k, v in models[grains].items()
                                                   if isinstance(v, float) and k in ref and ref[k]}
     summary.update(models=models, seed=seed, n_cells=specimen.n_cells, platens=platens,

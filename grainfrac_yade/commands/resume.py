@@ -34,7 +34,7 @@ def resumable_run(folder, command: str):
     """(parameters, checkpoint state) of the unfinished ``command`` run in ``folder``, or None if it is
     finished (summary.json).  GrainfracError (one line) if the folder holds no such run or no checkpoint."""
     from ..analysis.runparams import load_run_parameters
-    from ..runio import CHECKPOINT, SUMMARY, read_checkpoint_state
+    from ..runs.runio import CHECKPOINT, SUMMARY, read_checkpoint_state
     folder = Path(folder)
     try:
         found = json.loads((folder / "run.json").read_text()).get("command")

@@ -5,10 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dem_step import critical_dem_step
-from ..layout import layout_for
+from ..grains import critical_dem_step, layout_for
 from ..plotting import specimen_figure
-from ..runio import commit_run_dir, prepare_run_dir, write_json
+from ..runs.runio import commit_run_dir, prepare_run_dir, write_json
 from ..specimen import build_specimen
 
 
@@ -68,8 +67,7 @@ def run_specimen_in_yade():
         out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
         record = run_specimen(params, int(controls["seed"]), out, overwrite=False)
     scene = build_scene(build_specimen(params, int(controls["seed"])), params)
-    record["n_bonds_yade"] = scene.O.interactions.countReal() - len(scene.links)   # breakable bonds
-    record["n_links_yade"] = len(scene.links)   # unbreakable intra-cell links (deformable cells)
+    record["n_bonds_yade"] = scene.O.interactions.countReal()   # breakable bonds
     record["engines"] = scene.engine_names()
     record["dt_critical_yade"] = scene.dt_critical   # equals critical_dem_step_s (the same arithmetic)
     write_json(Path(out) / "specimen.json", {k: v for k, v in record.items() if k != "out"})

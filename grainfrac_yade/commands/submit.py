@@ -4,7 +4,7 @@
                                                           --max-running K --script S --dry-run]
 
 Writes ``results/NAME/slurm/`` (the study record, the frozen table, the sbatch script of each
-submission, logs, task records; see :mod:`grainfrac_yade.slurm`) and submits the array with
+submission, logs, task records; see :mod:`grainfrac_yade.runs.slurm`) and submits the array with
 ``sbatch``.  Each task runs its row exactly as a local batch row (``YADE_BATCH=<table>:<line> yade
 -n -x <script>``) into ``results/NAME/<row name>/``.  Submitting the study again submits only the
 rows without a finished summary.json that are neither queued nor running; a resubmitted row
@@ -72,7 +72,7 @@ def check_table_columns(table, command: str) -> None:
 def check_out_column(table, study_dir: Path) -> None:
     """A row's ``out`` cell must keep its run folder inside the study folder (or be empty)."""
     from ..errors import GrainfracError
-    from ..slurm import cell_value
+    from ..runs.slurm import cell_value
     for r in table.rows:
         out = cell_value(r.cells.get("out", "''"))
         if out in ("", None):
@@ -86,7 +86,7 @@ def check_out_column(table, study_dir: Path) -> None:
 def rows_to_submit(study_dir, record, table) -> tuple:
     """(rows, states, note) of a study submitted before: rows neither finished nor queued/running."""
     from ..errors import GrainfracError
-    from ..slurm import record_path, study_states, table_digest
+    from ..runs.slurm import record_path, study_states, table_digest
     if record.get("table_digest") != table_digest(table):
         raise GrainfracError(f"{record_path(study_dir)}: study {record['study']!r} was submitted from "
                              f"{record['source_table']} with other rows or columns than {table.path}; fix: "
@@ -103,7 +103,7 @@ def rows_to_submit(study_dir, record, table) -> tuple:
 
 def cmd_submit(args) -> int:
     from ..errors import GrainfracError
-    from ..slurm import (SubmitOptions, frozen_table_text, log_path, new_record, now_iso, read_batch_table,
+    from ..runs.slurm import (SubmitOptions, frozen_table_text, log_path, new_record, now_iso, read_batch_table,
                          read_json_file, record_path, render_sbatch, slurm_dir, study_dir_of, write_record,
                          write_text_atomically)
     options = SubmitOptions(study=args.study, partition=args.partition, time=args.time,

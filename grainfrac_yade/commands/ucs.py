@@ -79,24 +79,24 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
     from ..plotting import crack_map
-    from ..runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
+    from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
-    from ..yade_adapter import ucs_test
+    from ..yade_adapter import ucs_protocol
     require_plane(params, "ucs")
     out = Path(out) if resume else prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     outputs = {"checkpoint_folder": out, "run_values": {"seed": seed}}
     if resume:
-        history, result, scene, (broken_peak, mode_peak) = ucs_test.resume_ucs(specimen, params, out,
+        history, result, scene, (broken_peak, mode_peak) = ucs_protocol.resume_ucs(specimen, params, out,
                                                                               progress=progress)
     else:
         snapshot = None
         if vtk_every:
             from ..yade_adapter.vtk_output import AXIAL_STRAIN, StrainSeries
             snapshot = StrainSeries(out / "vtk", vtk_every, AXIAL_STRAIN)
-        history, result, scene, (broken_peak, mode_peak) = ucs_test.run_ucs(specimen, params, progress=progress,
+        history, result, scene, (broken_peak, mode_peak) = ucs_protocol.run_ucs(specimen, params, progress=progress,
                                                                            snapshot=snapshot, **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
     no_result = result["numerical_failure"] or result.get("failed_before_test")
@@ -121,7 +121,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
 
 def write_cracks(path, scene):
     """cracks.csv: one row per broken bond (DEM step, mode, kind, position, orientation)."""
-    from ..runio import write_csv
+    from ..runs.runio import write_csv
     from ..yade_adapter.scene import SHEAR
     idx = np.flatnonzero(scene.broken)
     t = scene.specimen.tessellation

@@ -44,6 +44,18 @@ def law_module(name: str):
     return importlib.import_module(f"{__name__}.{name}")
 
 
+def scales_with_beta1(name) -> bool:
+    """Whether every time the law ``name`` gives is exactly proportional to 1/beta1: the law's own
+    ``time_scales_with_beta1`` flag (:class:`DegradationLaw`); False for a name that is no law (an
+    older run's, say)."""
+    return name in LAW_NAMES and law_module(name).LAW.time_scales_with_beta1
+
+
+def time_scaling_laws() -> tuple:
+    """The laws whose times all scale with 1/beta1, in :data:`LAW_NAMES` order."""
+    return tuple(n for n in LAW_NAMES if scales_with_beta1(n))
+
+
 def build_law(sc) -> DegradationLaw:
     """The law ``sc.law`` built once from the ``[stress_corrosion]`` parameters ``sc``."""
     return law_module(sc.law).build(sc)
@@ -51,4 +63,4 @@ def build_law(sc) -> DegradationLaw:
 
 __all__ = ["LAW_NAMES", "BondState", "CreepStep", "DegradationLaw", "EVENT_REL_TOL", "MODE_CORRODED", "MODE_NEVER",
            "MODE_SHEAR", "MODE_TENSION", "Stresses", "build_law", "check_finite", "creep_step", "degrade_step",
-           "failed_now", "law_module", "shear_strength"]
+           "failed_now", "law_module", "scales_with_beta1", "shear_strength", "time_scaling_laws"]

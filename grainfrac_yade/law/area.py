@@ -318,6 +318,10 @@ class AreaLaw(DegradationLaw):
         return dt, failing, modes[failing]
 
 
+#: The law this module builds (its class attributes, e.g. ``time_scales_with_beta1``, are the law's own).
+LAW = AreaLaw
+
+
 def build(sc) -> AreaLaw:
     """The area law from ``[stress_corrosion]`` parameters (beta1 [Pa/s], beta2 [1/Pa])."""
     return AreaLaw(sc.beta1, sc.beta2)

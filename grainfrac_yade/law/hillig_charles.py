@@ -232,6 +232,10 @@ class HilligCharles(StrengthLaw):
                              state.tan_friction, self.beta1, self.beta2)
 
 
+#: The law this module builds (its class attributes, e.g. ``time_scales_with_beta1``, are the law's own).
+LAW = HilligCharles
+
+
 def build(sc) -> HilligCharles:
     """Paper Eq. 7 from ``[stress_corrosion]`` parameters (beta1, beta2, threshold_ratio, threshold_stress)."""
     return HilligCharles(sc.beta1, sc.beta2, sc.threshold_ratio, sc.threshold_stress)

@@ -137,6 +137,10 @@ class Normalised(StrengthLaw):
         return {"tensile_strength": np.maximum(new_t, 0.0), "cohesion": cohesion}
 
 
+#: The law this module builds (its class attributes, e.g. ``time_scales_with_beta1``, are the law's own).
+LAW = Normalised
+
+
 def build(sc) -> Normalised:
     """The normalised law from ``[stress_corrosion]`` (beta1 [Pa/s], beta2_normalised [1], thresholds)."""
     return Normalised(sc.beta1, sc.beta2_normalised, sc.threshold_ratio, sc.threshold_stress)

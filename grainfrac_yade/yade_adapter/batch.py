@@ -3,13 +3,13 @@
 Every parameter path (``section.key``, the names of ``--set``) is a possible
 column of a batch table, plus ``seed``, ``out``, ``study``, ``description`` and
 ``on_change``.  Values are read with YADE's own ``readParamsFromTable`` (each cell
-is a Python expression, so text is quoted: ``'deformable'``) and validated like files.
+is a Python expression, so text is quoted: ``'fem'``) and validated like files.
 
 A row whose folder already holds a finished run (summary.json) is skipped only if
 that run's stored parameters (params.json) and run values (seed, load) equal the
 row's; otherwise the row stops with one line naming the folder and the keys that
 differ, or, with ``on_change`` = ``'new_folder'``, runs into ``<folder>_<digest>``
-(:func:`grainfrac_yade.runio.run_digest` of its parameters), skipped in turn once
+(:func:`grainfrac_yade.runs.runio.run_digest` of its parameters), skipped in turn once
 finished there.  An unfinished creep, UCS or Brazilian row whose folder holds a checkpoint of the
 same parameters and run values goes on from it (:func:`row_plan`); otherwise it starts again.
 """
@@ -21,10 +21,10 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..batchrun import read_table_rows
+from ..runs.batchrun import read_table_rows
 from ..errors import GrainfracError
 from ..params import nearest_key, renamed_key_fix, shipped_values
-from ..runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
+from ..runs.runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
 from . import load_yade
 
 #: Table columns that are not model parameters: run controls, with defaults.
@@ -67,7 +67,7 @@ def read_table(extra_columns=None) -> tuple:
     try:
         utils.readParamsFromTable(noTableOk=True, **defaults, **run_defaults)
     except NameError as exc:   # YADE evaluates every cell as Python: text without quotes (columns checked above)
-        raise GrainfracError(f"batch table row {spec}: {exc}; fix: text cells must be quoted, e.g. 'deformable'"
+        raise GrainfracError(f"batch table row {spec}: {exc}; fix: text cells must be quoted, e.g. 'fem'"
                              ) from None
     table = yade.params.table
     overrides = [(k, getattr(table, k)) for k, v in defaults.items() if getattr(table, k) != v]
@@ -108,13 +108,13 @@ def run_folder_name(controls: dict, overrides) -> str:
 
 
 #: Environment variable naming a JSON file in which a row records the run folder it chose (set by the SLURM
-#: task wrapper, :mod:`grainfrac_yade.slurmtask`; the same name as ``grainfrac_yade.slurm.ROW_FOLDER_ENV``).
+#: task wrapper, :mod:`grainfrac_yade.runs.slurmtask`; the same name as ``grainfrac_yade.runs.slurm.ROW_FOLDER_ENV``).
 ROW_FOLDER_ENV = "GRAINFRAC_ROW_FOLDER_FILE"
 
 
 #: Environment variable naming a folder in which each yade-batch row records the run folder it chose, as
-#: ``<line number>.json`` (set by the ``batch`` command and the demo, :func:`grainfrac_yade.batchrun.run_batch`;
-#: the same name as ``grainfrac_yade.batchrun.ROW_FOLDERS_ENV``).
+#: ``<line number>.json`` (set by the ``batch`` command and the demo, :func:`grainfrac_yade.runs.batchrun.run_batch`;
+#: the same name as ``grainfrac_yade.runs.batchrun.ROW_FOLDERS_ENV``).
 ROW_FOLDERS_ENV = "GRAINFRAC_ROW_FOLDERS"
 
 
@@ -127,12 +127,12 @@ def record_row_folder(out: Path) -> Path:
     spec = os.environ.get("YADE_BATCH", "")
     folders = os.environ.get(ROW_FOLDERS_ENV)
     if folders and ":" in spec:
-        from ..runio import write_json
+        from ..runs.runio import write_json
         Path(folders).mkdir(parents=True, exist_ok=True)
         write_json(Path(folders) / f"{spec.rsplit(':', 1)[1]}.json", {"folder": str(Path(out).resolve())})
     target = os.environ.get(ROW_FOLDER_ENV)
     if target:
-        from ..runio import write_json
+        from ..runs.runio import write_json
         Path(target).parent.mkdir(parents=True, exist_ok=True)
         write_json(target, {"folder": str(Path(out).resolve())})
     return out

@@ -5,7 +5,7 @@ from __future__ import annotations
 import statistics
 import time
 
-from .creep_test import CreepRun
+from .creep_protocol import CreepRun
 
 #: DEM steps of the probe that sizes the timing windows.
 PROBE_STEPS = 200

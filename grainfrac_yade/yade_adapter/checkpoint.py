@@ -1,6 +1,6 @@
 """Checkpoints of long runs (creep, UCS and Brazilian tests) and resuming from them (``--resume DIR``).
 
-A checkpoint is the folder ``DIR/checkpoint/`` (:data:`grainfrac_yade.runio.CHECKPOINT`):
+A checkpoint is the folder ``DIR/checkpoint/`` (:data:`grainfrac_yade.runs.runio.CHECKPOINT`):
 
 * ``scene.yade.gz``: the YADE scene (``O.save``, YADE's binary archive, gzip'd: exact doubles);
 * ``arrays.npz``: the driver's per-bond arrays (bookkeeping of breaks; creep: the degradation law's
@@ -50,8 +50,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..clocks import EventClock, PaperClock
 from ..errors import GrainfracError
-from ..runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
+from ..grains import grain_model
+from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
+from .corrosion_engine import StressCorrosion, add_stiffness_restorer
+from .platens import StressServo
 
 #: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
 SCENE_FILE = "scene.yade.gz"
@@ -164,7 +168,7 @@ def base_state(test: str, run, phase: str, loop: dict, run_values: dict, version
             "code_version": version, "written": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "dem_steps": int(sc.O.iter), "wall_s": time.time() - run.t0, "cpu_s": time.process_time() - run.c0,
             "scene": {"n_bodies": len(sc.O.bodies), "n_bonds": sc.n_bonds, "cracks_seen": sc._cracks_seen,
-                      "tens_seen": getattr(sc, "_tens_seen", 0)}}
+                      "tens_seen": sc._tens_seen}}
 
 
 def scene_arrays(scene) -> dict:
@@ -187,13 +191,13 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
                 "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
                 "n_events": run.n_events, "vtk_times": run.vtk_times, "vtk_written": run.vtk_written,
                 "vtk_rows": run._vtk_rows, "vtk": run.vtk_folder is not None, "vtk_every": run.vtk_every,
-                "last_relaxation_steps": getattr(run, "last_relaxation_steps", 0), "resumes": run.resumes,
-                "consolidation": getattr(run, "consolidation", {})},
+                "last_relaxation_steps": run.last_relaxation_steps, "resumes": run.resumes,
+                "consolidation": run.consolidation},
         "platens": platen_state(pl),
         "servo": None, "clock": None, "corrosion": None, "start_table_columns": None,
     }
     arrays = {**scene_arrays(sc), "break_time": run.break_time, "macro_time": run.macro_time}
-    servo = getattr(run, "servo", None)
+    servo = run.servo
     if servo is not None:
         state["servo"] = {"target": servo.target, "gain": servo.gain, "max_speed": servo.max_speed,
                           "stress": float(servo.stress)}
@@ -202,7 +206,7 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
         state["corrosion"] = {"creep_time": corr["creep_time"], "law": corr["law"], "restored": corr["restored"]}
         arrays.update(tensile_strength_pa=np.asarray(corr["tensile_strength_pa"]),
                       cohesion_pa=np.asarray(corr["cohesion_pa"]), area_fraction=np.asarray(corr["area_fraction"]))
-    clock = getattr(run, "clock", None)
+    clock = run.clock
     if clock is not None:
         state["clock"] = clock.state_dict()
     if run.initial_bond_stresses is not None:
@@ -253,8 +257,6 @@ def rebind_scene(scene):
         return out
 
     scene.interactions = pairs(scene.layout.bond_spheres)
-    if scene.links:
-        scene.links = pairs(scene.layout.link_spheres)
     loops = [e for e in O.engines if isinstance(e, w.InteractionLoop)]
     scene.law = next(f for f in loops[0].lawDispatcher.functors
                      if isinstance(f, w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM))
@@ -292,17 +294,10 @@ def restore_platens(pl, p: dict):
     pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]
 
 
-#: Why a resumed run of finite-element cells is not bit-identical (measured: 3 x 6 mm fem UCS resumed at
-#: DEM step 20,179: E -6e-5, crack initiation -4e-5, peak +5e-7 relative, the same 26 bonds broken in the
-#: same modes, up to 17 DEM steps apart; docs/resuming.md).
-FEM_INEXACT = ("finite-element cells: YADE keys an element's nodes by their memory address, which O.load changes, "
-               "so the element sums its nodes in another order: the resumed run differs from an uninterrupted one "
-               "by rounding that grows (measured: E within 1e-4 relative)")
-
 
 def inexact_note(params) -> str:
     """"" if a resume of a run with ``params`` is bit-identical to the uninterrupted run (one thread), else why not."""
-    return FEM_INEXACT if params.resolution.grain_model == "fem" else ""
+    return grain_model(params.resolution.grain_model).resume_note
 
 
 def resume_record(state: dict) -> dict:
@@ -319,10 +314,6 @@ def restore(run, where, state: dict, arrays: dict):
 
     Returns (phase, loop counters) for the driver to go on from.
     """
-    from ..clocks import EventClock, PaperClock
-    from .corrosion_engine import StressCorrosion
-    from .creep_test import add_stiffness_restorer
-    from .platens import StressServo
     sc, pl = run.scene, run.platens
     restore_scene(sc, where, state, arrays, run.confinement)
     restore_platens(pl, state["platens"])
@@ -341,8 +332,7 @@ def restore(run, where, state: dict, arrays: dict):
     run.c0 = time.process_time() - state.get("cpu_s", 0.0)
     if state["servo"] is not None:
         s = state["servo"]
-        servo = StressServo(pl, s["target"], 1.0, 1, s["max_speed"])
-        servo.gain, servo.stress = s["gain"], s["stress"]
+        servo = StressServo.restored(pl, s["target"], s["gain"], s["max_speed"], s["stress"])
         run.servo = servo
         sc.drivers.append(servo)
     if state["corrosion"] is not None:

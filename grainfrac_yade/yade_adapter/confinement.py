@@ -3,7 +3,7 @@
 A flexible membrane: every boundary face of the cells on the left and right walls carries a
 constant inward force sigma_3 x face length x thickness, normal to the original wall, on the
 cell's body nearest the face's midpoint (the cell itself for rigid cells; a node sphere of a
-deformable or finite-element cell).  The forces are YADE permanent forces: they act in every DEM
+finite-element cell).  The forces are YADE permanent forces: they act in every DEM
 step with no Python call, and do not follow the cells as the specimen bulges or cracks open.  The
 lateral stress is therefore sigma_3 by construction, over the specimen's original height.
 

@@ -193,3 +193,9 @@ def _check_written(idx, *values):
     """NumericalFailure unless every value meant for YADE's bonds ``idx`` is finite."""
     for v in values:
         check_finite("value written to a YADE bond", v, idx)
+
+
+def add_stiffness_restorer(scene, corr):
+    """For a law that changes stiffness: broken bonds get their contact stiffness back before the next step."""
+    if not corr.law.exact_jump:
+        scene.drivers.append(ContactStiffnessRestorer(corr))

@@ -3,7 +3,7 @@
 Each lever changes the bonds or the cells of a scene built by :func:`.scene.build_scene` before
 the first DEM step; with every lever off (:class:`Levers` defaults) nothing is touched, so results
 are bit-identical to a scene without levers.  They are options of the ``brazilian`` command and of
-the lever study (``docs/brazilian_levers.py``, which applies them to UCS tests too), recorded in
+the lever study (``studies/brazilian_levers.py``, which applies them to UCS tests too), recorded in
 each summary.json under ``levers``; they are not model parameters (``params/``) yet, so the other
 commands (ucs, creep) do not know them.  The tensile strength of the contacts alone is a parameter
 already: ``brazilian --tensile-scale`` (contact rows' J^T).
@@ -66,7 +66,7 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         return done
     if scene.O.iter != 0:
         raise GrainfracError("levers: the scene has already run; fix: apply levers right after build_scene")
-    if not scene.layout.rigid_cells:
+    if scene.model.name != "rigid":
         raise GrainfracError("levers: built for rigid cells; fix: use resolution.grain_model = \"rigid\"")
     rng = np.random.default_rng([int(seed), LEVER_STREAM])
     n = scene.n_bonds

@@ -6,7 +6,7 @@ platen face stays flat), and their lateral motion is free (smooth platen,
 ``platen_lateral = "free"``) or blocked (rough platen, ``"fixed"``).  The axial
 stress is the platens' reaction over the specimen cross-section (width x
 thickness); lateral strain comes from the cells on the side walls.  With
-deformable cells all bodies (spheres) of those cells take part: a platen cell's
+fem cells all bodies (spheres) of those cells take part: a platen cell's
 spheres all move at the platen's speed, and the side-wall positions are the
 means over the side cells' spheres.
 """
@@ -170,6 +170,14 @@ class StressServo:
         self.stress = 0.0
         self.clipped = 0
         self.closing_clipped_steps = 0
+
+    @classmethod
+    def restored(cls, platens: Platens, target: float, gain: float, max_speed: float, stress: float) -> "StressServo":
+        """A servo as a checkpoint saved it: its own ``gain`` [m/Pa] and last measured ``stress`` [Pa]."""
+        servo = cls.__new__(cls)
+        servo.platens, servo.target, servo.gain, servo.max_speed = platens, target, gain, max_speed
+        servo.stress, servo.clipped, servo.closing_clipped_steps = stress, 0, 0
+        return servo
 
     def before_step(self, scene):
         self.stress = self.platens.axial_stress()

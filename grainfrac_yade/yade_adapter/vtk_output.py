@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..vtkio import (BOND_KIND_NAMES, BOND_STATE_NAMES, cluster_rigid_motion, rigid_motion, series_file,
+from ..vtkio import (BOND_KIND_NAMES, BOND_STATE_NAMES, rigid_motion, series_file,
                      time_field, write_polygons, write_pvd, write_segments)
 from .scene import bond_segments
 
@@ -25,40 +25,19 @@ AXIAL_STRAIN = ("axial_strain", "1")
 DIAMETRAL_STRAIN = ("diametral_strain", "1")
 
 
-def sphere_positions(scene) -> np.ndarray:
-    """(s, 3) current positions of the layout's spheres [m] (deformable cells: one body each)."""
-    return np.array([tuple(scene.O.bodies[int(b)].state.pos) for b in scene.sphere_body])
-
-
 def cell_motion(scene):
     """(n, 2+) positions [m] of the cell centroids and (n,) rotation angles about z [rad].
 
-    Rigid cells: the cell bodies' positions and rotations.  Deformable cells: the least-squares
-    rigid motion (translation + rotation) of each cell's spheres, weighted by their lumped areas.
+    Rigid cells: the cell bodies' positions and rotations.  Fem cells: the least-squares rigid motion
+    (translation + rotation) of each cell's spheres, weighted by their lumped areas.
     """
-    if not scene.layout.rigid_cells:
-        lay = scene.layout
-        return cluster_rigid_motion(lay.sphere_center, sphere_positions(scene), lay.sphere_cell, lay.sphere_area,
-                                    scene.specimen.tessellation.cell_centroid)
-    pos, angle = [], []
-    for b in scene.cell_body:
-        st = scene.O.bodies[int(b)].state
-        axis, ang = st.ori.toAxisAngle()
-        pos.append(tuple(st.pos))
-        angle.append(float(ang) * float(axis[2]))
-    return np.array(pos), np.array(angle)
+    return scene.cells.cell_motion(scene)
 
 
 def bond_shift(scene, pos) -> np.ndarray:
     """(b, 2) displacement [m] drawn for each bond: the mean of its two cells' (rigid) or two spheres'
-    (deformable) displacements; ``pos``: the cell positions of :func:`cell_motion`."""
-    lay, tess = scene.layout, scene.specimen.tessellation
-    if not lay.rigid_cells:
-        disp = sphere_positions(scene)[:, :2] - lay.sphere_center[:, :2]
-        return 0.5 * (disp[lay.bond_spheres[:, 0]] + disp[lay.bond_spheres[:, 1]])
-    cells_of_bond = scene.bond_cells
-    return 0.5 * (pos[cells_of_bond[:, 0], :2] + pos[cells_of_bond[:, 1], :2]
-                  - tess.cell_centroid[cells_of_bond[:, 0], :2] - tess.cell_centroid[cells_of_bond[:, 1], :2])
+    (fem) displacements; ``pos``: the cell positions of :func:`cell_motion`."""
+    return scene.cells.bond_shift(scene, pos)
 
 
 def code_tables(specimen) -> dict:

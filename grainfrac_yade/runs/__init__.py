@@ -1,0 +1,7 @@
+"""Run folders, batch tables and SLURM (pure core; no YADE).
+
+* :mod:`.runio`: run folders: ``run.json`` first, atomic writes, ``summary.json`` last; code versions
+  and the parameter digests that key batch rows;
+* :mod:`.batchrun`: batch tables (reading, checking, writing) and running them through yade-batch;
+* :mod:`.slurm`: SLURM job arrays of a table's rows; :mod:`.slurmtask`: the task each array job runs.
+"""
