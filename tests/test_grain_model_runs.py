@@ -141,7 +141,7 @@ def fake_scene(specimen, layout):
     n = layout.n_bonds
     return SimpleNamespace(specimen=specimen, layout=layout, n_bonds=n, broken=np.zeros(n, bool),
                            break_step=np.full(n, -1), break_mode=np.zeros(n, int), bond_is_inter=np.zeros(n, bool),
-                           O=SimpleNamespace(iter=1000))
+                           O=SimpleNamespace(iter=1000), sliding_erasures=lambda: 0)
 
 
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):
@@ -163,6 +163,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
     rows = [{"creep_time_s": t, "axial_strain": 2e-3 + 1e-9 * t, "lateral_strain": -4e-4, "axial_stress_pa": 200e6,
              "broken_total": 3, "macrocracks": 0, "dem_steps": 1000, "wall_s": 0.1} for t in (0.0, 10.0, 20.0)]
     run = SimpleNamespace(rows=rows, ramp_broken=3, failed=False, failure_reason="", failed_on_loading=False,
+                          failed_before_test=False,
                           numerical_failure=False, n_events=2, scene=scene, vtk_written=[], initial_bond_stresses=None,
                           break_time=np.full(lay.n_bonds, np.nan), macro_time=np.full(lay.n_bonds, np.nan))
     monkeypatch.setattr(creep_protocol, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
