@@ -231,8 +231,9 @@ def stand_in_run(tiny, rows, failed=False, numerical=False, reason=""):
     broken[:2] = True
     scene = SimpleNamespace(specimen=specimen, layout=layout, n_bonds=n, broken=broken, break_step=np.full(n, -1),
                             break_mode=np.where(broken, 1, 0), bond_is_inter=np.zeros(n, bool),
-                            O=SimpleNamespace(iter=1234))
+                            O=SimpleNamespace(iter=1234), sliding_erasures=lambda: 0)
     return SimpleNamespace(rows=rows, ramp_broken=2, failed=failed, failure_reason=reason, failed_on_loading=False,
+                           failed_before_test=False,
                            numerical_failure=numerical, n_events=0, scene=scene, vtk_written=[],
                            initial_bond_stresses=None, break_time=np.where(broken, -1.0, np.nan),
                            macro_time=np.full(n, np.nan))
@@ -453,7 +454,7 @@ def test_cli_grain_above_the_width_exits_2_with_one_line(tmp_path):
     res = _cli("specimen", "--width", "10e-3", "--height", "20e-3", "--grain-size", "12e-3", "--out", tmp_path / "x")
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert res.stderr.splitlines() == [
-        "error: --set: specimen.grain_size: 0.012 m is at or above the specimen's width (0.01 m); fix: make "
+        "error: --grain-size: specimen.grain_size: 0.012 m is at or above the specimen's width (0.01 m); fix: make "
         "specimen.grain_size smaller than specimen.width (paper: 1 mm in a 31.7 mm wide specimen) or enlarge the "
         "specimen"]
     assert not (tmp_path / "x").exists()
