@@ -31,7 +31,7 @@ declare -A WHAT=(
   [accuracy_cost_paper_size]="docs/studies/accuracy_cost.md paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
   [threshold]="docs/studies/creep.md long-term strength table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
-  [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired UCS/E of fem cells with the intact-joint guard at 0-10 %, without it and of rigid cells at 0, 2, 5 % (docs/regularisation_ucs.csv, 33 UCS runs: about 60 min on one core)"
+  [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired UCS/E of fem cells with the intact-joint guard at 0-10 %, without it and of rigid cells at 0, 2, 5 % (docs/regularisation_ucs.csv, 33 UCS runs: 38 CPU min measured on 2 shared cores)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
