@@ -79,3 +79,15 @@ def test_the_guard_is_in_fem_scenes_only():
     rigid = load_parameters(overrides=TINY)
     assert "IntactJointGuard" in build_scene(build_specimen(fem, 1), fem).engine_names()
     assert "IntactJointGuard" not in build_scene(build_specimen(rigid, 1), rigid).engine_names()
+
+
+@needs_yade
+def test_a_checkpoint_keeps_the_erasure_count():
+    """The synced count is scene state: a resumed run reports what the uninterrupted one would."""
+    import time
+    from types import SimpleNamespace
+    from grainfrac_yade.yade_adapter.checkpoint import base_state
+    sc, *_ = _sheared_bond(keep=False)
+    sc.erased_by_sliding = 3
+    run = SimpleNamespace(scene=sc, t0=time.time(), c0=time.process_time())
+    assert base_state("ucs", run, "loading", {}, {}, "")["scene"]["erased_by_sliding"] == 3

@@ -168,7 +168,7 @@ def base_state(test: str, run, phase: str, loop: dict, run_values: dict, version
             "code_version": version, "written": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "dem_steps": int(sc.O.iter), "wall_s": time.time() - run.t0, "cpu_s": time.process_time() - run.c0,
             "scene": {"n_bodies": len(sc.O.bodies), "n_bonds": sc.n_bonds, "cracks_seen": sc._cracks_seen,
-                      "tens_seen": sc._tens_seen}}
+                      "tens_seen": sc._tens_seen, "erased_by_sliding": sc.erased_by_sliding}}
 
 
 def scene_arrays(scene) -> dict:
@@ -283,6 +283,8 @@ def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):
         confinement.apply()   # permanent forces are not saved with the scene
     sc.broken, sc.break_mode, sc.break_step = (np.array(arrays[k]) for k in ("broken", "break_mode", "break_step"))
     sc._cracks_seen, sc._tens_seen = state["scene"]["cracks_seen"], state["scene"]["tens_seen"]
+    # checkpoints written before the count was kept: none was counted then
+    sc.erased_by_sliding = state["scene"].get("erased_by_sliding", 0)
     if sc.law.nbTensCracks + sc.law.nbShearCracks != sc._cracks_seen:
         raise GrainfracError(f"{where}: the loaded scene's crack count ({sc.law.nbTensCracks + sc.law.nbShearCracks}) "
                              f"is not the checkpoint's ({sc._cracks_seen}); fix: start the run again with --overwrite")
