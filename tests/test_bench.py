@@ -98,3 +98,36 @@ def test_stored_full_bench_has_the_clocks_to_failure_and_renders():
                 if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0]
     text = markdown_tables(data)
     assert "Creep to failure" in text and "| paper |" in text and "| event |" in text
+
+
+@needs_yade
+@pytest.mark.yade
+def test_fem_size_bench_on_tiny_specimens(monkeypatch, tmp_path):
+    """``bench --fem-sizes`` on two tiny specimens and one seed: the scene's critical step equals the core's
+    bound (the same formula, no YADE) to the last bits, the scene steps at or below it, every number is finite
+    and positive, the JSON written as it goes equals the result, and the table renders."""
+    from grainfrac_yade.commands import bench
+    monkeypatch.setattr(bench, "FEM_SIZES", (("10x20", 3e-3, 6e-3), ("paper", 4e-3, 8e-3)))
+    monkeypatch.setattr(bench, "FEM_SEEDS", (2,))
+    monkeypatch.setattr(bench, "FEM_WARMUP_STEPS", 20)
+    monkeypatch.setattr(bench, "FEM_TIMED_STEPS", 50)
+    out = tmp_path / "fem_sizes.json"
+    result = bench.run_fem_sizes(out=out)
+    assert [(r["specimen"], r["seed"]) for r in result["scenes"]] == [("10x20", 2), ("paper", 2)]
+    for r in result["scenes"]:
+        assert r["critical_step_s"] == pytest.approx(r["critical_step_core_s"], rel=1e-12)
+        assert 0 < r["dem_step_s"] <= r["critical_step_s"]
+        assert r["steps"] == 50
+    assert not [(path, value) for path, value in numbers(result)
+                if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0]
+    assert json.loads(out.read_text()) == json.loads(json.dumps(result))
+    text = bench.fem_sizes_table(result)
+    assert "| paper | 2 |" in text and "Cost per body, paper size over 10 x 20 mm" in text
+
+
+def test_creep_stress_needs_the_fem_size_bench():
+    """``--creep-stress`` alone gets one line naming the fix, not a traceback."""
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "bench", "--creep-stress", "160"],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert res.returncode != 0
+    assert "--fem-sizes" in res.stderr and "Traceback" not in res.stderr

@@ -56,6 +56,15 @@ SCENES = (
 FAILURE_SCENE = "rigid_1"
 #: Driving-stress ratio of calibration.reference_ucs held in every scene.
 DEFAULT_RATIO = 0.7
+#: Where ``bench --fem-sizes`` writes by default.
+FEM_SIZES_OUT = DEFAULT_OUT.with_name("bench_fem_sizes.json")
+#: Specimens of the finite-element size comparison: name, width [m], height [m] (the paper's: section 3.1).
+FEM_SIZES = (("10x20", 10e-3, 20e-3), ("paper", 31.7e-3, 63.4e-3))
+#: Seeds of the finite-element size comparison.
+FEM_SEEDS = (1, 2, 3)
+#: DEM steps of the loading ramp before and inside the timed window of the size comparison (the
+#: profile of docs/studies/fem_speed.md: 200 and 1,000).
+FEM_WARMUP_STEPS, FEM_TIMED_STEPS = 200, 1000
 
 
 @dataclass(frozen=True)
@@ -92,11 +101,30 @@ def register(sub, common):
                    help="TOML file merged over the shipped parameters, under each scene's own settings")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one parameter in every scene (a scene's own keys win)")
+    p.add_argument("--fem-sizes", action="store_true",
+                   help="only the finite-element size comparison: params/presets/fem.toml on 10 x 20 mm and the "
+                        "paper's 31.7 x 63.4 mm, seeds 1-3, critical and actual DEM step and the CPU cost of "
+                        f"{FEM_TIMED_STEPS} loading steps (default out: "
+                        f"{FEM_SIZES_OUT.relative_to(FEM_SIZES_OUT.parents[1])}; about 5 CPU min)")
+    p.add_argument("--creep-stress", type=float, metavar="MPA",
+                   help="with --fem-sizes: also one paper-size creep run to failure at this stress [MPa] "
+                        "(seed 1, event clock), with its CPU time and relaxation steps per event")
     p.set_defaults(func=cmd_bench)
 
 
 def cmd_bench(args) -> int:
+    from ..errors import GrainfracError
     from ..runs.runio import write_json
+    if args.creep_stress is not None and not args.fem_sizes:
+        raise GrainfracError("--creep-stress belongs to the finite-element size comparison; fix: add --fem-sizes")
+    if args.fem_sizes:
+        out = Path(args.out or FEM_SIZES_OUT)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        result = run_fem_sizes(extra_files=args.params, overrides=args.overrides, creep_stress_mpa=args.creep_stress,
+                               progress=print, out=out)
+        print(fem_sizes_table(result))
+        print(f"written: {out}")
+        return 0
     settings = QUICK if args.quick else FULL
     out = Path(args.out or ("results/bench_quick.json" if args.quick else DEFAULT_OUT))
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -220,6 +248,109 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
     if event.get("lifetime_s") and paper.get("lifetime_s"):
         out["paper_over_event_lifetime"] = paper["lifetime_s"] / event["lifetime_s"]
     return out
+
+
+def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=None, out=None) -> dict:
+    """Finite-element cells on 10 x 20 mm and on the paper's specimen, seeds 1-3: the critical DEM step by
+    the core's bound (no YADE) and the scene's, the DEM step, and DEM steps and body-steps per CPU second of
+    a loading ramp; the paper-size cost per body against the 10 x 20 mm one of the same seed.  With
+    ``creep_stress_mpa``, one paper-size creep run to failure (seed 1).  ``out``: JSON rewritten after each
+    scene, so that partial results survive an interruption."""
+    from ..errors import GrainfracError
+    from ..grains import critical_dem_step
+    from ..runs.runio import code_version, write_json
+    from ..specimen import build_specimen
+    from ..yade_adapter.bench_timing import loading_step_cost
+    progress = progress or (lambda msg: None)
+    if creep_stress_mpa is not None and not creep_stress_mpa > 0:
+        raise GrainfracError(f"--creep-stress {creep_stress_mpa}: a creep stress must be positive [MPa]; fix: e.g. "
+                             "--creep-stress 160")
+    t0, load_start = time.perf_counter(), os.getloadavg()[0]
+    result = {"bench": {"kind": "fem_sizes", "preset": str(FEM_PRESET.relative_to(FEM_PRESET.parents[2])),
+                        "overrides": list(overrides), "warmup_steps": FEM_WARMUP_STEPS, "timed_steps": FEM_TIMED_STEPS,
+                        "code_version": code_version(), "argv": list(sys.argv),
+                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")},
+              "machine": machine(), "scenes": []}
+
+    def save():
+        result["peak_rss_mb"] = peak_rss_mb()
+        result["bench"]["wall_s"] = time.perf_counter() - t0
+        result["machine"]["load_average_1min"] = f"{load_start:.2f} at the start, {os.getloadavg()[0]:.2f} now"
+        if out is not None:
+            write_json(out, result)
+
+    for seed in FEM_SEEDS:
+        for name, width, height in FEM_SIZES:
+            params = scene_params(extra_files, (FEM_PRESET,), [f"specimen.width={width}", f"specimen.height={height}",
+                                                              *overrides], ())
+            specimen = build_specimen(params, seed)
+            row = {"specimen": name, "seed": seed, "n_cells": specimen.n_cells,
+                   "edges_collapsed": specimen.edges_collapsed,
+                   "critical_step_core_s": critical_dem_step(specimen, params),
+                   **loading_step_cost(specimen, params, FEM_WARMUP_STEPS, FEM_TIMED_STEPS)}
+            result["scenes"].append(row)
+            progress(f"fem {name}, seed {seed}: critical step {row['critical_step_s']:.3g} s, "
+                     f"{row['dem_steps_per_cpu_s']:.1f} DEM steps / CPU s, "
+                     f"{row['body_steps_per_cpu_s'] / 1e6:.2f} M body-steps / CPU s")
+            save()
+    by = {(r["specimen"], r["seed"]): r for r in result["scenes"]}
+    result["paper_cost_per_body_over_small"] = {
+        str(seed): by[("10x20", seed)]["body_steps_per_cpu_s"] / by[("paper", seed)]["body_steps_per_cpu_s"]
+        for seed in FEM_SEEDS}
+    if creep_stress_mpa is not None:
+        result["paper_creep"] = paper_creep_to_failure(extra_files, overrides, creep_stress_mpa * 1e6, progress)
+    save()
+    return result
+
+
+def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
+    """One paper-size finite-element creep run to failure (seed 1, event clock): lifetime or what ended it, DEM
+    steps, CPU time, and the relaxation steps per event."""
+    from ..specimen import build_specimen
+    from ..yade_adapter.bench_timing import TimedCreepRun
+    _, width, height = FEM_SIZES[-1]
+    params = scene_params(extra_files, (FEM_PRESET,), [f"specimen.width={width}", f"specimen.height={height}",
+                                                      *overrides], ("stress_corrosion.clock=event",))
+    t0, c0 = time.perf_counter(), time.process_time()
+    run = TimedCreepRun(build_specimen(params, FEM_SEEDS[0]), params, stress)
+    run.run()
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    last = run.rows[-1]
+    out = {"seed": FEM_SEEDS[0], "stress_pa": stress, "failed": bool(run.failed),
+           "failure_reason": run.failure_reason or "not failed",
+           "held_after_ramp": run.initial_bond_stresses is not None,
+           ("lifetime_s" if run.failed else "creep_time_end_s"): last["creep_time_s"], "n_events": run.n_events,
+           "dem_steps": int(run.scene.O.iter), "ramp_steps": run.rows[0]["dem_steps"], "wall_s": wall, "cpu_s": cpu,
+           "events": run.event_costs()}
+    progress(f"paper-size fem creep at {stress / 1e6:.0f} MPa: {out['failure_reason']} at {last['creep_time_s']:.4g} s "
+             f"creep time, {out['dem_steps']} DEM steps, {cpu:.0f} CPU s")
+    return out
+
+
+def fem_sizes_table(result: dict) -> str:
+    """``bench --fem-sizes`` as markdown: one row per specimen and seed, the cost ratio, the creep run."""
+    b, m = result["bench"], result["machine"]
+    lines = [f"Finite-element size bench ({b['date']}, {b['code_version']}): {m['cpu_model']}, {m['cores']} cores, "
+             f"YADE {m['yade']}, OMP_NUM_THREADS {m['omp_num_threads']}; load average {m['load_average_1min']}; "
+             f"{b['preset']} {' '.join('--set ' + o for o in b['overrides'])}; {b['timed_steps']} loading DEM steps "
+             f"after {b['warmup_steps']}; peak memory {result['peak_rss_mb']:.0f} MB; wall time {b['wall_s']:.0f} s.", "",
+             "| specimen | seed | cells | edges collapsed | bodies | critical step, core [s] | critical step, scene [s] | "
+             "DEM step [s] | DEM steps / CPU s | body-steps / CPU s |", "|" + "---|" * 10]
+    for r in result["scenes"]:
+        lines.append(f"| {r['specimen']} | {r['seed']} | {r['n_cells']} | {r['edges_collapsed']} | {r['n_bodies']} | "
+                     f"{r['critical_step_core_s']:.3g} | {r['critical_step_s']:.3g} | {r['dem_step_s']:.3g} | "
+                     f"{r['dem_steps_per_cpu_s']:.1f} | {r['body_steps_per_cpu_s'] / 1e6:.2f} M |")
+    ratios = result.get("paper_cost_per_body_over_small", {})
+    if ratios:
+        lines += ["", "Cost per body, paper size over 10 x 20 mm (seeds " + ", ".join(ratios) + "): " +
+                  " / ".join(f"x {v:.2f}" for v in ratios.values()) + "."]
+    c = result.get("paper_creep")
+    if c:
+        life = f"lifetime {c['lifetime_s']:.4g} s" if c["failed"] else f"not failed by {c['creep_time_end_s']:.4g} s"
+        lines += ["", f"Paper-size creep at {c['stress_pa'] / 1e6:.0f} MPa (seed {c['seed']}): {c['failure_reason']}, "
+                      f"{life}, {c['n_events']} events, relaxation steps per event {_event_steps(c['events'])}, "
+                      f"{c['dem_steps']} DEM steps ({c['ramp_steps']} in the ramp), {c['cpu_s']:.0f} CPU s."]
+    return "\n".join(lines)
 
 
 def peak_rss_mb() -> float:

@@ -172,3 +172,43 @@ def time_bond_io(corr, repeats: int) -> dict:
     return {"n_intact_bonds": n, "read_all_bonds_s": statistics.median(read),
             "write_all_strengths_s": statistics.median(write), "time_to_failure_all_bonds_s": statistics.median(law),
             "read_per_bond_s": statistics.median(read) / n, "write_per_bond_s": statistics.median(write) / n}
+
+
+def loading_step_cost(specimen, params, warmup: int, steps: int, engine_timing: bool = False) -> dict:
+    """CPU cost of DEM steps of a strain-controlled loading ramp (the platens at ``ucs.strain_rate``, as a
+    UCS test moves them): ``warmup`` steps, then ``steps`` steps through :meth:`GrainScene.run` timed by
+    the process's CPU clock (which waiting for a core does not inflate).
+
+    Returns the scene's size, its DEM step and critical step, DEM steps and body-steps per CPU second,
+    and with ``engine_timing`` the share of each engine in YADE's own engine time (``execTime``)."""
+    from .platens import Platens
+    from .scene import build_scene
+    c0 = time.process_time()
+    scene = build_scene(specimen, params)
+    build_cpu = time.process_time() - c0
+    O = scene.O
+    platens = Platens(scene, params.ucs.platen_lateral)
+    scene.extras.append(platens)
+    platens.set_axial_velocity(params.ucs.strain_rate * platens.height)
+    scene.run(warmup)
+    if engine_timing:
+        O.timingEnabled = True
+        for e in O.engines:
+            e.execTime, e.execCount = 0, 0
+    c0, w0 = time.process_time(), time.perf_counter()
+    scene.run(steps)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    n_bodies = len(O.bodies)
+    out = {"n_bodies": n_bodies, "n_interactions": len(O.interactions), "n_bonds": scene.n_bonds,
+           "dem_step_s": O.dt, "critical_step_s": scene.dt_critical, "build_cpu_s": build_cpu,
+           "warmup_steps": warmup, "steps": steps, "cpu_s": cpu, "wall_s": wall,
+           "dem_steps_per_cpu_s": steps / cpu, "body_steps_per_cpu_s": steps * n_bodies / cpu}
+    if engine_timing:
+        engines = {(e.label or type(e).__name__): e.execTime * 1e-9 for e in O.engines}
+        yade_s = sum(engines.values())
+        out["python_share_of_wall"] = max(0.0, 1 - yade_s / wall)
+        out["engine_share"] = {k: round(v / yade_s, 4) for k, v in sorted(engines.items(), key=lambda kv: -kv[1])}
+        collider = next((e for e in O.engines if type(e).__name__ == "InsertionSortCollider"), None)
+        if collider is not None:
+            out.update(verlet_dist=collider.verletDist, collider_runs=int(getattr(collider, "numAction", -1)))
+    return out
