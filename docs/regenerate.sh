@@ -31,7 +31,7 @@ declare -A WHAT=(
   [accuracy_cost_paper_size]="docs/studies/accuracy_cost.md paper-size spot checks (params/accuracy_cost_paper_size.table): about 1 h on 2 cores"
   [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
   [threshold]="docs/studies/creep.md long-term strength table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
-  [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired UCS/E of fem cells with the intact-joint guard at 0-10 %, without it and of rigid cells at 0, 2, 5 % (docs/regularisation_ucs.csv, 33 UCS runs: 38 CPU min measured on 2 shared cores)"
+  [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired UCS/E of fem cells with the intact-joint guard at 0-10 %, without it and of rigid cells at 0, 2, 5 % (docs/regularisation_ucs.csv, 33 UCS runs: 38 CPU min measured on 2 shared cores) and the static contact-stress tails of fem cells (docs/regularisation_tails.csv, 30 static solves, no YADE: 80 s)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -74,7 +74,8 @@ run_target() {
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
     step_floor) $PY -m studies.step_floor_steps ;;
     regularisation) $PY -m studies.regularisation_steps
-                    $PY -m studies.regularisation_ucs ;;
+                    $PY -m studies.regularisation_ucs
+                    $PY -m studies.regularisation_tails ;;
     threshold) for s in 1 2; do $PY -m grainfrac_yade ucs --width 4e-3 --height 8e-3 --seed $s \
                    --out results/threshold_tiny/ucs_seed$s --overwrite; done
                batch params/threshold_study_tiny.table creep.py threshold_tiny
