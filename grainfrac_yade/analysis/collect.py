@@ -16,7 +16,8 @@ PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resol
                  "calibration.strength_scale", "calibration.stiffness_scale", "stress_corrosion.clock",
                  "stress_corrosion.law", "stress_corrosion.beta1", "stress_corrosion.beta2",
                  "stress_corrosion.beta2_normalised", "stress_corrosion.threshold_ratio",
-                 "stress_corrosion.threshold_stress", "confinement.stress")
+                 "stress_corrosion.threshold_stress", "confinement.stress", "ucs.strain_rate", "creep.ramp_strain_rate",
+                 "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")
 #: summary.json of creep runs made before the degradation laws had names: "mode" -> "law".
 _SUMMARY_LAW = RENAMED_KEYS["stress_corrosion.mode"][1]
 

@@ -31,12 +31,14 @@ VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
 #: Outcomes of creep runs that belong to a model variant.
 CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "failed before test", "unfinished",
                   "run error")
-#: Columns of runs.csv (those present).
+#: Columns of runs.csv (those present); the parameter columns are those of ucs_runs.csv that tell runs apart.
 RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
              "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
              "tertiary_start_s", "dem_steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
-             "study", "beta1_run", "time_factor", "code_version", "problem")
+             "resolution.grain_model", "calibration.strength_scale", "calibration.stiffness_scale",
+             "stress_corrosion.beta1", "stress_corrosion.beta2", "specimen.min_edge_fraction", "creep.ramp_strain_rate",
+             "numerics.density_scale", "study", "beta1_run", "time_factor", "code_version", "problem")
 #: Decades of lifetime scatter that count as "orders of magnitude" when comparing with the lab.
 ORDER_OF_MAGNITUDE = 1.0
 

@@ -8,6 +8,9 @@ from pathlib import Path
 #: Columns that define a model variant in a UCS study.
 VARIANT = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height",
            "resolution.grain_model", "resolution.nodes_per_face", "confinement.stress")
+#: Further columns that make a variant; the table names those that differ among its rows ("variant" column).
+LOADING_VARIANT = ("calibration.strength_scale", "calibration.stiffness_scale", "ucs.strain_rate",
+                   "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")
 #: The confining stress column: the envelope's abscissa.
 CONFINEMENT = "confinement.stress"
 MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "dem_steps")
@@ -32,17 +35,21 @@ def cmd_analyze_ucs(args) -> int:
     runs = runs[runs["command"] == "ucs"]
     runs, _ = fill_missing_params(runs)   # keys that older params.json lack: the shipped defaults
     runs[CONFINEMENT] = runs[CONFINEMENT].fillna(0.0).astype(float)   # runs older than the key were uniaxial
-    stats = group_stats(runs, VARIANT, MEASURES)
+    by = VARIANT + tuple(k for k in LOADING_VARIANT if k in runs)
+    stats = group_stats(runs, by, MEASURES)
     runs.to_csv(folder / "ucs_runs.csv", index=False)
     stats.to_csv(folder / "ucs_stats.csv", index=False)
-    lines = ["| cells | spheres/cell | grain [mm] | specimen [mm] | sigma_3 [MPa] | n | peak [MPa] | E [GPa] | Poisson "
-             "| CI/peak | CD/peak | DEM steps | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    varying = [k for k in by[len(VARIANT):] if stats[k].astype(str).nunique() > 1]
+    lines = ["| cells | spheres/cell | grain [mm] | specimen [mm] | sigma_3 [MPa] | " + ("variant | " if varying else "")
+             + "n | peak [MPa] | E [GPa] | Poisson | CI/peak | CD/peak | DEM steps | wall [s] |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if varying else "")]
     for _, r in stats.iterrows():
+        variant = (", ".join(f"{k.split('.', 1)[1]} {_cell(r[k])}" for k in varying) + " | ") if varying else ""
         lines.append(
             f"| {cells_label(r['resolution.grain_model'], r['resolution.nodes_per_face'])} "
             f"| {r[VARIANT[0]]:.0f} | {r[VARIANT[1]] * 1e3:.2f} "
-            f"| {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} | {r[CONFINEMENT] / 1e6:g} "
-            f"| {r['ucs_pa_count']:.0f} | {r['ucs_pa_mean'] / 1e6:.1f} +- {r['ucs_pa_std'] / 1e6:.1f} "
+            f"| {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} | {r[CONFINEMENT] / 1e6:g} | {variant}"
+            f"{r['ucs_pa_count']:.0f} | {r['ucs_pa_mean'] / 1e6:.1f} +- {r['ucs_pa_std'] / 1e6:.1f} "
             f"| {r['young_pa_mean'] / 1e9:.1f} +- {r['young_pa_std'] / 1e9:.1f} | {r['poisson_mean']:.3f} "
             f"| {r['crack_initiation_pa_mean'] / r['ucs_pa_mean']:.2f} "
             f"| {r['crack_damage_pa_mean'] / r['ucs_pa_mean']:.2f} "
@@ -68,7 +75,7 @@ def envelopes(runs, folder) -> list:
     from ..analysis.labdata import lab_property
     from ..errors import GrainfracError
     done = runs[(runs["status"] == "finished") & runs["ucs_pa"].notna()]
-    others = [v for v in VARIANT if v != CONFINEMENT]
+    others = [v for v in VARIANT if v != CONFINEMENT] + [k for k in LOADING_VARIANT if k in runs]
     rows, lines = [], []
     for key, group in done.groupby(others, dropna=False):
         if group[CONFINEMENT].nunique() < 2:
@@ -97,6 +104,10 @@ def envelopes(runs, folder) -> list:
     if rows:
         pd.DataFrame(rows).to_csv(folder / "envelope.csv", index=False)
     return lines
+
+
+def _cell(value) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def cells_label(grain_model, nodes_per_face) -> str:
