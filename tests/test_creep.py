@@ -110,3 +110,22 @@ def test_small_specimen_creep_curve_has_three_stages():
     tau, rate = local_rates(t[:-1], strain[:-1], t[-1])
     inner = rate[(tau >= STAGE_WINDOW / 2) & (tau <= 1 - STAGE_WINDOW / 2)]
     assert inner[0] > STAGE_RATE_FACTOR * inner.min() and inner[-1] > STAGE_RATE_FACTOR * inner.min()
+
+
+def test_hold_budget_in_wave_crossings(small_ucs):
+    """The hold's budget: by default the fixed step counts exactly; with crossings, ceil(crossings x H / (c dt)),
+    c = sqrt(E / rho) from the servo's modulus estimate and the scene's density (closed form, to the last bit).
+    A control run (no corrosion) with a relaxation budget of 400 crossings holds the load as with 30,000 steps."""
+    import math
+    from grainfrac_yade.wave import scene_density
+    plain = _creep(0.85, small_ucs, ["stress_corrosion.enabled=false"])
+    assert (plain.hold_budget.servo_response_steps, plain.hold_budget.max_relaxation_steps) == (200, 30000)
+    run = _creep(0.85, small_ucs, ["stress_corrosion.enabled=false", "creep.max_relaxation_crossings=400",
+                                   "creep.servo_response_crossings=0.5"])
+    young = run.target / run.rows[0]["axial_strain"]
+    c = math.sqrt(young / scene_density(run.params))
+    n = run.platens.height / (c * run.scene.O.dt)
+    assert run.hold_budget.crossing_steps == pytest.approx(n, rel=1e-6)   # E from the strain at the ramp's end
+    assert run.hold_budget.max_relaxation_steps == math.ceil(400 * run.hold_budget.crossing_steps) > 30000
+    assert run.hold_budget.servo_response_steps == max(200, math.ceil(0.5 * run.hold_budget.crossing_steps))
+    assert not run.failed, run.failure_reason

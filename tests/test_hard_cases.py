@@ -103,6 +103,8 @@ def ucs_folder(params, out, captured, nullable=("crack_initiation_pa",)) -> dict
 
 #: summary.json keys a creep run leaves null when it has no lifetime or no creep stages
 NO_LIFETIME = ("lifetime_s", "primary_end_s", "tertiary_start_s")
+#: A run that never held its load (failed on loading, or before it) has no hold budget.
+NO_HOLD = ("wave_crossing_steps", "servo_response_steps_used", "max_relaxation_steps_used")
 
 
 def creep_folder(params, out, stress, ucs, captured, nullable=NO_LIFETIME) -> dict:
@@ -142,7 +144,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_a_numerical_failure_of_creep(t
     """Before, the unstable DEM 'reached' 176 MPa in 5 DEM steps and the run ended as failed ('no
     equilibrium') at creep time 0: a lifetime.  Now: a numerical failure before the first step (1 s)."""
     s = creep_folder(load_parameters(overrides=TINY), tmp_path / "run", 176e6, 252e6, captured,
-                     NO_LIFETIME + ("failed",))
+                     NO_LIFETIME + ("failed",) + NO_HOLD)
     assert (s["numerical_failure"], s["failed"], s["lifetime_s"], s["failed_on_loading"]) == (True, None, None, False)
     assert s["end_reason"] == s["failure_reason"]
     assert s["end_reason"].startswith("numerical failure: DEM step ") and "critical step" in s["end_reason"]
@@ -192,7 +194,7 @@ def test_b_a_load_above_the_ucs_fails_on_loading_with_lifetime_0(tmp_path, rigid
     carried (sampled every 2e-5 strain; the ramp checks every 1e-5), and the run is a short lifetime.
     The CLI and batch rows refuse a load at or above the UCS they refer to."""
     s = creep_folder(load_parameters(overrides=TINY), tmp_path / "run", factor * rigid_ucs, rigid_ucs, captured,
-                     NO_LIFETIME[1:])
+                     NO_LIFETIME[1:] + NO_HOLD)
     _fails_on_loading(s)
     assert outcome_in_analysis(tmp_path) == ["failed at load"]
 
@@ -204,7 +206,7 @@ def test_b_fem_grains_above_their_ucs_fail_on_loading(tmp_path, captured):
     """Fem preset, 4 x 8 mm: UCS, then 1.001 x it."""
     p = load_parameters(overrides=TINY, extra_files=FEM)
     ucs = ucs_folder(p, tmp_path / "ucs", captured)["ucs_pa"]
-    _fails_on_loading(creep_folder(p, tmp_path / "creep", 1.001 * ucs, ucs, captured, NO_LIFETIME[1:]))
+    _fails_on_loading(creep_folder(p, tmp_path / "creep", 1.001 * ucs, ucs, captured, NO_LIFETIME[1:] + NO_HOLD))
 
 
 # ------------------------------------------------------------------ (c) a very low load

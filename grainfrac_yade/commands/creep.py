@@ -359,6 +359,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                          write_json)
     from ..specimen import build_specimen
     from ..yade_adapter.creep_protocol import resume_creep, run_creep
+    from ..wave import budget_fields
     from ..yade_adapter.scene import bond_segments, broken_counts
     t0, c0 = time.time(), time.process_time()
     require_plane(params, "creep")
@@ -413,6 +414,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "n_events": run.n_events, "broken_ramp": run.ramp_broken, "broken_creep": int(broken_creep[-1]),
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "bonds_erased_by_sliding": run.scene.sliding_erasures(),
+        **budget_fields(getattr(run, "hold_budget", None)),
         "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
         "cpu_s": time.process_time() - c0,
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,

@@ -196,12 +196,18 @@ class CreepParams:
     ramp_strain_rate: float = _spec("1/s", "positive", "strain rate of the ramp to the creep load (DEM time)")
     servo_response_steps: int = _spec("1", "positive_int", "DEM steps in which the servo removes a stress error")
     servo_max_strain_rate: float = _spec("1/s", "positive", "largest platen strain rate the servo may use")
+    servo_response_crossings: float = _spec("1", "nonnegative",
+                                            "the servo's response in elastic wave crossings of the specimen's "
+                                            "height, where longer than servo_response_steps; 0 = steps alone")
     equilibrium_tolerance: float = _spec("1", "unit_interval_open",
                                          "equilibrium: mean unbalanced force on free cells / mean bond force")
     stress_tolerance: float = _spec("1", "unit_interval_open", "equilibrium: |held - target| / target")
     check_period: int = _spec("1", "positive_int", "DEM steps between equilibrium checks")
     max_relaxation_steps: int = _spec("1", "positive_int",
                                       "no equilibrium at the held load within this many steps = failure")
+    max_relaxation_crossings: float = _spec("1", "nonnegative",
+                                            "relaxation budget in elastic wave crossings of the specimen's height, "
+                                            "where longer than max_relaxation_steps; 0 = steps alone")
     collapse_strain_increment: float = _spec("1", "nonnegative",
                                              "collapse = failure: the servo closes the platens at its speed limit "
                                              "on every DEM step while the axial strain grows by more than this; "

@@ -55,6 +55,7 @@ from ..errors import GrainfracError
 from ..grains import grain_model
 from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
+from ..wave import HoldBudget
 from .platens import StressServo
 
 #: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
@@ -200,7 +201,7 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
     servo = run.servo
     if servo is not None:
         state["servo"] = {"target": servo.target, "gain": servo.gain, "max_speed": servo.max_speed,
-                          "stress": float(servo.stress)}
+                          "stress": float(servo.stress), "hold_budget": run.hold_budget.as_dict()}
     if run.corr is not None:
         corr = run.corr.state_dict()
         state["corrosion"] = {"creep_time": corr["creep_time"], "law": corr["law"], "restored": corr["restored"]}
@@ -336,6 +337,9 @@ def restore(run, where, state: dict, arrays: dict):
         s = state["servo"]
         servo = StressServo.restored(pl, s["target"], s["gain"], s["max_speed"], s["stress"])
         run.servo = servo
+        # checkpoints written before the hold budget had wave crossings held the fixed step counts
+        run.hold_budget = (HoldBudget.from_dict(s["hold_budget"]) if "hold_budget" in s
+                           else HoldBudget.fixed(run.params.creep))
         sc.drivers.append(servo)
     if state["corrosion"] is not None:
         corr = StressCorrosion(sc, run.params.stress_corrosion)

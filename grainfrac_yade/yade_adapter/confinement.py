@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..tessellation import SIDES
+from ..wave import hold_budget
 from .platens import StressServo, free_bodies, held_at_equilibrium
 
 #: Share of the bonds broken in the isotropic stage at which the specimen counts as broken apart before
@@ -70,21 +71,24 @@ def young_estimate(params) -> float:
     return float(sum(fraction * params.grains[m].young for m, fraction in params.composition.items()))
 
 
-def consolidate(scene, platens, stress: float, creep_params, young: float) -> dict:
+def consolidate(scene, platens, stress: float, creep_params, young: float, density: float) -> dict:
     """Isotropic stage: with the confining forces on, a servo brings the axial stress to ``stress``
     [Pa] and holds it until equilibrium (mean resultant on free bodies / mean bond force below
     ``creep.equilibrium_tolerance`` and the axial stress within ``creep.stress_tolerance``), at most
     ``creep.max_relaxation_steps`` DEM steps (:func:`.platens.held_at_equilibrium`, as a creep run's
     hold).  ``young`` [Pa]: an estimate of the specimen's modulus
-    for the servo gain.  The platens are left at rest.  Returns the stage's DEM steps, whether it
+    for the servo gain, ``density`` [kg/m3] the scene's (grains x ``numerics.density_scale``): with them the
+    servo's response and the stage's step budget follow the creep hold's (:func:`~grainfrac_yade.wave.hold_budget`).
+    The platens are left at rest.  Returns the stage's DEM steps, whether it
     reached equilibrium, and the axial stress at its end."""
     cp = creep_params
-    servo = StressServo(platens, stress, young, cp.servo_response_steps, cp.servo_max_strain_rate * platens.height)
+    budget = hold_budget(cp, platens.height, young, density, scene.O.dt)
+    servo = StressServo(platens, stress, young, budget.servo_response_steps, cp.servo_max_strain_rate * platens.height)
     scene.drivers.append(servo)
     free = free_bodies(scene, platens)
     done, balanced = 0, False
     try:
-        while done < cp.max_relaxation_steps:
+        while done < budget.max_relaxation_steps:
             scene.run(cp.check_period)
             done += cp.check_period
             if held_at_equilibrium(scene, servo, free, np.flatnonzero(~scene.broken), cp):

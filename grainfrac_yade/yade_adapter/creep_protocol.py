@@ -34,6 +34,7 @@ computes what the uninterrupted run would have (:mod:`.checkpoint`).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -44,6 +45,7 @@ from ..errors import NumericalFailure
 from ..creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
 from ..law import shear_strength
 from ..params import unbalanced_threshold
+from ..wave import hold_budget, scene_density
 from .checkpoint import Checkpointer, inexact_note, read, restore
 from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
@@ -116,6 +118,8 @@ class CreepRun:
         #: the stress servo that holds the load (:meth:`hold_servo`) and the creep clock (:meth:`creep`);
         #: None before the ramp ends
         self.servo = None
+        #: DEM steps of the hold (wave crossing, servo response, relaxation budget): set with the servo
+        self.hold_budget = None
         self.clock = None
         #: DEM steps of the last relaxation to equilibrium
         self.last_relaxation_steps = 0
@@ -219,20 +223,22 @@ class CreepRun:
         if cp.relaxation_damping > 0:
             self.scene.newton.damping = cp.relaxation_damping
         young = max(self.target / max(self.platens.axial_strain(), SERVO_STRAIN_FLOOR), SERVO_MODULUS_FLOOR)
-        self.servo = StressServo(self.platens, self.target, young, cp.servo_response_steps,
+        self.hold_budget = hold_budget(cp, self.platens.height, young, scene_density(self.params), self.scene.O.dt)
+        self.servo = StressServo(self.platens, self.target, young, self.hold_budget.servo_response_steps,
                                  cp.servo_max_strain_rate * self.platens.height)
         self.scene.drivers.append(self.servo)
 
     def relax(self, creep_time):
         """Run DEM steps until equilibrium at the held load; False (and failed) at collapse
         (:class:`CollapseWatch`, checked every ``creep.check_period`` steps) or if equilibrium does not
-        come within ``creep.max_relaxation_steps``."""
+        come within the hold's budget (``creep.max_relaxation_steps``, or ``creep.max_relaxation_crossings``
+        wave crossings where longer: :attr:`hold_budget`)."""
         cp = self.params.creep
         done = 0
         self.last_relaxation_steps = 0
         watch = (CollapseWatch(cp.collapse_strain_increment, self.platens.axial_strain())
                  if cp.collapse_strain_increment > 0 else None)
-        while done < cp.max_relaxation_steps:
+        while done < self.hold_budget.max_relaxation_steps:
             self.scene.run(cp.check_period)
             done += cp.check_period
             self.last_relaxation_steps = done
@@ -272,7 +278,8 @@ class CreepRun:
         sc = self.params.stress_corrosion
         if resume is None:
             self.clock = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
-        paper_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, self.params.creep, resume)
+        creep = dataclasses.replace(self.params.creep, max_relaxation_steps=self.hold_budget.max_relaxation_steps)
+        paper_clock_loop(self, self.corr, self.clock, self.params.stress_corrosion, creep, resume)
         self.n_events = int(np.sum(self.break_time > 0))
 
     def safe_point(self, phase, loop):
@@ -324,7 +331,7 @@ class CreepRun:
         if phase in (None, "loading"):
             if phase is None and self.confinement is not None:
                 self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params.creep,
-                                                 young_estimate(self.params))
+                                                 young_estimate(self.params), scene_density(self.params))
                 self.failure_reason = broken_apart_reason(self.scene, self.confinement.stress, "no creep test")
                 if self.failure_reason:   # no specimen left to load: neither a lifetime nor a survival
                     self.failed_before_test = True
@@ -342,7 +349,7 @@ class CreepRun:
             if not self.params.stress_corrosion.enabled:
                 # control run: the load is held, nothing corrodes; equilibrium must come and stay
                 if self.relax(0.0):
-                    self.scene.run(self.params.creep.max_relaxation_steps)
+                    self.scene.run(self.hold_budget.max_relaxation_steps)
                     self.check_failure()
                 self.record(0.0, self.servo.stress)
                 return self

@@ -21,6 +21,7 @@ import time
 import numpy as np
 
 from ..errors import NumericalFailure
+from ..wave import scene_density
 from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_state, read, restore_platens,
                          restore_scene, resume_record, scene_arrays)
 from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
@@ -69,7 +70,7 @@ class UcsRun(LoadingCheckpoints):
                 self.confinement = Confinement(scene, confining)
                 scene.extras.append(self.confinement)
                 self.consolidation = consolidate(scene, platens, confining, self.params.creep,
-                                                 young_estimate(self.params))
+                                                 young_estimate(self.params), scene_density(self.params))
                 platens.set_axial_velocity(self.closing_speed)
                 broken_apart = end = broken_apart_reason(scene, confining)
                 if broken_apart and self.progress:
