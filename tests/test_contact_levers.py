@@ -332,6 +332,7 @@ def test_weibull_scatter_lowers_brazilian_strength(tmp_path):
 
 @needs_yade
 @pytest.mark.yade
+@pytest.mark.slow
 def test_brazilian_runs_with_fem_cells(tmp_path):
     """A tiny disc of fem cells (5 mm, 25 cells) loads to a split, as rigid cells do."""
     from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
