@@ -46,8 +46,10 @@ SETTINGS = {
     "baseline": [],
     "ks_over_kn_x2.5": ["calibration.shear_stiffness_ratio_scale=2.5"],
     "tensile_over_cohesion_x0.5": ["calibration.tensile_cohesion_ratio_scale=0.5"],
+    "tensile_over_cohesion_x0.25": ["calibration.tensile_cohesion_ratio_scale=0.25"],
     "inter_over_intra_0.7": ["calibration.inter_mineral_strength_ratio=0.7"],
     "weibull_m3": ["calibration.strength_weibull_modulus=3.0"],
+    "weibull_m1.5": ["calibration.strength_weibull_modulus=1.5"],
     "lloyd_0": ["specimen.lloyd_iterations=0"],
 }
 LEVER_FIELDS = ("setting", "overrides", "test", "seed", "size_m", "n_cells", "ucs_pa", "young_pa", "poisson",
