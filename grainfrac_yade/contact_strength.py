@@ -31,6 +31,10 @@ import numpy as np
 CONTACT_STRENGTH_STREAM = 20261202
 #: Weibull modulus meaning "no scatter" (every multiplier 1).
 NO_SCATTER = 0.0
+#: Smallest Weibull modulus a parameter set may give [1]: m = 1 is the exponential distribution (CV 1).
+#: Below it the density's mode is at 0 (most faces all but unbonded) and the CV exceeds 1 (2.2 at m = 0.5;
+#: Gamma overflows below m = 0.006); Weibull moduli of rock strengths lie above it.
+MIN_WEIBULL_MODULUS = 1.0
 
 
 def weibull_unit_mean_scale(modulus: float) -> float:
@@ -71,5 +75,5 @@ def _require_positive(modulus: float):
         raise ValueError(f"Weibull modulus must be finite and > 0, got {modulus!r}")
 
 
-__all__ = ["CONTACT_STRENGTH_STREAM", "NO_SCATTER", "weibull_unit_mean_scale", "weibull_cv", "weibull_multipliers",
+__all__ = ["CONTACT_STRENGTH_STREAM", "NO_SCATTER", "MIN_WEIBULL_MODULUS", "weibull_unit_mean_scale", "weibull_cv", "weibull_multipliers",
            "face_strength_multipliers", "contact_strength_rng"]

@@ -179,6 +179,7 @@ def test_weibull_multiplier_is_one_per_face_on_both_strengths():
     ("calibration.tensile_cohesion_ratio_scale", -0.5, "must be > 0"),
     ("calibration.inter_mineral_strength_ratio", "nan", "not finite"),
     ("calibration.strength_weibull_modulus", '"high"', "not a number"),
+    ("calibration.strength_weibull_modulus", 0.5, "is below 1 (the exponential distribution, CV 1)"),
 ])
 def test_bad_lever_is_one_clear_line(key, value, words):
     with pytest.raises(ParameterError) as err:
@@ -250,22 +251,32 @@ def test_higher_ks_over_kn_raises_e_and_lowers_nu(fem):
 @pytest.mark.yade
 @pytest.mark.parametrize("fem", [False, True])
 def test_levers_reach_yades_bonds(fem):
-    """FnMax = J^T A, FsMax = J^C A and k_s of every interaction are the lever-scaled bond arrays, exactly."""
+    """FnMax = J^T A and FsMax = J^C A of every interaction are Table 2's strengths with every lever, exactly
+    (J^T x ratio x inter-mineral factor x strength_scale x the face's Weibull multiplier, in that order);
+    k_n and k_s are the bond arrays, k_s above the no-lever value (k_s/k_n x 2)."""
     from grainfrac_yade.yade_adapter.scene import build_scene
-    p = tiny_params("calibration.tensile_cohesion_ratio_scale=0.6", "calibration.inter_mineral_strength_ratio=0.7",
-                    "calibration.shear_stiffness_ratio_scale=2.0", "calibration.strength_weibull_modulus=3.0", fem=fem)
+    ratio, inter, modulus = 0.6, 0.7, 3.0
+    p = tiny_params(f"calibration.tensile_cohesion_ratio_scale={ratio}", f"calibration.inter_mineral_strength_ratio={inter}",
+                    "calibration.shear_stiffness_ratio_scale=2.0", f"calibration.strength_weibull_modulus={modulus}",
+                    fem=fem)
     s = build_specimen(p, 2)
     sc = build_scene(s, p)
     lay = sc.layout
     bp = bond_properties(s, lay, p)
     plain = bond_properties(s, lay, tiny_params(fem=fem))
-    assert not np.allclose(bp.tensile_strength, plain.tensile_strength)
-    for k, inter in enumerate(sc.interactions):
+    w = face_strength_multipliers(s.tessellation.n_faces, modulus, s.seed)[lay.bond_face]
+    names = s.mineral_names
+    cells = s.tessellation.face_cells[lay.bond_face]
+    scale = p.calibration.strength_scale
+    for k, inter_k in enumerate(sc.interactions):
+        a, b = (names[s.mineral[c]] for c in cells[k])
+        c = p.contact(a, b)
+        f = inter if a != b else 1.0
         area = float(lay.bond_area[k])
-        assert inter.phys.FnMax == float(bp.tensile_strength[k]) * area
-        assert inter.phys.FsMax == float(bp.cohesion[k]) * area
-        assert inter.phys.ks == float(bp.shear_stiffness[k])
-        assert inter.phys.kn == float(bp.normal_stiffness[k])
+        assert inter_k.phys.FnMax == float(c.tensile_strength * ratio * f * scale * w[k]) * area
+        assert inter_k.phys.FsMax == float(c.cohesion * f * scale * w[k]) * area
+        assert inter_k.phys.kn == float(bp.normal_stiffness[k]) == float(plain.normal_stiffness[k])
+        assert inter_k.phys.ks == float(bp.shear_stiffness[k]) > float(plain.shear_stiffness[k])
 
 
 def _ucs(tmp_path, name, *overrides, size=TINY):

@@ -268,7 +268,7 @@ class CalibrationParams:
     strength_weibull_modulus: float = _spec("1", "nonnegative", "Weibull modulus m of a per-face multiplier of J^T "
                                             "and J^C (unit mean, CV = sqrt(Gamma(1+2/m)/Gamma(1+1/m)^2 - 1); one "
                                             "draw per Voronoi face, seeded by the specimen's seed on a stream of its "
-                                            "own: grainfrac_yade.contact_strength); 0 = no scatter")
+                                            "own: grainfrac_yade.contact_strength); 0 = no scatter, else >= 1 (CV <= 1)")
 
 
 @dataclass(frozen=True, kw_only=True)
