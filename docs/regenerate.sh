@@ -32,6 +32,7 @@ declare -A WHAT=(
   [step_floor]="docs/studies/accuracy_cost.md per-cell mass scaling: docs/step_floor_steps.{csv,md} (scene builds and 200-step ramps, rigid and fem cells, 10 x 20 mm and paper size): about 6 min on one core"
   [threshold]="docs/studies/creep.md long-term strength table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
   [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired UCS/E of fem cells with the intact-joint guard at 0-10 %, without it and of rigid cells at 0, 2, 5 % (docs/regularisation_ucs.csv, 33 UCS runs: 38 CPU min measured on 2 shared cores) and the static contact-stress tails of fem cells (docs/regularisation_tails.csv, 30 static solves, no YADE: 80 s)"
+  [lab_bands]="docs/studies/lab_bands.md: grain-size CV against lloyd_iterations (no YADE, seconds) and paired fem UCS (5 x 10 mm) and Brazilian (10 mm disc) runs per lever on the contacts: about 10 min on one core"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -73,6 +74,8 @@ run_target() {
                    cp results/accuracy_cost/accuracy_cost.csv results/accuracy_cost/accuracy_cost.md docs/
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
     step_floor) $PY -m studies.step_floor_steps ;;
+    lab_bands) $PY -m studies.lab_bands grain-size
+               $PY -m studies.lab_bands levers --params params/presets/fem.toml --out results/lab_bands ;;
     regularisation) $PY -m studies.regularisation_steps
                     $PY -m studies.regularisation_ucs
                     $PY -m studies.regularisation_tails ;;
@@ -94,7 +97,7 @@ fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
-                           regularisation)
+                           regularisation lab_bands)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)

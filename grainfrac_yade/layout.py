@@ -15,7 +15,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from .params import Parameters
+from .contact_strength import face_strength_multipliers
+from .params import Parameters, calibrated_contact
 from .specimen import Specimen
 
 
@@ -47,8 +48,11 @@ class ClumpLayout:
 
 
 def mineral_pair_table(names, params: Parameters, attr: str) -> np.ndarray:
-    """(m, m) Table 2 value ``attr`` of every pair of the minerals ``names`` (mixed pairs averaged)."""
-    return np.array([[getattr(params.contact(a, b), attr) for b in names] for a in names])
+    """(m, m) Table 2 value ``attr`` of every pair of the minerals ``names`` (mixed pairs averaged), with
+    the pair-wise levers of ``params.calibration`` (:func:`grainfrac_yade.params.calibrated_contact`)."""
+    cal = params.calibration
+    return np.array([[getattr(calibrated_contact(params.contact(a, b), a != b, cal), attr) for b in names]
+                     for a in names])
 
 
 @dataclass(frozen=True)
@@ -79,7 +83,11 @@ def bond_properties(specimen: Specimen, layout: ClumpLayout, params: Parameters)
     as UDEC) or E' = E in 3D (Table 1).  Strengths are stresses [Pa]; the
     adapter multiplies them by A.  The calibration factors of
     ``params.calibration`` scale both stiffnesses and both strengths of every
-    bond (one factor each, so Table 2's ratios stay).
+    bond (one factor each, so Table 2's ratios stay); its pair-wise levers act
+    on the pair's values (:func:`mineral_pair_table`), and every bond's J^T and
+    J^C are multiplied by its face's Weibull multiplier (unit mean, modulus
+    ``calibration.strength_weibull_modulus``, drawn from the specimen's seed:
+    :func:`grainfrac_yade.contact_strength.face_strength_multipliers`).
     """
     t = specimen.tessellation
     names = specimen.mineral_names
@@ -102,9 +110,10 @@ def bond_properties(specimen: Specimen, layout: ClumpLayout, params: Parameters)
     ks = area / (1 / table["shear_stiffness"][ma, mb] + la / g_mod[ma] + lb / g_mod[mb])
     pick = {k: v[ma, mb] for k, v in table.items()}
     cal = params.calibration
+    face_factor = face_strength_multipliers(t.n_faces, cal.strength_weibull_modulus, specimen.seed)[face]
     return BondProperties(normal_stiffness=kn * cal.stiffness_scale, shear_stiffness=ks * cal.stiffness_scale,
-                          tensile_strength=pick["tensile_strength"] * cal.strength_scale,
-                          cohesion=pick["cohesion"] * cal.strength_scale,
+                          tensile_strength=pick["tensile_strength"] * cal.strength_scale * face_factor,
+                          cohesion=pick["cohesion"] * cal.strength_scale * face_factor,
                           friction_angle=pick["friction_angle"],
                           residual_friction_angle=pick["residual_friction_angle"],
                           residual_tensile_strength=pick["residual_tensile_strength"],

@@ -228,7 +228,7 @@ def test_brazilian_command_writes_a_run_folder(tmp_path):
 
 def test_brazilian_bad_input_is_one_line(tmp_path):
     for extra, word in ((["--diameter", "0.8e-3"], "brazilian.diameter"),
-                        (["--set", "resolution.grain_model=fem"], "rigid cells only"),
+                        (["--set", "specimen.dimension=3"], "plane (2D) specimens only"),
                         (["--set", "brazilian.loading_arc_deg=-5"], "brazilian.loading_arc_deg"),
                         (["--tensile-scale", "0"], "--tensile-scale")):
         res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "brazilian", *extra, "--out",

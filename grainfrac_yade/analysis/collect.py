@@ -13,7 +13,9 @@ from ..params import flatten as flatten_tree
 #: :func:`~grainfrac_yade.params.migrate_tree`: ``stress_corrosion.mode`` becomes ``stress_corrosion.law``).
 PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resolution.nodes_per_face",
                  "specimen.grain_size", "specimen.width", "specimen.height",
-                 "calibration.strength_scale", "calibration.stiffness_scale", "stress_corrosion.clock",
+                 "calibration.strength_scale", "calibration.stiffness_scale", "calibration.shear_stiffness_ratio_scale",
+                 "calibration.tensile_cohesion_ratio_scale", "calibration.inter_mineral_strength_ratio",
+                 "calibration.strength_weibull_modulus", "stress_corrosion.clock",
                  "stress_corrosion.law", "stress_corrosion.beta1", "stress_corrosion.beta2",
                  "stress_corrosion.beta2_normalised", "stress_corrosion.threshold_ratio",
                  "stress_corrosion.threshold_stress", "confinement.stress", "ucs.strain_rate", "creep.ramp_strain_rate",

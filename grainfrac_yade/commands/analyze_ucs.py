@@ -9,7 +9,9 @@ from pathlib import Path
 VARIANT = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height",
            "resolution.grain_model", "resolution.nodes_per_face", "confinement.stress")
 #: Further columns that make a variant; the table names those that differ among its rows ("variant" column).
-LOADING_VARIANT = ("calibration.strength_scale", "calibration.stiffness_scale", "ucs.strain_rate",
+LOADING_VARIANT = ("calibration.strength_scale", "calibration.stiffness_scale", "calibration.shear_stiffness_ratio_scale",
+                   "calibration.tensile_cohesion_ratio_scale", "calibration.inter_mineral_strength_ratio",
+                   "calibration.strength_weibull_modulus", "ucs.strain_rate",
                    "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")
 #: The confining stress column: the envelope's abscissa.
 CONFINEMENT = "confinement.stress"

@@ -83,7 +83,7 @@ def cmd_calibrate(args, params) -> int:
             strength *= args.target_ucs / mean_ucs
             stiffness *= args.target_young / mean_e
     out = commit_run_dir(out)   # a replacing run (--overwrite) takes the old one's place
-    write_calibration_file(Path(args.write), rows, args, base)
+    write_calibration_file(Path(args.write), rows, args, base, params.calibration)
     print(f"written {args.write} and {out / 'calibration.csv'}")
     return 0
 
@@ -110,7 +110,19 @@ def _stats(rows, key):
     return v.mean(), v.std(ddof=1) if len(v) > 1 else 0.0
 
 
-def write_calibration_file(path: Path, rows, args, overrides):
+#: Keys of [calibration] this command fits or measures; the file it writes carries the others (the levers
+#: on the contacts) at the values the calibration ran with.
+FITTED_KEYS = ("strength_scale", "stiffness_scale", "reference_ucs")
+
+
+def carried_lines(calibration) -> list:
+    """``key = value  # unit, meaning`` lines of the [calibration] keys not fitted here, at ``calibration``'s values."""
+    import dataclasses
+    return [f"{f.name} = {getattr(calibration, f.name)!r}    # {f.metadata['unit']}, {f.metadata['doc']}"
+            for f in dataclasses.fields(calibration) if f.name not in FITTED_KEYS]
+
+
+def write_calibration_file(path: Path, rows, args, overrides, calibration):
     first = [r for r in rows if r["round"] == 0]
     last_round = max(r["round"] for r in rows)
     last = [r for r in rows if r["round"] == last_round]
@@ -137,5 +149,7 @@ def write_calibration_file(path: Path, rows, args, overrides):
               f"stiffness_scale = {last[0]['stiffness_scale']:.6g}   # 1, multiplies the series k_n and k_s of every bond",
               f"reference_ucs = {_stats(last, 'ucs_pa')[0]:.6g}     # Pa, calibrated mean UCS (round {last_round}): "
               "what a driving-stress ratio refers to, as in the lab",
+              "# levers on the contacts, as this calibration ran with them",
+              *carried_lines(calibration),
               ""]
     path.write_text("\n".join(lines))

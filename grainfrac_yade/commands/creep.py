@@ -210,7 +210,9 @@ UCS_FROM_CALIBRATION = "calibration.reference_ucs"
 #: has another strength than calibration.reference_ucs, which was measured with the shipped values
 #: (params/calibration.toml: the paper-size specimen, seeds 1-5).  Prefixes of dotted keys.
 STRENGTH_KEYS = ("specimen.", "composition.", "contacts.", "grains.", "resolution.", "numerics.", "ucs.",
-                 "calibration.strength_scale", "calibration.stiffness_scale")
+                 "calibration.strength_scale", "calibration.stiffness_scale", "calibration.shear_stiffness_ratio_scale",
+                 "calibration.tensile_cohesion_ratio_scale", "calibration.inter_mineral_strength_ratio",
+                 "calibration.strength_weibull_modulus")
 
 
 def reference_differences(params) -> list:

@@ -14,6 +14,7 @@ from itertools import combinations_with_replacement
 from typing import Mapping
 
 from ..arrhenius import betas_from_physical
+from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
 from ..tessellation import n_cells_for
 from .files import read_toml
@@ -44,7 +45,9 @@ def renamed_key_fix(dotted: str) -> str | None:
 #: Keys added to the schema after runs were made, with the value every run before had by construction
 #: (no such knob then): params.json of older runs read them so (:func:`migrate_tree`).
 ADDED_KEYS = {"specimen.min_edge_fraction": 0.0, "numerics.keep_intact_joints": False,
-              "creep.servo_response_crossings": 0.0, "creep.max_relaxation_crossings": 0.0}
+              "creep.servo_response_crossings": 0.0, "creep.max_relaxation_crossings": 0.0,
+              "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
+              "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0}
 
 
 def migrate_tree(tree: dict) -> list:
@@ -288,6 +291,7 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
     typed["stress_corrosion"] = _rate_constants(sc, origins)
     _check_law(sc, origins)
     _check_grain_size(typed["specimen"], origins)
+    _check_weibull_modulus(typed["calibration"], origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
 
 
@@ -310,6 +314,18 @@ def _check_grain_size(sp: SpecimenParams, origins: Mapping):
         raise ParameterError(origins.get("specimen.grain_size", "parameters"), "specimen.grain_size",
                              f"{sp.grain_size:g} m gives a specimen of one cell (a lone cell has no face to bond)",
                              "make specimen.grain_size smaller or enlarge the specimen")
+
+
+def _check_weibull_modulus(cal, origins: Mapping):
+    """The Weibull modulus of contact strength is 0 (no scatter) or at least
+    :data:`~grainfrac_yade.contact_strength.MIN_WEIBULL_MODULUS`."""
+    m = cal.strength_weibull_modulus
+    if 0 < m < MIN_WEIBULL_MODULUS:
+        raise ParameterError(origins.get("calibration.strength_weibull_modulus", "parameters"),
+                             "calibration.strength_weibull_modulus",
+                             f"{m:g} is below {MIN_WEIBULL_MODULUS:g} (the exponential distribution, CV 1): most faces "
+                             "would be all but unbonded", f"give 0 (no scatter) or a modulus >= {MIN_WEIBULL_MODULUS:g} "
+                             "(e.g. 3: CV 0.36)")
 
 
 def require_plane(params: Parameters, command: str):

@@ -43,7 +43,10 @@ class SpecimenParams:
     height: float = _spec("m", "positive", "specimen height")
     thickness: float = _spec("m", "positive", "layer thickness (2D) or box depth (3D)")
     grain_size: float = _spec("m", "positive", "equivalent diameter of a Voronoi cell")
-    lloyd_iterations: int = _spec("1", "nonnegative_int", "Lloyd relaxations of the seeds")
+    lloyd_iterations: int = _spec("1", "nonnegative_int", "Lloyd relaxations of the seeds: the lever on the "
+                                  "spread of grain sizes, which they narrow (CV of the cells' equivalent diameter "
+                                  "on the paper's specimen: 0.27 at 0 = Poisson-Voronoi, 0.16 at 2, 0.12 at 5, 0.09 "
+                                  "at 10; docs/studies/lab_bands.md); no value widens it beyond 0's")
     dimension: int = _spec("1", "choice", "2 = plane model, 3 = box", (2, 3))
     min_edge_fraction: float = _spec("1", "fraction_below_half", "regularisation: interior Voronoi edges shorter "
                                      "than this fraction of grain_size are collapsed (their two vertices merged) "
@@ -246,13 +249,32 @@ class ConfinementParams:
 
 @dataclass(frozen=True, kw_only=True)
 class CalibrationParams:
-    """Scale factors that map the paper's UDEC values (Tables 1 and 2) onto this YADE packing.
+    """Scale factors that map the paper's UDEC values (Tables 1 and 2) onto this YADE packing, and the
+    levers on the contacts a calibration to more lab properties may turn.
 
-    One factor for all mineral pairs, so the ratios of Table 2 stay as printed.
+    ``strength_scale`` and ``stiffness_scale``: one factor for all mineral pairs, so the ratios of Table
+    2 stay as printed.  The levers (:func:`calibrated_contact`, :mod:`grainfrac_yade.contact_strength`)
+    change one ratio each: k_s / k_n, J^T / J^C, inter- over intra-mineral strength, and the scatter
+    of strength between faces; at their defaults (1, 1, 1, 0) they change nothing.
     """
     strength_scale: float = _spec("1", "positive", "multiplies J^T and J^C of every contact")
     stiffness_scale: float = _spec("1", "positive", "multiplies the series normal and shear stiffness of every bond")
     reference_ucs: float = _spec("Pa", "positive", "UCS a driving-stress ratio refers to: calibrated mean")
+    shear_stiffness_ratio_scale: float = _spec("1", "positive", "multiplies every pair's k_s / k_n "
+                                               "(contacts.\"a/b\".shear_stiffness_ratio, which stays per pair): the "
+                                               "contact shear stiffness k_s, before the grain's compliance in series; "
+                                               "one knob for the k_s / k_n of all pairs; 1 = as the pairs give it")
+    tensile_cohesion_ratio_scale: float = _spec("1", "positive", "multiplies J^T of every contact, J^C kept: each "
+                                                "pair's J^T / J^C times this, Table 2's differences between minerals "
+                                                "kept; 1 = as the pairs give it")
+    inter_mineral_strength_ratio: float = _spec("1", "positive", "multiplies J^T and J^C of the contacts between "
+                                                "cells of different minerals (after the arithmetic-average rule, or "
+                                                "as a file gives the pair): their strength over that rule's; 1 = the "
+                                                "paper's rule")
+    strength_weibull_modulus: float = _spec("1", "nonnegative", "Weibull modulus m of a per-face multiplier of J^T "
+                                            "and J^C (unit mean, CV = sqrt(Gamma(1+2/m)/Gamma(1+1/m)^2 - 1); one "
+                                            "draw per Voronoi face, seeded by the specimen's seed on a stream of its "
+                                            "own: grainfrac_yade.contact_strength); 0 = no scatter, else >= 1 (CV <= 1)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -322,6 +344,18 @@ def average_contact(a: ContactParams, b: ContactParams) -> ContactParams:
     """Contact of a mixed pair: arithmetic average of each parameter (paper section 3.1)."""
     return ContactParams(**{f.name: 0.5 * (getattr(a, f.name) + getattr(b, f.name))
                             for f in dataclasses.fields(ContactParams)})
+
+
+def calibrated_contact(contact: ContactParams, mixed: bool, calibration: CalibrationParams) -> ContactParams:
+    """A pair's contact with the pair-wise levers of ``calibration``: k_s / k_n x
+    ``shear_stiffness_ratio_scale``; J^T x ``tensile_cohesion_ratio_scale``; for a ``mixed`` pair (two
+    different minerals) J^T and J^C x ``inter_mineral_strength_ratio`` too.  Every factor 1: the same
+    values, bit for bit (x * 1.0 == x)."""
+    inter = calibration.inter_mineral_strength_ratio if mixed else 1.0
+    return dataclasses.replace(
+        contact, shear_stiffness_ratio=contact.shear_stiffness_ratio * calibration.shear_stiffness_ratio_scale,
+        tensile_strength=contact.tensile_strength * calibration.tensile_cohesion_ratio_scale * inter,
+        cohesion=contact.cohesion * inter)
 
 
 def field_spec(dotted: str) -> Mapping:
@@ -409,4 +443,4 @@ RETIRED_VALUES = {"resolution.grain_model": {
                    "use resolution.grain_model = \"fem\" (params/presets/fem.toml; docs/models.md)")}}
 
 
-__all__ = ["PARAMS_DIR", "DEFAULT_FILES", "FRACTION_SUM_TOLERANCE", "NEAREST_KEY_CUTOFF", "SpecimenParams", "GrainParams", "ContactParams", "ResolutionParams", "NumericsParams", "StressCorrosionParams", "unbalanced_threshold", "UcsParams", "CreepParams", "BrazilianParams", "ConfinementParams", "CalibrationParams", "Parameters", "SECTION_CLASSES", "pair_key", "average_contact", "field_spec", "_check_value", "nearest_key", "RETIRED_VALUES"]
+__all__ = ["PARAMS_DIR", "DEFAULT_FILES", "FRACTION_SUM_TOLERANCE", "NEAREST_KEY_CUTOFF", "SpecimenParams", "GrainParams", "ContactParams", "ResolutionParams", "NumericsParams", "StressCorrosionParams", "unbalanced_threshold", "UcsParams", "CreepParams", "BrazilianParams", "ConfinementParams", "CalibrationParams", "Parameters", "SECTION_CLASSES", "pair_key", "average_contact", "calibrated_contact", "field_spec", "_check_value", "nearest_key", "RETIRED_VALUES"]

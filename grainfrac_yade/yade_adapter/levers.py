@@ -4,9 +4,11 @@ Each lever changes the bonds or the cells of a scene built by :func:`.scene.buil
 the first DEM step; with every lever off (:class:`Levers` defaults) nothing is touched, so results
 are bit-identical to a scene without levers.  They are options of the ``brazilian`` command and of
 the lever study (``studies/brazilian_levers.py``, which applies them to UCS tests too), recorded in
-each summary.json under ``levers``; they are not model parameters (``params/``) yet, so the other
-commands (ucs, creep) do not know them.  The tensile strength of the contacts alone is a parameter
-already: ``brazilian --tensile-scale`` (contact rows' J^T).
+each summary.json under ``levers``; they are not model parameters (``params/``), so the other
+commands (ucs, creep) do not know them.  The levers on the contacts that are parameters of every
+command and both grain models live in ``[calibration]`` (k_s/k_n, J^T/J^C, inter-mineral strength, a
+per-face Weibull scatter of strength: :func:`grainfrac_yade.params.calibrated_contact`,
+:mod:`grainfrac_yade.contact_strength`); ``brazilian --tensile-scale`` sets the contact rows' J^T.
 
 * ``slit_fraction`` f: a random share f of the bonds (faces, with one sphere per cell) start broken
   ("slits", as the flat-joint model's unbonded faces, Potyondy 2012, or a granite's pre-existing
