@@ -72,7 +72,8 @@ def main(argv=None) -> int:
     young = run.target / max(run.platens.axial_strain(), 1e-12)
     crossing_s = params.specimen.height / math.sqrt(young / rho)
     crossing_steps = crossing_s / run.scene.O.dt
-    summary.update(servo_young_pa=young, density_kg_m3=rho, crossing_time_s=crossing_s, crossing_steps=crossing_steps)
+    summary.update(servo_young_pa=young, density_kg_m3=rho, crossing_time_s=crossing_s, crossing_steps=crossing_steps,
+                   **run.hold_budget.as_dict())
     done, equilibrium_at = 0, None
     with open(out / "relaxation.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=FIELDS)
