@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import math
 import os
 import sys
 import time
@@ -52,7 +51,8 @@ def main(argv=None) -> int:
     from grainfrac_yade.runs.runio import code_version
     from grainfrac_yade.specimen import build_specimen
     from grainfrac_yade.yade_adapter.creep_protocol import CreepRun
-    from grainfrac_yade.yade_adapter.platens import mean_bond_force, resultant_forces
+    from grainfrac_yade.wave import scene_density
+    from grainfrac_yade.yade_adapter.scene import mean_bond_force
     import numpy as np
     out.mkdir(parents=True)
     c0 = time.process_time()
@@ -67,13 +67,10 @@ def main(argv=None) -> int:
         print(f"ramp failed: {run.failure_reason}")
         return 0
     run.hold_servo()
-    grains = params.grains
-    rho = sum(f * grains[m].density for m, f in params.composition.items()) * params.numerics.density_scale
-    young = run.target / max(run.platens.axial_strain(), 1e-12)
-    crossing_s = params.specimen.height / math.sqrt(young / rho)
-    crossing_steps = crossing_s / run.scene.O.dt
-    summary.update(servo_young_pa=young, density_kg_m3=rho, crossing_time_s=crossing_s, crossing_steps=crossing_steps,
-                   **run.hold_budget.as_dict())
+    crossing_steps = run.hold_budget.crossing_steps   # the servo's: its modulus estimate, the scene's density
+    summary.update(servo_young_pa=run.servo.platens.height / (run.servo.gain * run.hold_budget.servo_response_steps),
+                   density_kg_m3=scene_density(params), crossing_time_s=crossing_steps * run.scene.O.dt,
+                   crossing_steps=crossing_steps, **run.hold_budget.as_dict())
     done, equilibrium_at = 0, None
     with open(out / "relaxation.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=FIELDS)
@@ -87,13 +84,10 @@ def main(argv=None) -> int:
                 balanced = run.at_equilibrium(run.servo)
                 if balanced and equilibrium_at is None:
                     equilibrium_at = done
-            bonds = np.flatnonzero(~run.scene.broken)
-            _, mean_resultant = resultant_forces(run.scene, run._free_ids)
-            ref = mean_bond_force(run.scene, bonds)
+            _, unbalanced_ratio = run.unbalanced(mean_bond_force(run.scene, np.flatnonzero(~run.scene.broken)))
             w.writerow({"hold_steps": done, "crossings": done / crossing_steps,
                         "axial_strain": run.platens.axial_strain(), "axial_stress_pa": run.servo.stress,
-                        "broken_total": int(run.scene.broken.sum()),
-                        "unbalanced_ratio": mean_resultant / ref if ref > 0 else math.inf,
+                        "broken_total": int(run.scene.broken.sum()), "unbalanced_ratio": unbalanced_ratio,
                         "at_equilibrium": bool(balanced), "servo_clipped": clipped,
                         "cpu_s": time.process_time() - c0})
             f.flush()

@@ -54,8 +54,8 @@ from ..clocks import EventClock, PaperClock
 from ..errors import GrainfracError
 from ..grains import grain_model
 from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
-from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from ..wave import HoldBudget
+from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import StressServo
 
 #: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).

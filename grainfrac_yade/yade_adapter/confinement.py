@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..tessellation import SIDES
-from ..wave import hold_budget
+from ..wave import hold_budget, scene_density
 from .platens import StressServo, free_bodies, held_at_equilibrium
 
 #: Share of the bonds broken in the isotropic stage at which the specimen counts as broken apart before
@@ -71,18 +71,19 @@ def young_estimate(params) -> float:
     return float(sum(fraction * params.grains[m].young for m, fraction in params.composition.items()))
 
 
-def consolidate(scene, platens, stress: float, creep_params, young: float, density: float) -> dict:
+def consolidate(scene, platens, stress: float, params) -> dict:
     """Isotropic stage: with the confining forces on, a servo brings the axial stress to ``stress``
     [Pa] and holds it until equilibrium (mean resultant on free bodies / mean bond force below
     ``creep.equilibrium_tolerance`` and the axial stress within ``creep.stress_tolerance``), at most
     ``creep.max_relaxation_steps`` DEM steps (:func:`.platens.held_at_equilibrium`, as a creep run's
-    hold).  ``young`` [Pa]: an estimate of the specimen's modulus
-    for the servo gain, ``density`` [kg/m3] the scene's (grains x ``numerics.density_scale``): with them the
-    servo's response and the stage's step budget follow the creep hold's (:func:`~grainfrac_yade.wave.hold_budget`).
+    hold).  The servo's gain uses :func:`young_estimate` of ``params``; with it and the scene's density
+    (:func:`~grainfrac_yade.wave.scene_density`) the servo's response and the stage's step budget follow the
+    creep hold's (:func:`~grainfrac_yade.wave.hold_budget`).
     The platens are left at rest.  Returns the stage's DEM steps, whether it
     reached equilibrium, and the axial stress at its end."""
-    cp = creep_params
-    budget = hold_budget(cp, platens.height, young, density, scene.O.dt)
+    cp = params.creep
+    young = young_estimate(params)
+    budget = hold_budget(cp, platens.height, young, scene_density(params), scene.O.dt)
     servo = StressServo(platens, stress, young, budget.servo_response_steps, cp.servo_max_strain_rate * platens.height)
     scene.drivers.append(servo)
     free = free_bodies(scene, platens)

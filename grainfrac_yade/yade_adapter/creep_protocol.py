@@ -47,7 +47,7 @@ from ..law import shear_strength
 from ..params import unbalanced_threshold
 from ..wave import hold_budget, scene_density
 from .checkpoint import Checkpointer, inexact_note, read, restore
-from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
+from .confinement import Confinement, broken_apart_reason, consolidate
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
 from .scene import broken_counts, build_scene, check_value, resultant_forces
@@ -330,8 +330,7 @@ class CreepRun:
         phase, loop = self.resumed or (None, None)
         if phase in (None, "loading"):
             if phase is None and self.confinement is not None:
-                self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params.creep,
-                                                 young_estimate(self.params), scene_density(self.params))
+                self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params)
                 self.failure_reason = broken_apart_reason(self.scene, self.confinement.stress, "no creep test")
                 if self.failure_reason:   # no specimen left to load: neither a lifetime nor a survival
                     self.failed_before_test = True

@@ -21,10 +21,9 @@ import time
 import numpy as np
 
 from ..errors import NumericalFailure
-from ..wave import scene_density
 from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_state, read, restore_platens,
                          restore_scene, resume_record, scene_arrays)
-from .confinement import Confinement, broken_apart_reason, consolidate, young_estimate
+from .confinement import Confinement, broken_apart_reason, consolidate
 from .platens import Platens
 from .scene import broken_counts, build_scene, check_value, softened_past_peak
 
@@ -69,8 +68,7 @@ class UcsRun(LoadingCheckpoints):
             if confining > 0 and not self.resumed:
                 self.confinement = Confinement(scene, confining)
                 scene.extras.append(self.confinement)
-                self.consolidation = consolidate(scene, platens, confining, self.params.creep,
-                                                 young_estimate(self.params), scene_density(self.params))
+                self.consolidation = consolidate(scene, platens, confining, self.params)
                 platens.set_axial_velocity(self.closing_speed)
                 broken_apart = end = broken_apart_reason(scene, confining)
                 if broken_apart and self.progress:
