@@ -84,26 +84,34 @@ def _write(path: Path, rows, fields):
 
 
 def run_setting(name, extra_files, out: Path, seed: int = SEED) -> list:
+    rows = measure(extra_files, SETTINGS[name], seed, out / f"{name}_seed{seed}")
+    return [{"setting": name, **r} for r in rows]
+
+
+def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, disc_diameter=DISC_DIAMETER) -> list:
+    """One UCS test (``ucs_size`` = (width, height) [m]) into ``prefix``_ucs and one Brazilian test
+    (``disc_diameter`` [m]) into ``prefix``_brazilian with ``overrides``: their two rows of
+    :data:`LEVER_FIELDS` (without the setting's name)."""
     from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
-    rows, overrides = [], SETTINGS[name]
-    w, h = UCS_SIZE
+    rows, prefix = [], Path(prefix)
+    w, h = ucs_size
     p = load_parameters(extra_files=extra_files, overrides=[f"specimen.width={w}", f"specimen.height={h}", *overrides])
     t0 = time.process_time()
-    s = run_ucs_to_folder(p, seed, out / f"{name}_seed{seed}_ucs", overwrite=True)
+    s = run_ucs_to_folder(p, seed, prefix.with_name(prefix.name + "_ucs"), overwrite=True)
     ucs = s["ucs_pa"]
-    rows.append({"setting": name, "overrides": " ".join(overrides), "test": "ucs", "seed": seed,
+    rows.append({"overrides": " ".join(overrides), "test": "ucs", "seed": seed,
                  "size_m": f"{w}x{h}", "n_cells": s["n_cells"], "ucs_pa": ucs, "young_pa": s["young_pa"],
                  "poisson": s["poisson"], "crack_initiation_pa": s["crack_initiation_pa"],
                  "crack_damage_pa": s["crack_damage_pa"],
                  "ci_over_ucs": s["crack_initiation_pa"] / ucs if s["crack_initiation_pa"] else None,
                  "cd_over_ucs": s["crack_damage_pa"] / ucs if s["crack_damage_pa"] else None,
                  "cpu_s": time.process_time() - t0})
-    p = load_parameters(extra_files=extra_files, overrides=[f"brazilian.diameter={DISC_DIAMETER}", *overrides])
+    p = load_parameters(extra_files=extra_files, overrides=[f"brazilian.diameter={disc_diameter}", *overrides])
     t0 = time.process_time()
-    s = run_brazilian_to_folder(p, seed, out / f"{name}_seed{seed}_brazilian", overwrite=True)
-    rows.append({"setting": name, "overrides": " ".join(overrides), "test": "brazilian", "seed": seed,
-                 "size_m": f"{DISC_DIAMETER}", "n_cells": s.get("n_cells"),
+    s = run_brazilian_to_folder(p, seed, prefix.with_name(prefix.name + "_brazilian"), overwrite=True)
+    rows.append({"overrides": " ".join(overrides), "test": "brazilian", "seed": seed,
+                 "size_m": f"{disc_diameter}", "n_cells": s.get("n_cells"),
                  "tensile_strength_pa": s["tensile_strength_pa"], "split_found": s["split_found"],
                  "cpu_s": time.process_time() - t0})
     return rows

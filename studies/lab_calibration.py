@@ -1,0 +1,141 @@
+"""Joint calibration of the contact levers to the lab's bands (grainfrac_yade.lab_fit): docs/studies/lab_calibration.md.
+
+Three parts, run in this order; each reads what the one before wrote and writes plain files:
+
+* ``design``: the design points (``lab_fit.design``), each a 10 x 20 mm UCS test and a 10 mm Brazilian
+  test per seed, one row per test into CSV (units in the column names).  Rows already in the CSV are
+  skipped, so a stopped run goes on where it was (``--n`` and ``--design-seed`` must stay the same).
+* ``fit``: the linear response surface and its least-squares optimum: JSON with the candidate's keys.
+* ``verify``: the candidate on more seeds (same specimens): rows into a CSV of their own.
+
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_calibration design --n 14 --seeds 1 2 \\
+        --csv docs/studies/lab_calibration_design.csv --out results/lab_calibration
+    /usr/bin/python3 -m studies.lab_calibration fit --csv docs/studies/lab_calibration_design.csv \\
+        --json docs/studies/lab_calibration_fit.json
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit.json \\
+        --seeds 1 2 3 --csv docs/studies/lab_calibration_verify.csv --out results/lab_calibration
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from grainfrac_yade import lab_fit
+from studies.lab_bands import LEVER_FIELDS, measure
+
+ROOT = Path(__file__).resolve().parents[1]
+#: The base model: finite-element cells, Tables 1 and 2 as printed.
+BASE_PARAMS = [str(ROOT / "params" / "presets" / "fem.toml")]
+#: Specimens: the 10 x 20 mm UCS specimen of the fem studies and the smallest disc whose sigma_t the
+#: lever study read (10 mm, about 100 cells) [m].
+UCS_SIZE = (10e-3, 20e-3)
+DISC_DIAMETER = 10e-3
+POINT_FIELDS = ("point", *(f"u_{v.name}" for v in lab_fit.FIT_VARIABLES), *LEVER_FIELDS[1:])
+
+
+def _rows(path: Path) -> list:
+    return list(csv.DictReader(Path(path).open())) if Path(path).exists() else []
+
+
+def _append(path: Path, rows):
+    path = Path(path)
+    new = not path.exists()
+    with path.open("a", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=POINT_FIELDS)
+        if new:
+            w.writeheader()
+        w.writerows(rows)
+
+
+def run_point(point: int, u, seeds, csv_path: Path, out: Path, extra=()):
+    """Run point ``u`` on ``seeds`` unless its rows are in ``csv_path``; rows appended as each seed ends."""
+    done = {(int(r["point"]), int(r["seed"])) for r in _rows(csv_path)}
+    for seed in seeds:
+        if (point, seed) in done:
+            continue
+        rows = measure([*BASE_PARAMS, *extra], lab_fit.overrides(u), seed, Path(out) / f"point{point}_seed{seed}",
+                       ucs_size=UCS_SIZE, disc_diameter=DISC_DIAMETER)
+        coords = {f"u_{v.name}": float(x) for v, x in zip(lab_fit.FIT_VARIABLES, u)}
+        _append(csv_path, [{"point": point, **coords, **r} for r in rows])
+        print(f"point {point} seed {seed}: " + ", ".join(
+            f"{r['test']} {(r.get('ucs_pa') or r.get('tensile_strength_pa') or float('nan')) / 1e6:.1f} MPa "
+            f"({r['cpu_s']:.0f} s)" for r in rows), flush=True)
+
+
+def point_means(rows) -> tuple:
+    """(points, u (m, 5), measured seed means (m, 5) in Pa and 1: UCS, E, sigma_t, CI/UCS, CD/UCS)."""
+    def val(r, k):
+        return float(r[k]) if r.get(k) not in (None, "", "None") else np.nan
+    by_point = {}
+    for r in rows:
+        by_point.setdefault(int(r["point"]), []).append(r)
+    points, us, ys = [], [], []
+    for p, rs in sorted(by_point.items()):
+        ucs = [r for r in rs if r["test"] == "ucs"]
+        bz = [r for r in rs if r["test"] == "brazilian"]
+        points.append(p)
+        us.append([float(rs[0][f"u_{v.name}"]) for v in lab_fit.FIT_VARIABLES])
+        ys.append([np.nanmean([val(r, "ucs_pa") for r in ucs]) if ucs else np.nan,
+                   np.nanmean([val(r, "young_pa") for r in ucs]) if ucs else np.nan,
+                   np.nanmean([val(r, "tensile_strength_pa") for r in bz]) if bz else np.nan,
+                   np.nanmean([val(r, "ci_over_ucs") for r in ucs]) if ucs else np.nan,
+                   np.nanmean([val(r, "cd_over_ucs") for r in ucs]) if ucs else np.nan])
+    return points, np.array(us), np.array(ys)
+
+
+def fit(csv_path: Path, ucs_target=None) -> dict:
+    points, u, y = point_means(_rows(csv_path))
+    targets = lab_fit.lab_targets(ucs_value=ucs_target)
+    surface = lab_fit.fit_surrogate(u, lab_fit.scaled(y))
+    best, predicted = lab_fit.solve(surface, targets)
+    names = [v.name for v in lab_fit.FIT_VARIABLES]
+    return {
+        "design_csv": str(csv_path), "n_points": len(points),
+        "targets": dict(zip(targets.names, targets.value.tolist())),
+        "target_spreads": dict(zip(targets.names, targets.spread.tolist())),
+        "target_sources": dict(zip(targets.names, targets.sources)),
+        "surface_r2": dict(zip(targets.names, surface.r2.tolist())),
+        "surface_residual_sd": dict(zip(targets.names, surface.residual_sd.tolist())),
+        "surface_slope_per_unit": {o: dict(zip(names, row)) for o, row in zip(targets.names, surface.slope.tolist())},
+        "candidate_u": dict(zip(names, best.tolist())),
+        "candidate_overrides": lab_fit.overrides(best),
+        "predicted": dict(zip(targets.names, lab_fit.unscaled(surface.predict(best)).tolist())),
+        "predicted_weighted_residuals": dict(zip(targets.names, predicted.tolist())),
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("part", choices=("design", "fit", "verify"))
+    ap.add_argument("--csv", required=True, help="rows of the design (design, fit) or of the verification (verify)")
+    ap.add_argument("--json", help="the fit's result (written by fit, read by verify)")
+    ap.add_argument("--out", default=str(ROOT / "results" / "lab_calibration"), help="run folders")
+    ap.add_argument("--n", type=int, default=14, help="Latin-hypercube points besides Tables 1 and 2 as printed")
+    ap.add_argument("--design-seed", type=int, default=1, help="seed of the Latin hypercube")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2], help="specimen seeds per point")
+    ap.add_argument("--only", type=int, nargs="+", help="design points to run (default all)")
+    args = ap.parse_args(argv)
+    if args.part == "design":
+        pts = lab_fit.design(args.n, args.design_seed)
+        for i, u in enumerate(pts):
+            if args.only is None or i in args.only:
+                run_point(i, u, args.seeds, Path(args.csv), Path(args.out))
+        return 0
+    if args.part == "fit":
+        result = fit(Path(args.csv))
+        Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
+        print(json.dumps({k: result[k] for k in ("surface_r2", "candidate_overrides", "predicted",
+                                                  "predicted_weighted_residuals")}, indent=1))
+        return 0
+    result = json.loads(Path(args.json).read_text())
+    u = np.array([result["candidate_u"][v.name] for v in lab_fit.FIT_VARIABLES])
+    run_point(-1, u, args.seeds, Path(args.csv), Path(args.out) / "verify")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
