@@ -33,6 +33,8 @@ declare -A WHAT=(
   [threshold]="docs/studies/creep.md long-term strength table (params/threshold_study_tiny.table, 4 x 8 mm): about 5 min on 2 cores"
   [regularisation]="docs/studies/regularisation.md: critical DEM step of rigid and fem cells against specimen.min_edge_fraction (docs/regularisation_steps.csv, no YADE: about 15 min on one core) and paired UCS/E of fem cells with the intact-joint guard at 0-10 %, without it and of rigid cells at 0, 2, 5 % (docs/regularisation_ucs.csv, 33 UCS runs: 38 CPU min measured on 2 shared cores) and the static contact-stress tails of fem cells (docs/regularisation_tails.csv, 30 static solves, no YADE: 80 s)"
   [lab_bands]="docs/studies/lab_bands.md: grain-size CV against lloyd_iterations (no YADE, seconds) and paired fem UCS (5 x 10 mm) and Brazilian (10 mm disc) runs per lever on the contacts: about 10 min on one core"
+  [paper_fem]="docs/studies/paper_fem.md tables: docs/studies/paper_fem/ucs_runs.csv (params/paper_fem_ucs.table, about 6 CPU h) and docs/studies/paper_fem/runs.csv (params/paper_fem_creep.table, 9 paper-size fem creep runs: more than 1.2 CPU h each, not all measured)"
+  [lab_calibration]="docs/studies/lab_calibration.md: the joint calibration's design (15 points x 2 seeds of a 10 x 20 mm fem UCS and a 10 mm disc, about 90 CPU s each), its fit and the candidate on seeds 1-3: about 50 min on one core"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -84,6 +86,17 @@ run_target() {
                batch params/threshold_study_tiny.table creep.py threshold_tiny
                $PY -m grainfrac_yade analyze results/threshold_tiny
                cp results/threshold_tiny/report/lifetime.png docs/figures/threshold_tiny_lifetime.png ;;
+    paper_fem) batch params/paper_fem_ucs.table ucs.py paper_fem_ucs
+               $PY -m grainfrac_yade analyze-ucs results/paper_fem_ucs
+               cp results/paper_fem_ucs/ucs_runs.csv docs/studies/paper_fem/ucs_runs.csv
+               batch params/paper_fem_creep.table creep.py paper_fem_creep
+               $PY -m grainfrac_yade analyze results/paper_fem_creep
+               cp results/paper_fem_creep/report/runs.csv docs/studies/paper_fem/runs.csv ;;
+    lab_calibration) $PY -m studies.lab_calibration design --n 14 --seeds 1 2 --csv docs/studies/lab_calibration_design.csv
+                     $PY -m studies.lab_calibration fit --csv docs/studies/lab_calibration_design.csv \
+                         --json docs/studies/lab_calibration_fit.json
+                     $PY -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit.json --seeds 1 2 3 \
+                         --csv docs/studies/lab_calibration_verify.csv ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
                               $PY -m grainfrac_yade analyze results/accuracy_cost_paper_size ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
@@ -97,7 +110,7 @@ fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
-                           regularisation lab_bands)
+                           regularisation lab_bands lab_calibration paper_fem)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
