@@ -1,12 +1,14 @@
 """Joint calibration of the contact levers to the lab's bands (grainfrac_yade.lab_fit): docs/studies/lab_calibration.md.
 
-Three parts, run in this order; each reads what the one before wrote and writes plain files:
+Four parts, run in this order; each reads what the one before wrote and writes plain files:
 
 * ``design``: the design points (``lab_fit.design``), each a 10 x 20 mm UCS test and a 10 mm Brazilian
   test per seed, one row per test into CSV (units in the column names).  Rows already in the CSV are
   skipped, so a stopped run goes on where it was (``--n`` and ``--design-seed`` must stay the same).
 * ``fit``: the linear response surface and its least-squares optimum: JSON with the candidate's keys.
 * ``verify``: the candidate on more seeds (same specimens): rows into a CSV of their own.
+* ``preset``: ``params/presets/ldb_lab.toml``, the fem preset with the candidate's keys and the verified
+  measurements and residuals beside each target.
 
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_calibration design --n 14 --seeds 1 2 \\
         --csv docs/studies/lab_calibration_design.csv --out results/lab_calibration
@@ -14,6 +16,8 @@ Three parts, run in this order; each reads what the one before wrote and writes 
         --json docs/studies/lab_calibration_fit.json
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit.json \\
         --seeds 1 2 3 --csv docs/studies/lab_calibration_verify.csv --out results/lab_calibration
+    /usr/bin/python3 -m studies.lab_calibration preset --json docs/studies/lab_calibration_fit.json \\
+        --csv docs/studies/lab_calibration_verify.csv
 """
 from __future__ import annotations
 
@@ -34,6 +38,7 @@ BASE_PARAMS = [str(ROOT / "params" / "presets" / "fem.toml")]
 #: lever study read (10 mm, about 100 cells) [m].
 UCS_SIZE = (10e-3, 20e-3)
 DISC_DIAMETER = 10e-3
+PRESET = ROOT / "params" / "presets" / "ldb_lab.toml"
 POINT_FIELDS = ("point", *(f"u_{v.name}" for v in lab_fit.FIT_VARIABLES), *LEVER_FIELDS[1:])
 
 
@@ -108,9 +113,54 @@ def fit(csv_path: Path, ucs_target=None) -> dict:
     }
 
 
+def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[0])) -> str:
+    """The preset: a header with the verified residuals, the base preset's model keys ([resolution],
+    [numerics]) and a [calibration] section with the candidate's keys and the verified mean UCS."""
+    import tomllib
+    targets = lab_fit.lab_targets()
+    _, _, measured = point_means(verify_rows)
+    per_seed = {}
+    for r in verify_rows:
+        per_seed.setdefault(r["test"], []).append(r)
+    seeds = sorted({int(r["seed"]) for r in verify_rows})
+    mean = measured[0]
+    y_scaled = lab_fit.scaled(mean[None, :])[0]
+    resid = lab_fit.weighted_residuals(y_scaled, targets)
+    units = {"ucs": (1e6, "MPa"), "young": (1e9, "GPa"), "tensile_strength": (1e6, "MPa"),
+             "ci_over_ucs": (1.0, ""), "cd_over_ucs": (1.0, "")}
+    lines = ["# Finite-element grains calibrated jointly to Lac du Bonnet granite's lab bands (docs/studies/lab_calibration.md):",
+             "# UCS, E, Brazilian tensile strength, CI/UCS and CD/UCS, by five contact levers ([calibration] below),",
+             "# written by  python3 -m studies.lab_calibration preset  from the fit of",
+             f"#   {result['design_csv']} ({result['n_points']} design points)",
+             f"# and its verification on seeds {seeds} (10 x 20 mm UCS at the preset's 0.5 /s, 10 mm Brazilian disc).",
+             "# Targets: params/reference/ldb_lab_properties.csv (the lab's UCS 200 MPa, not the paper's simulated 234.5 MPa:",
+             "# every other target is a lab property of one granite). Use with --params params/presets/ldb_lab.toml.",
+             "#",
+             "# target             lab value +- spread       verified mean (seeds)     residual [lab spreads]   surface predicted"]
+    for k, name in enumerate(targets.names):
+        f, unit = units[name]
+        lines.append(f"#   {name:18s} {targets.value[k] / f:8.3g} +- {targets.spread[k] / f:<7.3g} {unit:4s} "
+                     f"{mean[k] / f:9.4g} {unit:4s}            {resid[k]:+6.2f}                 "
+                     f"{result['predicted'][name] / f:.4g}")
+    base = Path(base_preset).read_text()
+    model = base[base.index("[resolution]"):base.index("[calibration]")].rstrip()
+    cal = dict(o.split("=") for o in result["candidate_overrides"])
+    doc = {v.key: v for v in lab_fit.FIT_VARIABLES}
+    lines += ["", "# the model's keys, as " + str(Path(base_preset).relative_to(ROOT)), model, "", "[calibration]"]
+    for key, value in cal.items():
+        name = key.split(".", 1)[1]
+        lines.append(f"{name} = {float(value)!r}    # 1, fitted: {doc[key].doc}")
+    lines += ["stiffness_scale = 1.0    # 1, not fitted: Table 2 as printed",
+              f"reference_ucs = {mean[0]:.6g}    # Pa, the verified mean UCS above; what a driving-stress ratio refers to",
+              ""]
+    text = "\n".join(lines)
+    tomllib.loads(text)   # a preset that does not parse is never written
+    return text
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("part", choices=("design", "fit", "verify"))
+    ap.add_argument("part", choices=("design", "fit", "verify", "preset"))
     ap.add_argument("--csv", required=True, help="rows of the design (design, fit) or of the verification (verify)")
     ap.add_argument("--json", help="the fit's result (written by fit, read by verify)")
     ap.add_argument("--out", default=str(ROOT / "results" / "lab_calibration"), help="run folders")
@@ -118,6 +168,7 @@ def main(argv=None) -> int:
     ap.add_argument("--design-seed", type=int, default=1, help="seed of the Latin hypercube")
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2], help="specimen seeds per point")
     ap.add_argument("--only", type=int, nargs="+", help="design points to run (default all)")
+    ap.add_argument("--write", default=str(PRESET), help="the preset file (preset)")
     args = ap.parse_args(argv)
     if args.part == "design":
         pts = lab_fit.design(args.n, args.design_seed)
@@ -133,7 +184,11 @@ def main(argv=None) -> int:
         return 0
     result = json.loads(Path(args.json).read_text())
     u = np.array([result["candidate_u"][v.name] for v in lab_fit.FIT_VARIABLES])
-    run_point(-1, u, args.seeds, Path(args.csv), Path(args.out) / "verify")
+    if args.part == "verify":
+        run_point(-1, u, args.seeds, Path(args.csv), Path(args.out) / "verify")
+        return 0
+    Path(args.write).write_text(preset_text(result, _rows(Path(args.csv))))
+    print(f"written {args.write}")
     return 0
 
 

@@ -73,3 +73,53 @@ def test_targets_are_the_lab_csv_in_fit_scale():
     assert t.scaled_value[0] == pytest.approx(np.log(200e6))
     assert t.scaled_spread[2] == pytest.approx(np.log1p(0.3 / 9.0))
     assert lab_fit.lab_targets(ucs_value=234.5e6).value[0] == 234.5e6
+
+
+def _synthetic_rows(points, law, seeds=(1, 2)):
+    """Rows as the study's design CSV holds them, measured = law(u) (Pa and 1) on every seed."""
+    rows = []
+    for i, u in enumerate(points):
+        ucs, young, sigma_t, ci, cd = law(u)
+        coords = {f"u_{v.name}": str(x) for v, x in zip(lab_fit.FIT_VARIABLES, u)}
+        for seed in seeds:
+            rows.append({"point": str(i), **coords, "test": "ucs", "seed": str(seed), "ucs_pa": str(ucs),
+                         "young_pa": str(young), "ci_over_ucs": str(ci), "cd_over_ucs": str(cd)})
+            rows.append({"point": str(i), **coords, "test": "brazilian", "seed": str(seed),
+                         "tensile_strength_pa": str(sigma_t)})
+    return rows
+
+
+def test_study_fit_and_preset_on_a_known_linear_law(tmp_path):
+    """The study's fit reads its CSV, finds the point where a log-linear law meets the lab's values, and
+    writes a preset that loads with those keys and the measured UCS as its reference."""
+    import csv
+    from grainfrac_yade.params import load_parameters
+    from studies import lab_calibration as study
+    targets = lab_fit.lab_targets()
+    rng = np.random.default_rng(2)
+    slope = np.eye(5) * targets.scaled_spread * 20 + 0.01 * rng.normal(size=(5, 5)) * targets.scaled_spread
+    u_true = np.array([0.3, 0.6, 0.5, 0.8, 0.2])
+    intercept = targets.scaled_value - slope @ u_true
+
+    def law(u):
+        return lab_fit.unscaled(intercept + slope @ u)
+    path = tmp_path / "design.csv"
+    rows = _synthetic_rows(lab_fit.design(14, 1), law)
+    with path.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(study.POINT_FIELDS))
+        w.writeheader()
+        w.writerows({k: r.get(k, "") for k in study.POINT_FIELDS} for r in rows)
+    result = study.fit(path)
+    u = np.array([result["candidate_u"][v.name] for v in lab_fit.FIT_VARIABLES])
+    assert np.allclose(u, u_true, atol=1e-6)
+    assert all(abs(r) < 1e-6 for r in result["predicted_weighted_residuals"].values())
+    verify = _synthetic_rows([u_true], law, seeds=(1, 2, 3))
+    preset = tmp_path / "ldb_lab.toml"
+    preset.write_text(study.preset_text(result, verify))
+    p = load_parameters(extra_files=[str(preset)])
+    expected = dict(o.split("=") for o in lab_fit.overrides(u))
+    assert p.calibration.strength_scale == pytest.approx(float(expected["calibration.strength_scale"]), rel=1e-5)
+    assert p.calibration.shear_stiffness_ratio_scale == pytest.approx(
+        float(expected["calibration.shear_stiffness_ratio_scale"]), rel=1e-5)
+    assert p.calibration.reference_ucs == pytest.approx(200e6, rel=1e-5)
+    assert p.resolution.grain_model == "fem"
