@@ -85,13 +85,13 @@ def _write(path: Path, rows, fields):
 
 def run_setting(name, extra_files, out: Path, seed: int = SEED) -> list:
     rows = measure(extra_files, SETTINGS[name], seed, out / f"{name}_seed{seed}")
-    return [{"setting": name, **r} for r in rows]
+    return [{"setting": name, **{k: v for k, v in r.items() if k in LEVER_FIELDS}} for r in rows]
 
 
 def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, disc_diameter=DISC_DIAMETER) -> list:
     """One UCS test (``ucs_size`` = (width, height) [m]) into ``prefix``_ucs and one Brazilian test
     (``disc_diameter`` [m]) into ``prefix``_brazilian with ``overrides``: their two rows of
-    :data:`LEVER_FIELDS` (without the setting's name)."""
+    :data:`LEVER_FIELDS` (without the setting's name; the Brazilian row also has ``broken_total``)."""
     from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
     rows, prefix = [], Path(prefix)
@@ -113,7 +113,7 @@ def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, 
     rows.append({"overrides": " ".join(overrides), "test": "brazilian", "seed": seed,
                  "size_m": f"{disc_diameter}", "n_cells": s.get("n_cells"),
                  "tensile_strength_pa": s["tensile_strength_pa"], "split_found": s["split_found"],
-                 "cpu_s": time.process_time() - t0})
+                 "broken_total": s["broken_total"], "cpu_s": time.process_time() - t0})
     return rows
 
 

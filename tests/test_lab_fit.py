@@ -84,7 +84,7 @@ def _synthetic_rows(points, law, seeds=(1, 2)):
         for seed in seeds:
             rows.append({"point": str(i), **coords, "test": "ucs", "seed": str(seed), "ucs_pa": str(ucs),
                          "young_pa": str(young), "ci_over_ucs": str(ci), "cd_over_ucs": str(cd)})
-            rows.append({"point": str(i), **coords, "test": "brazilian", "seed": str(seed),
+            rows.append({"point": str(i), **coords, "test": "brazilian", "seed": str(seed), "broken_total": "100",
                          "tensile_strength_pa": str(sigma_t)})
     return rows
 
@@ -123,3 +123,17 @@ def test_study_fit_and_preset_on_a_known_linear_law(tmp_path):
         float(expected["calibration.shear_stiffness_ratio_scale"]), rel=1e-5)
     assert p.calibration.reference_ucs == pytest.approx(200e6, rel=1e-5)
     assert p.resolution.grain_model == "fem"
+
+
+def test_a_brazilian_peak_without_a_split_is_left_out():
+    """Fewer bonds broken than grains on the diameter: a seating transient, not a tensile strength."""
+    from studies import lab_calibration as study
+    u = lab_fit.AS_PRINTED
+    rows = _synthetic_rows([u], lambda u: [200e6, 69e9, 9e6, 0.45, 0.75], seeds=(1, 2))
+    bz = [r for r in rows if r["test"] == "brazilian"]
+    bz[0]["broken_total"], bz[0]["tensile_strength_pa"] = "1", "1.3e6"
+    _, _, y = study.point_means(rows)
+    assert y[0, 2] == 9e6
+    bz[1]["broken_total"] = str(study.MIN_SPLIT_BREAKS - 1)
+    _, _, y = study.point_means(rows)
+    assert np.isnan(y[0, 2])
