@@ -43,6 +43,31 @@ def crack_initiation_stress(stress, broken_count):
     return float(stress[hit[0]]) if len(hit) else float("nan")
 
 
+def crack_volumetric_strain(stress, axial_strain, lateral_strain, young, poisson):
+    """Crack volumetric strain of the plane model [1] (Martin & Chandler 1994, in 2D):
+    eps_v^crack = eps_v - (1 - nu) sigma / E, the measured area strain eps_a + eps_l less the elastic one
+    of a uniaxial stress sigma (eps_a = sigma / E, eps_l = -nu sigma / E).  Negative when cracks dilate."""
+    stress = np.asarray(stress, float)
+    ev = np.asarray(axial_strain, float) + np.asarray(lateral_strain, float)
+    return ev - (1.0 - poisson) * stress / young
+
+
+def crack_initiation_volumetric_stress(stress, axial_strain, lateral_strain, young, poisson,
+                                       fraction=CI_FRACTION_OF_PEAK_COUNT):
+    """Crack initiation as the lab reads it [Pa]: the stress from which the crack volumetric strain
+    (:func:`crack_volumetric_strain`) leaves zero for good, i.e. after the last pre-peak point where its
+    dilation is at most ``fraction`` of the dilation at the peak (nan if there is none at the peak)."""
+    stress = np.asarray(stress, float)
+    ip = int(np.argmax(stress))
+    dilation = -crack_volumetric_strain(stress, axial_strain, lateral_strain, young, poisson)[: ip + 1]
+    if not dilation[ip] > 0:
+        return float("nan")
+    below = np.flatnonzero(dilation <= fraction * dilation[ip])
+    if len(below) == 0:
+        return float(stress[0])
+    return float(stress[min(below[-1] + 1, ip)])
+
+
 def crack_damage_stress(stress, axial_strain, lateral_strain):
     """Axial stress at the onset of volumetric strain reversal [Pa]: max of eps_a + eps_l before peak."""
     stress = np.asarray(stress, float)

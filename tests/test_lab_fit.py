@@ -137,3 +137,19 @@ def test_a_brazilian_peak_without_a_split_is_left_out():
     bz[1]["broken_total"] = str(study.MIN_SPLIT_BREAKS - 1)
     _, _, y = study.point_means(rows)
     assert np.isnan(y[0, 2])
+
+
+def test_crack_volumetric_strain_onset_of_a_known_history():
+    """Elastic to sigma_ci = 90 MPa, then a crack dilation growing as (sigma - sigma_ci)^2: the lab's
+    crack-initiation reading finds where the dilation reaches 2 % of its peak value, to the stress step."""
+    from grainfrac_yade.ucs_analysis import crack_initiation_volumetric_stress, crack_volumetric_strain
+    young, poisson, ci = 70e9, 0.25, 90e6
+    stress = np.linspace(0.0, 200e6, 401)          # 0.5 MPa a row
+    ea = stress / young
+    crack = 1e-3 * np.clip((stress - ci) / 110e6, 0.0, None) ** 2
+    el = -poisson * stress / young - crack        # cracks open laterally: area strain falls by `crack`
+    assert np.allclose(crack_volumetric_strain(stress, ea, el, young, poisson), -crack, atol=1e-15)
+    found = crack_initiation_volumetric_stress(stress, ea, el, young, poisson)
+    # 2 % of the peak dilation is reached at ci + 110 MPa sqrt(0.02) = 105.6 MPa
+    assert found == pytest.approx(ci + 110e6 * np.sqrt(0.02), abs=0.5e6)
+    assert np.isnan(crack_initiation_volumetric_stress(stress, ea, -poisson * stress / young, young, poisson))
