@@ -88,17 +88,29 @@ def run_setting(name, extra_files, out: Path, seed: int = SEED) -> list:
     return [{"setting": name, **{k: v for k, v in r.items() if k in LEVER_FIELDS}} for r in rows]
 
 
+def volumetric_crack_initiation(folder: Path, summary: dict) -> float:
+    """Crack initiation read from the crack volumetric strain of the UCS run in ``folder`` (as the lab
+    reads it: grainfrac_yade.ucs_analysis.crack_initiation_volumetric_stress) [Pa]."""
+    from grainfrac_yade.ucs_analysis import crack_initiation_volumetric_stress
+    rows = list(csv.DictReader((Path(folder) / "history.csv").open()))
+    col = {k: np.array([float(r[k]) for r in rows]) for k in ("axial_stress_pa", "axial_strain", "lateral_strain")}
+    return crack_initiation_volumetric_stress(col["axial_stress_pa"], col["axial_strain"], col["lateral_strain"],
+                                              summary["young_pa"], summary["poisson"])
+
+
 def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, disc_diameter=DISC_DIAMETER) -> list:
     """One UCS test (``ucs_size`` = (width, height) [m]) into ``prefix``_ucs and one Brazilian test
     (``disc_diameter`` [m]) into ``prefix``_brazilian with ``overrides``: their two rows of
-    :data:`LEVER_FIELDS` (without the setting's name; the Brazilian row also has ``broken_total``)."""
+    :data:`LEVER_FIELDS` (without the setting's name; the UCS row also has ``crack_initiation_volumetric_pa``, the Brazilian
+    row ``broken_total``)."""
     from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
     rows, prefix = [], Path(prefix)
     w, h = ucs_size
     p = load_parameters(extra_files=extra_files, overrides=[f"specimen.width={w}", f"specimen.height={h}", *overrides])
     t0 = time.process_time()
-    s = run_ucs_to_folder(p, seed, prefix.with_name(prefix.name + "_ucs"), overwrite=True)
+    folder = prefix.with_name(prefix.name + "_ucs")
+    s = run_ucs_to_folder(p, seed, folder, overwrite=True)
     ucs = s["ucs_pa"]
     rows.append({"overrides": " ".join(overrides), "test": "ucs", "seed": seed,
                  "size_m": f"{w}x{h}", "n_cells": s["n_cells"], "ucs_pa": ucs, "young_pa": s["young_pa"],
@@ -106,6 +118,7 @@ def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, 
                  "crack_damage_pa": s["crack_damage_pa"],
                  "ci_over_ucs": s["crack_initiation_pa"] / ucs if s["crack_initiation_pa"] else None,
                  "cd_over_ucs": s["crack_damage_pa"] / ucs if s["crack_damage_pa"] else None,
+                 "crack_initiation_volumetric_pa": volumetric_crack_initiation(folder, s),
                  "cpu_s": time.process_time() - t0})
     p = load_parameters(extra_files=extra_files, overrides=[f"brazilian.diameter={disc_diameter}", *overrides])
     t0 = time.process_time()

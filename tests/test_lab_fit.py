@@ -83,7 +83,8 @@ def _synthetic_rows(points, law, seeds=(1, 2)):
         coords = {f"u_{v.name}": str(x) for v, x in zip(lab_fit.FIT_VARIABLES, u)}
         for seed in seeds:
             rows.append({"point": str(i), **coords, "test": "ucs", "seed": str(seed), "ucs_pa": str(ucs),
-                         "young_pa": str(young), "ci_over_ucs": str(ci), "cd_over_ucs": str(cd)})
+                         "young_pa": str(young), "ci_over_ucs": str(ci), "cd_over_ucs": str(cd),
+                         "crack_initiation_volumetric_pa": str(ci * ucs)})
             rows.append({"point": str(i), **coords, "test": "brazilian", "seed": str(seed), "broken_total": "100",
                          "tensile_strength_pa": str(sigma_t)})
     return rows
