@@ -18,6 +18,11 @@ CONFINEMENT = "confinement.stress"
 MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "dem_steps")
 
 
+def _mean_sd(mean, sd, unit) -> str:
+    """``mean +- sd`` in ``unit``, one decimal; the mean alone when there is no spread (one run: sd is nan)."""
+    return f"{mean / unit:.1f}" if sd != sd else f"{mean / unit:.1f} +- {sd / unit:.1f}"
+
+
 def register(sub, common):
     p = sub.add_parser("analyze-ucs", help="summarise UCS runs of a study folder (CSV, markdown, PNG)")
     p.add_argument("folder")
@@ -51,8 +56,8 @@ def cmd_analyze_ucs(args) -> int:
             f"| {cells_label(r['resolution.grain_model'], r['resolution.nodes_per_face'])} "
             f"| {r[VARIANT[0]]:.0f} | {r[VARIANT[1]] * 1e3:.2f} "
             f"| {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} | {r[CONFINEMENT] / 1e6:g} | {variant}"
-            f"{r['ucs_pa_count']:.0f} | {r['ucs_pa_mean'] / 1e6:.1f} +- {r['ucs_pa_std'] / 1e6:.1f} "
-            f"| {r['young_pa_mean'] / 1e9:.1f} +- {r['young_pa_std'] / 1e9:.1f} | {r['poisson_mean']:.3f} "
+            f"{r['ucs_pa_count']:.0f} | {_mean_sd(r['ucs_pa_mean'], r['ucs_pa_std'], 1e6)} "
+            f"| {_mean_sd(r['young_pa_mean'], r['young_pa_std'], 1e9)} | {r['poisson_mean']:.3f} "
             f"| {r['crack_initiation_pa_mean'] / r['ucs_pa_mean']:.2f} "
             f"| {r['crack_damage_pa_mean'] / r['ucs_pa_mean']:.2f} "
             f"| {r['dem_steps_mean']:.0f} | {r['wall_s_mean']:.1f} |")
