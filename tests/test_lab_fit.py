@@ -154,3 +154,13 @@ def test_crack_volumetric_strain_onset_of_a_known_history():
     # 2 % of the peak dilation is reached at ci + 110 MPa sqrt(0.02) = 105.6 MPa
     assert found == pytest.approx(ci + 110e6 * np.sqrt(0.02), abs=0.5e6)
     assert np.isnan(crack_initiation_volumetric_stress(stress, ea, -poisson * stress / young, young, poisson))
+
+
+def test_a_ucs_test_without_a_modulus_is_left_out():
+    """A UCS run that stopped in its seating has no fitted E: none of its measures enter the fit."""
+    from studies import lab_calibration as study
+    rows = _synthetic_rows([lab_fit.AS_PRINTED], lambda u: [200e6, 69e9, 9e6, 0.45, 0.75], seeds=(1, 2))
+    bad = next(r for r in rows if r["test"] == "ucs" and r["seed"] == "2")
+    bad["ucs_pa"], bad["young_pa"] = "11.5e6", ""
+    _, _, y = study.point_means(rows)
+    assert y[0, 0] == 200e6 and y[0, 1] == 69e9
