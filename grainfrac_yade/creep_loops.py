@@ -1,7 +1,8 @@
 """The two creep clocks' loops over a held specimen (pure numpy; no YADE).
 
 A *holder* is the creep run the loops drive (:class:`grainfrac_yade.yade_adapter.creep_protocol.CreepRun`
-in YADE): ``relax(creep_time) -> bool`` (DEM steps to equilibrium at the held load), ``record_now``,
+in YADE): ``relax(creep_time, safe_point=None, resume=None) -> bool`` (DEM steps to equilibrium at the
+held load; ``safe_point(counters)`` is called between its checks, ``resume`` goes on from such counters), ``record_now``,
 ``mark_breaks``, ``check_failure``, ``unbalanced(mean_bond_force) -> (largest, relative)``,
 ``progress``, ``safe_point(phase, counters)`` (a checkpoint if one is due), ``platens``, ``servo``
 (None without a stress servo), ``failed``, ``failure_reason`` and ``last_relaxation_steps``.  The
@@ -94,10 +95,14 @@ def event_clock_loop(holder, corr, clock, resume=None) -> int:
 
     ``holder`` (see module doc) relaxes the scene (``relax(creep_time) -> bool``), records rows
     (``record_now``) and reports progress. Returns the number of events (intervals that ended in a
-    failure).  Each pass starts at a safe point (``holder.safe_point("event", counters)``, a checkpoint if due);
-    ``resume``: the counters of such a point, to go on from it (scene and clock restored).
+    failure).  Each pass starts at a safe point (``holder.safe_point("event", counters)``, a checkpoint if due),
+    and the relaxation after each creep step has safe points between its checks (phase ``relaxation``: the
+    interval's counters with the relaxation's own under ``relaxation``), so that a long relaxation (a
+    collapse at paper size takes hours) can be resumed inside.  ``resume``: the counters of such a point, to
+    go on from it (scene and clock restored).
     """
     safe_point = holder.safe_point
+    pending = None
     if resume is None:
         n_events = stalled = 0
         ok = holder.relax(0.0)
@@ -106,30 +111,44 @@ def event_clock_loop(holder, corr, clock, resume=None) -> int:
             return n_events
     else:
         n_events, stalled = int(resume["n_events"]), int(resume["stalled"])
+        if "relaxation" in resume:   # inside the relaxation after a creep step: the step is done
+            pending = resume
     while True:
-        safe_point("event", {"n_events": n_events, "stalled": stalled})
-        broken_before = int(corr.scene.broken.sum())
-        idx = corr.intact()
-        stresses = corr.stresses(idx)
-        step = creep_step(corr.law, clock, corr.state, stresses)
-        if step.stalled:
-            break
-        corr.state = step.state
-        corr.write(idx)
-        if len(step.failing):
-            corr.hand_over_failures(step.failing, stresses.normal[step.positions], stresses.shear[step.positions],
-                                    step.modes)
-            n_events += 1
-        clock.advance(step.dt, step.failing)
-        corr.creep_time = clock.creep_time
-        ok = holder.relax(clock.creep_time)
+        if pending is None:
+            safe_point("event", {"n_events": n_events, "stalled": stalled})
+            broken_before = int(corr.scene.broken.sum())
+            idx = corr.intact()
+            stresses = corr.stresses(idx)
+            step = creep_step(corr.law, clock, corr.state, stresses)
+            if step.stalled:
+                break
+            corr.state = step.state
+            corr.write(idx)
+            if len(step.failing):
+                corr.hand_over_failures(step.failing, stresses.normal[step.positions], stresses.shear[step.positions],
+                                        step.modes)
+                n_events += 1
+            clock.advance(step.dt, step.failing)
+            corr.creep_time = clock.creep_time
+            interval = {"n_events": n_events, "stalled": stalled, "broken_before": broken_before,
+                        "broke": bool(len(step.failing)), "zero_step": bool(step.dt == 0)}
+            relaxation = None
+        else:
+            interval = {k: pending[k] for k in ("n_events", "stalled", "broken_before", "broke", "zero_step")}
+            relaxation, pending = pending["relaxation"], None
+
+        def relaxation_point(counters, interval=interval):
+            safe_point("relaxation", {**interval, "relaxation": counters})
+
+        ok = holder.relax(clock.creep_time, safe_point=relaxation_point, resume=relaxation)
         holder.record_now(clock.creep_time)
-        if n_events % PROGRESS_EVERY == 0 and len(step.failing):
+        if n_events % PROGRESS_EVERY == 0 and interval["broke"]:
             holder.progress(f"t {clock.creep_time:.4g} s  events {n_events}  broken "
                             f"{int(corr.scene.broken.sum())}  relaxation {holder.last_relaxation_steps} steps")
         if not ok or clock.finished:
             break
-        stalled = stalled + 1 if step.dt == 0 and int(corr.scene.broken.sum()) == broken_before else 0
+        stalled = (stalled + 1 if interval["zero_step"] and int(corr.scene.broken.sum()) == interval["broken_before"]
+                   else 0)
         if stalled >= MAX_STALLED_INTERVALS:
             raise NumericalFailure(f"{stalled} creep intervals of length 0 in a row broke no bond (creep time "
                                    f"{clock.creep_time:.6g} s): a bond at its failure point that the contact law "

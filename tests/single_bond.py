@@ -75,7 +75,7 @@ class BondUnderForce:
         res = self.scene.O.forces.f(self._body.id).norm()
         return res, res / max(np.hypot(*self.force[:2]), 1e-300)
 
-    def relax(self, creep_time):
+    def relax(self, creep_time, safe_point=None, resume=None):
         self.last_relaxation_steps = 0
         while self.last_relaxation_steps < MAX_RELAX_STEPS:
             self.scene.run(100)

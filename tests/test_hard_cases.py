@@ -444,9 +444,9 @@ class BreakRecorder(StandInHolder):
         self.bonds, self.clock = bonds, clock
         self.break_time, self.break_step = np.full(len(bonds.sigma), np.nan), np.full(len(bonds.sigma), np.nan)
 
-    def relax(self, creep_time):
+    def relax(self, creep_time, safe_point=None, resume=None):
         self.mark_breaks(creep_time)
-        return super().relax(creep_time)
+        return super().relax(creep_time, safe_point, resume)
 
     def mark_breaks(self, creep_time):
         new = self.bonds.scene.broken & np.isnan(self.break_time)

@@ -95,7 +95,7 @@ class StandInHolder:
         rel = next(self.forces)
         return rel * mean_bond_force, rel
 
-    def relax(self, creep_time):
+    def relax(self, creep_time, safe_point=None, resume=None):
         self.relaxations += 1
         self.last_relaxation_steps = 100
         return True
@@ -197,7 +197,7 @@ def test_a_run_failing_in_its_first_relaxation_records_that_state():
     0.85: a slow cascade that never settles) ends at creep time 0 with a history row of that state, so
     its cracks count; the row was missing and the summary counted only the ramp's cracks."""
     class FailingFirst(StandInHolder):
-        def relax(self, creep_time):
+        def relax(self, creep_time, safe_point=None, resume=None):
             super().relax(creep_time)
             self.failed, self.failure_reason = True, "no equilibrium at the held load (strain runs away)"
             return False

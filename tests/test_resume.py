@@ -393,6 +393,27 @@ def test_a_ucs_test_killed_mid_loading_resumes_to_the_uninterrupted_result(tmp_p
 
 @needs_yade
 @pytest.mark.yade
+def test_a_run_killed_inside_a_relaxation_resumes_to_the_uninterrupted_result(tmp_path):
+    """A relaxation after a creep step has safe points between its checks (a collapse at paper size
+    relaxes for hours): killed there, the run resumes inside it, with the servo's clip count and the
+    collapse watch as they were, to the uninterrupted run's results bit for bit."""
+    ref = tmp_path / "uninterrupted"
+    s = _reference(SMALL, ref)
+    killed = tmp_path / "killed"
+    state = _start_and_kill(SMALL, killed, lambda st: st["phase"] == "relaxation" and st["loop"]["n_events"] >= 8
+                            and st["loop"]["relaxation"]["done"] >= 500)
+    assert state["phase"] == "relaxation" and state["loop"]["relaxation"]["done"] >= 500
+    assert "closing_clipped_steps" in state["servo"]
+    res = _cli("--resume", killed)
+    assert res.returncode == 0, res.stderr
+    _assert_same_run(ref, killed)
+    resumed = json.loads((killed / "summary.json").read_text())
+    assert [(r["dem_steps"], r["phase"]) for r in resumed["resumed_from"]] == [(state["dem_steps"], "relaxation")]
+    assert resumed["n_events"] == s["n_events"]
+
+
+@needs_yade
+@pytest.mark.yade
 def test_a_creep_run_killed_in_its_ramp_resumes_to_the_uninterrupted_result(tmp_path):
     ref = tmp_path / "uninterrupted"
     s = _reference(TINY, ref)

@@ -45,9 +45,9 @@ class TimedCreepRun(CreepRun):
         if self.at_hold is not None:
             self.measured = self.at_hold(self)
 
-    def relax(self, creep_time):
+    def relax(self, creep_time, safe_point=None, resume=None):
         start = time.perf_counter()
-        ok = super().relax(creep_time)
+        ok = super().relax(creep_time, safe_point, resume)
         end = time.perf_counter()
         if self.hold_steps is None:
             self.hold_steps = self.last_relaxation_steps

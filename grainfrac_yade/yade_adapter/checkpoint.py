@@ -66,7 +66,7 @@ ARRAYS_FILE = "arrays.npz"
 FORMAT = 1
 #: Safe points of each test's driver at which a checkpoint can be taken (the phase it resumes in);
 #: a checkpoint without a ``test`` key is a creep run's (written before the other tests had any).
-PHASES = {"creep": ("loading", "ramp", "event", "paper"), "ucs": ("loading",), "brazilian": ("loading",)}
+PHASES = {"creep": ("loading", "ramp", "event", "relaxation", "paper"), "ucs": ("loading",), "brazilian": ("loading",)}
 #: Prefix of the initial bond-stress table's columns in arrays.npz.
 START_TABLE = "start_"
 
@@ -201,7 +201,8 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
     servo = run.servo
     if servo is not None:
         state["servo"] = {"target": servo.target, "gain": servo.gain, "max_speed": servo.max_speed,
-                          "stress": float(servo.stress), "hold_budget": run.hold_budget.as_dict()}
+                          "stress": float(servo.stress), "hold_budget": run.hold_budget.as_dict(),
+                          "clipped": int(servo.clipped), "closing_clipped_steps": int(servo.closing_clipped_steps)}
     if run.corr is not None:
         corr = run.corr.state_dict()
         state["corrosion"] = {"creep_time": corr["creep_time"], "law": corr["law"], "restored": corr["restored"]}
@@ -335,7 +336,9 @@ def restore(run, where, state: dict, arrays: dict):
     run.c0 = time.process_time() - state.get("cpu_s", 0.0)
     if state["servo"] is not None:
         s = state["servo"]
-        servo = StressServo.restored(pl, s["target"], s["gain"], s["max_speed"], s["stress"])
+        # checkpoints written before the clip count was kept: counted from 0 again
+        servo = StressServo.restored(pl, s["target"], s["gain"], s["max_speed"], s["stress"],
+                                     s.get("clipped", 0), s.get("closing_clipped_steps", 0))
         run.servo = servo
         # checkpoints written before the hold budget had wave crossings held the fixed step counts
         run.hold_budget = (HoldBudget.from_dict(s["hold_budget"]) if "hold_budget" in s

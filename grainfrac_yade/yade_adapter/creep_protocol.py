@@ -228,17 +228,26 @@ class CreepRun:
                                  cp.servo_max_strain_rate * self.platens.height)
         self.scene.drivers.append(self.servo)
 
-    def relax(self, creep_time):
+    def relax(self, creep_time, safe_point=None, resume=None):
         """Run DEM steps until equilibrium at the held load; False (and failed) at collapse
         (:class:`CollapseWatch`, checked every ``creep.check_period`` steps) or if equilibrium does not
         come within the hold's budget (``creep.max_relaxation_steps``, or ``creep.max_relaxation_crossings``
-        wave crossings where longer: :attr:`hold_budget`)."""
+        wave crossings where longer: :attr:`hold_budget`).
+
+        ``safe_point(counters)``: called before each check's DEM steps but the first (the state is
+        complete there; the caller checkpoints if one is due); ``resume``: such counters, to go on
+        from them (the scene and the servo came back with the checkpoint)."""
         cp = self.params.creep
-        done = 0
-        self.last_relaxation_steps = 0
-        watch = (CollapseWatch(cp.collapse_strain_increment, self.platens.axial_strain())
-                 if cp.collapse_strain_increment > 0 else None)
+        done = 0 if resume is None else int(resume["done"])
+        self.last_relaxation_steps = done
+        watch = None
+        if cp.collapse_strain_increment > 0:
+            saved = (resume or {}).get("collapse")
+            watch = (CollapseWatch.from_state(cp.collapse_strain_increment, saved) if saved
+                     else CollapseWatch(cp.collapse_strain_increment, self.platens.axial_strain()))
         while done < self.hold_budget.max_relaxation_steps:
+            if safe_point is not None and done > 0:
+                safe_point({"done": done, "collapse": None if watch is None else watch.state_dict()})
             self.scene.run(cp.check_period)
             done += cp.check_period
             self.last_relaxation_steps = done
@@ -284,7 +293,8 @@ class CreepRun:
 
     def safe_point(self, phase, loop):
         """A point between DEM steps where the driver's state is complete (``phase``: "loading" (in the
-        ramp), "ramp" (its end), "event", "paper"; ``loop``: the ramp's or the clock loop's counters):
+        ramp), "ramp" (its end), "event", "relaxation" (inside the relaxation after an event-clock creep step),
+        "paper"; ``loop``: the ramp's or the clock loop's counters):
         write a checkpoint if one is due, always at the end of the ramp, else every
         ``numerics.checkpoint_interval`` s of wall time."""
         ck = self.checkpointer

@@ -172,11 +172,13 @@ class StressServo:
         self.closing_clipped_steps = 0
 
     @classmethod
-    def restored(cls, platens: Platens, target: float, gain: float, max_speed: float, stress: float) -> "StressServo":
-        """A servo as a checkpoint saved it: its own ``gain`` [m/Pa] and last measured ``stress`` [Pa]."""
+    def restored(cls, platens: Platens, target: float, gain: float, max_speed: float, stress: float,
+                 clipped: int = 0, closing_clipped_steps: int = 0) -> "StressServo":
+        """A servo as a checkpoint saved it: its own ``gain`` [m/Pa], last measured ``stress`` [Pa] and
+        clip state (``clipped``, ``closing_clipped_steps``)."""
         servo = cls.__new__(cls)
         servo.platens, servo.target, servo.gain, servo.max_speed = platens, target, gain, max_speed
-        servo.stress, servo.clipped, servo.closing_clipped_steps = stress, 0, 0
+        servo.stress, servo.clipped, servo.closing_clipped_steps = stress, int(clipped), int(closing_clipped_steps)
         return servo
 
     def before_step(self, scene):
