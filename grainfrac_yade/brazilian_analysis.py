@@ -94,28 +94,34 @@ def crack_location(bond_points, broken, break_step, centre, diameter: float) -> 
     return out
 
 
-def split_peak_index(load, broken) -> tuple:
+def split_peak_index(load, broken, strain=None, min_strain: float = 0.0) -> tuple:
     """(index of the failure load, index of the split or None): the split is the first row whose load is
     below :data:`SPLIT_DROP_RATIO` x the peak of the rows before it with more broken bonds than at that
-    peak; the failure load is that peak.  No split: the largest load (a lower bound)."""
+    peak; the failure load is that peak.  No split: the largest load (a lower bound).
+
+    ``strain``, ``min_strain``: only rows at a diametral strain of ``min_strain`` or more count as the
+    drop (``brazilian.stop_min_strain``: a drop in the start transient is not the split); a transient
+    peak before them is then overtaken by the real one."""
     load, broken = np.asarray(load, float), np.asarray(broken)
+    late = (np.ones(len(load), bool) if strain is None or min_strain <= 0
+            else np.asarray(strain, float) >= min_strain)
     ip = 0
     for i in range(1, len(load)):
-        if load[i] < SPLIT_DROP_RATIO * load[ip] and broken[i] > broken[ip]:
+        if late[i] and load[i] < SPLIT_DROP_RATIO * load[ip] and broken[i] > broken[ip]:
             return ip, i
         if load[i] > load[ip]:
             ip = i
     return (int(np.argmax(load)) if len(load) else 0), None
 
 
-def brazilian_summary(history: dict, diameter: float, thickness: float) -> dict:
+def brazilian_summary(history: dict, diameter: float, thickness: float, min_strain: float = 0.0) -> dict:
     """Failure load (at the split), tensile strength, the diametral strain there, and the largest load
-    of the whole test, from history columns."""
+    of the whole test, from history columns; ``min_strain``: as :func:`split_peak_index`."""
     load = np.asarray(history["load_n"], float)
     if not len(load):
         return dict.fromkeys(("peak_load_n", "peak_load_per_thickness_n_per_m", "tensile_strength_pa",
                               "peak_diametral_strain", "split_found", "max_tensile_stress_pa"))
-    ip, split = split_peak_index(load, history["broken_total"])
+    ip, split = split_peak_index(load, history["broken_total"], history["diametral_strain"], min_strain)
     return {"peak_load_n": float(load[ip]),
             "peak_load_per_thickness_n_per_m": float(load[ip] / thickness),
             "tensile_strength_pa": float(tensile_stress(load[ip], diameter, thickness)),

@@ -148,6 +148,46 @@ def test_failure_load_is_the_peak_before_the_split():
     assert s["max_tensile_stress_pa"] == pytest.approx(tensile_stress(17, 0.01, 0.001))
 
 
+def test_a_drop_before_the_minimum_strain_is_not_the_split():
+    """The start transient: the jaws start at full speed, a weak contact breaks and the load rings down
+    (6 of 30 lab-design discs: 2e-6 strain). With ``min_strain`` the drop is skipped and the real peak
+    overtakes the transient one; without it (0, the default) the transient is taken as the split."""
+    from grainfrac_yade.brazilian_analysis import brazilian_summary, split_peak_index
+    load = [20, 5, 8, 30, 60, 90, 40]
+    broken = [0, 1, 1, 2, 3, 10, 80]
+    strain = [2e-6, 4e-6, 6e-6, 3e-4, 6e-4, 9e-4, 1e-3]
+    assert split_peak_index(load, broken, strain) == (0, 1)
+    assert split_peak_index(load, broken, strain, 2e-4) == (5, 6)
+    assert split_peak_index(load, broken) == split_peak_index(load, broken, strain, 0.0)
+    s = brazilian_summary({"load_n": load, "broken_total": broken, "diametral_strain": strain}, 0.01, 0.001, 2e-4)
+    assert s["peak_load_n"] == 90 and s["split_found"] and s["peak_diametral_strain"] == 9e-4
+
+
+#: A lab-design point with weak contact tails (Weibull modulus 2.2, strengths x 0.52; docs/studies/lab_calibration.md)
+WEAK_TAILS = ["calibration.strength_scale=0.523261", "calibration.shear_stiffness_ratio_scale=3.6752",
+              "calibration.tensile_cohesion_ratio_scale=0.360578", "calibration.inter_mineral_strength_ratio=0.785496",
+              "calibration.strength_weibull_modulus=2.21629", "brazilian.diameter=6e-3"]
+
+
+@needs_yade
+@pytest.mark.yade
+@pytest.mark.slow   # the split of a 6 mm fem disc: about 25 s
+def test_a_disc_with_weak_contacts_is_split_past_the_start_transient(tmp_path):
+    """Fem disc of 6 mm, seed 1, weak contact tails: by default it stops in the start transient (a bond
+    broke, the load rang down below half its first peak, 1.6 MPa); with ``brazilian.stop_min_strain`` 2e-4
+    it goes on to its split, past that strain and several times stronger."""
+    from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
+    fem = [str(ROOT / "params" / "presets" / "fem.toml")]
+    out = {}
+    for name, extra in (("default", []), ("waits", ["brazilian.stop_min_strain=2e-4"])):
+        p = load_parameters(overrides=WEAK_TAILS + extra, extra_files=fem)
+        out[name] = run_brazilian_to_folder(p, 1, tmp_path / name)
+    early, split = out["default"], out["waits"]
+    assert early["peak_diametral_strain"] < 1e-4 and early["dem_steps"] < 1000
+    assert split["split_found"] and split["peak_diametral_strain"] >= 2e-4
+    assert split["tensile_strength_pa"] > 5 * early["tensile_strength_pa"]
+
+
 def test_crack_location_counts():
     pts = np.array([[0.0, 0.0], [0.1, 0.5], [0.9, 0.0], [-0.5, 0.1]])   # disc of radius 1 at the origin
     broken = np.array([True, True, True, False])

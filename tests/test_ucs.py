@@ -39,6 +39,23 @@ def test_ucs_scene_has_no_stress_corrosion_engine():
     assert summary["ucs_pa"] > 0 and result["broken_total"] > 0
 
 
+def test_the_post_peak_stop_waits_for_the_minimum_strain():
+    """``ucs.stop_min_strain`` past the default run's end: the same history up to that end, bit for bit
+    (the key only moves the stop), then the test goes on to the minimum strain before it may stop."""
+    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    tiny = ["specimen.width=3e-3", "specimen.height=6e-3"]
+    p = load_parameters(overrides=tiny)
+    h0, r0, _, _ = run_ucs(build_specimen(p, 1), p)
+    end = h0["axial_strain"][-1]
+    assert r0["peak_reached"]
+    p1 = load_parameters(overrides=tiny + [("ucs.stop_min_strain", 1.5 * end)])
+    h1, r1, _, _ = run_ucs(build_specimen(p1, 1), p1)
+    n = len(h0["axial_strain"])
+    for k in ("axial_strain", "axial_stress_pa", "broken_total"):
+        assert list(h1[k][:n]) == list(h0[k]), k
+    assert h1["axial_strain"][-1] >= 1.5 * end and len(h1["axial_strain"]) > n
+
+
 def test_doubled_strengths_give_a_higher_ucs():
     base, _, _ = _ucs([])
     p = load_parameters()

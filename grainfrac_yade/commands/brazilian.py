@@ -169,7 +169,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     t = specimen.tessellation
     diameter = t.diameter
     summary = dict.fromkeys(MEASURES) if result["numerical_failure"] else \
-        brazilian_summary(history, diameter, specimen.thickness)
+        brazilian_summary(history, diameter, specimen.thickness, params.brazilian.stop_min_strain)
     ucs = params.calibration.reference_ucs
     sigma = summary["tensile_strength_pa"]
     summary["reference_ucs_pa"] = ucs

@@ -187,6 +187,8 @@ class UcsParams:
     """Strain-controlled uniaxial compression with rigid platens."""
     strain_rate: float = _spec("1/s", "positive", "axial strain rate of the platens (DEM time)")
     stop_stress_ratio: float = _spec("1", "unit_interval_open", "stop when stress falls below this x peak")
+    stop_min_strain: float = _spec("1", "nonnegative", "the post-peak stop applies only once the axial strain "
+                                   "has passed this (a drop in the start transient is not the peak)")
     max_strain: float = _spec("1", "positive", "stop at this axial strain")
     record_strain_increment: float = _spec("1", "positive", "axial strain between history rows")
     platen_lateral: str = _spec("", "choice", "platen-end cells free (smooth) or fixed (rough) laterally",
@@ -234,6 +236,8 @@ class BrazilianParams:
     strain_rate: float = _spec("1/s", "positive", "jaw closing speed / D (DEM time)")
     stop_load_ratio: float = _spec("1", "unit_interval_open", "stop when the load falls below this x peak "
                                    "(with bonds broken since the peak)")
+    stop_min_strain: float = _spec("1", "nonnegative", "the post-peak stop applies only once the diametral strain "
+                                   "has passed this (a drop in the start transient is not the split)")
     max_strain: float = _spec("1", "positive", "stop at this diametral strain (jaw closure / D)")
     record_strain_increment: float = _spec("1", "positive", "diametral strain between history rows")
     platen_lateral: str = _spec("", "choice", "jaw cells fixed (rough, hold the disc) or free (smooth) "

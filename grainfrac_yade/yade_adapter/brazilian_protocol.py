@@ -21,7 +21,8 @@ thickness t); diametral strain = jaw closure / D; horizontal strain = change of 
 between the rim cells at the two ends of the horizontal diameter / D (compression positive, so
 the disc's widening is negative, as the UCS test's lateral strain).
 
-The test ends once the load falls below ``brazilian.stop_load_ratio`` of its peak with bonds
+The test ends once the load falls below ``brazilian.stop_load_ratio`` of its peak (past
+``brazilian.stop_min_strain`` of diametral strain) with bonds
 broken since the peak (the split), or at ``brazilian.max_strain`` (the peak is then a lower
 bound), or on a numerical failure (no result); ``end_reason`` says which.
 
@@ -187,7 +188,7 @@ class BrazilianRun(LoadingCheckpoints):
                     cols[k].append(v)
                 if self.snapshot is not None:
                     self.snapshot.row(scene, len(cols["dem_step"]), strain)
-                if (self.split_snapshot is None and load < SPLIT_DROP_RATIO * self.peak
+                if (self.split_snapshot is None and strain >= bz.stop_min_strain and load < SPLIT_DROP_RATIO * self.peak
                         and row["broken_total"] > self.broken_at_peak):   # the split: the failure load is behind us
                     self.split_snapshot = self.peak_snapshot
                 if load > self.peak:
@@ -197,7 +198,8 @@ class BrazilianRun(LoadingCheckpoints):
                 if self.progress and len(cols["dem_step"]) % 50 == 0:
                     self.progress(f"strain {strain:.6f}  sigma {row['tensile_stress_pa'] / 1e6:6.2f} MPa  "
                                   f"broken {row['broken_total']}")
-                if softened_past_peak(load, self.peak, row["broken_total"], self.broken_at_peak, bz.stop_load_ratio):
+                if strain >= bz.stop_min_strain and softened_past_peak(load, self.peak, row["broken_total"],
+                                                                       self.broken_at_peak, bz.stop_load_ratio):
                     peak_reached = True
                     end = f"post-peak: the load fell below {bz.stop_load_ratio:g} x its peak"
                     break

@@ -3,7 +3,8 @@ confined (biaxial) compression with ``confinement.stress`` sigma_3 > 0 on the si
 (:mod:`.confinement`: isotropic stage to sigma_1 = sigma_3 first, then the same axial loading; the
 post-peak stop rule then applies to the deviator sigma_1 - sigma_3).
 
-The test ends once the axial stress falls below ``ucs.stop_stress_ratio`` of its peak with bonds
+The test ends once the axial stress falls below ``ucs.stop_stress_ratio`` of its peak (past
+``ucs.stop_min_strain`` of axial strain) with bonds
 broken since the peak (post-peak; a drop without a break is elastic ringing, e.g. of a one-cell-wide
 column set in motion from rest: measured 3.4 MPa then below 2.4 MPa, no bond broken), or at ``ucs.max_strain`` (then the largest stress so far is only a lower bound of the strength), or
 on a numerical failure (NaN or infinite measures, a DEM step above the critical one): no result.
@@ -91,8 +92,9 @@ class UcsRun(LoadingCheckpoints):
                     self.peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
                 if self.progress and len(cols["dem_step"]) % 50 == 0:
                     self.progress(f"strain {strain:.5f}  stress {stress / 1e6:7.1f} MPa  broken {row['broken_total']}")
-                if softened_past_peak(stress - confining, self.peak - confining, row["broken_total"],
-                                      self.broken_at_peak, ucs.stop_stress_ratio):
+                if strain >= ucs.stop_min_strain and softened_past_peak(
+                        stress - confining, self.peak - confining, row["broken_total"], self.broken_at_peak,
+                        ucs.stop_stress_ratio):
                     peak_reached = True
                     end = (f"post-peak: the axial stress fell below {ucs.stop_stress_ratio:g} x its peak"
                            if confining == 0 else
