@@ -5,6 +5,9 @@ Four parts, run in this order; each reads what the one before wrote and writes p
 * ``design``: the design points (``lab_fit.design``), each a 10 x 20 mm UCS test and a 10 mm Brazilian
   test per seed, one row per test into CSV (units in the column names).  Rows already in the CSV are
   skipped, so a stopped run goes on where it was (``--n`` and ``--design-seed`` must stay the same).
+* ``backfill``: columns rows of older code lack, read from their run folders.
+* ``reseat``: the (point, seed) pairs whose UCS test or disc stopped in its seating, run again with the end
+  criteria's minimum strain (:data:`STOP_KEYS`); their old rows are kept in ``<csv>.seating.csv``.
 * ``fit``: the linear response surface and its least-squares optimum: JSON with the candidate's keys.
 * ``verify``: the candidate on more seeds (same specimens): rows into a CSV of their own.
 * ``preset``: ``params/presets/ldb_lab.toml``, the fem preset with the candidate's keys and the verified
@@ -49,6 +52,11 @@ GRAIN_SIZE = 1e-3
 #: 1.7: measured 1 bond broken, 1.3 MPa, 108 DEM steps) and the end criterion took the ringing for the
 #: post-peak branch; such a sigma_t is left out of the fit.
 MIN_SPLIT_BREAKS = round(DISC_DIAMETER / GRAIN_SIZE)
+#: The end criteria's minimum strain (``ucs.stop_min_strain``, ``brazilian.stop_min_strain``) [1]: past the start
+#: transient (the seating stops ended at 2e-6 to 4e-5 of strain) and well before any real peak of the design
+#: (UCS at 3.3e-3 of axial strain or more, splits at 7.9e-4 of diametral strain or more), so that it moves
+#: only the seating stops.
+STOP_KEYS = ("ucs.stop_min_strain=2e-4", "brazilian.stop_min_strain=2e-4")
 
 
 def _rows(path: Path) -> list:
@@ -71,13 +79,80 @@ def run_point(point: int, u, seeds, csv_path: Path, out: Path, extra=()):
     for seed in seeds:
         if (point, seed) in done:
             continue
-        rows = measure([*BASE_PARAMS, *extra], lab_fit.overrides(u), seed, Path(out) / f"point{point}_seed{seed}",
+        rows = measure([*BASE_PARAMS, *extra], [*lab_fit.overrides(u), *STOP_KEYS], seed,
+                       Path(out) / f"point{point}_seed{seed}",
                        ucs_size=UCS_SIZE, disc_diameter=DISC_DIAMETER)
         coords = {f"u_{v.name}": float(x) for v, x in zip(lab_fit.FIT_VARIABLES, u)}
         _append(csv_path, [{"point": point, **coords, **r} for r in rows])
         print(f"point {point} seed {seed}: " + ", ".join(
             f"{r['test']} {(r.get('ucs_pa') or r.get('tensile_strength_pa') or float('nan')) / 1e6:.1f} MPa "
             f"({r['cpu_s']:.0f} s)" for r in rows), flush=True)
+
+
+def _write(path: Path, rows):
+    """Rewrite ``path`` with ``rows`` (written beside it, then renamed: a stop never leaves half a file)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    with tmp.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=POINT_FIELDS)
+        w.writeheader()
+        w.writerows({k: r.get(k, "") for k in POINT_FIELDS} for r in rows)
+    tmp.replace(path)
+
+
+def _missing(r, key) -> bool:
+    return r.get(key) in (None, "", "None", "nan")
+
+
+def backfill(csv_path: Path, out: Path) -> int:
+    """Fill the columns rows written by older code lack (``broken_total`` of a disc, the volumetric CI of a
+    UCS test) from their run folders ``out``/point{P}_seed{S}_{test}/; returns the number filled."""
+    from studies.lab_bands import volumetric_crack_initiation
+    rows, filled = _rows(csv_path), 0
+    for r in rows:
+        folder = Path(out) / f"point{r['point']}_seed{r['seed']}_{r['test']}"
+        if not (folder / "summary.json").exists():
+            continue
+        s = json.loads((folder / "summary.json").read_text())
+        if r["test"] == "brazilian" and _missing(r, "broken_total"):
+            r["broken_total"], filled = s["broken_total"], filled + 1
+        if r["test"] == "ucs" and _missing(r, "crack_initiation_volumetric_pa") and s.get("young_pa"):
+            r["crack_initiation_volumetric_pa"], filled = volumetric_crack_initiation(folder, s), filled + 1
+    if filled:
+        _write(csv_path, rows)
+    return filled
+
+
+def seating_stops(rows) -> set:
+    """(point, seed) pairs with a test that stopped in its seating: a UCS test without a fitted modulus, or a
+    disc with fewer than :data:`MIN_SPLIT_BREAKS` bonds broken."""
+    out = set()
+    for r in rows:
+        if ((r["test"] == "ucs" and _missing(r, "young_pa"))
+                or (r["test"] == "brazilian" and not _missing(r, "broken_total")
+                    and float(r["broken_total"]) < MIN_SPLIT_BREAKS)):
+            out.add((int(r["point"]), int(r["seed"])))
+    return out
+
+
+def reseat(csv_path: Path, out: Path, n: int, design_seed: int) -> list:
+    """Run the design's (point, seed) pairs that stopped in their seating again with :data:`STOP_KEYS`.
+    Their old rows move to ``<csv>.seating.csv`` (kept, not lost) before the new ones are appended."""
+    csv_path = Path(csv_path)
+    rows = _rows(csv_path)
+    pairs = sorted(seating_stops(rows))
+    if not pairs:
+        return []
+    keep = [r for r in rows if (int(r["point"]), int(r["seed"])) not in pairs]
+    moved = [r for r in rows if (int(r["point"]), int(r["seed"])) in pairs]
+    side = csv_path.with_name(csv_path.name + ".seating.csv")
+    old = _rows(side)
+    _write(side, old + moved)
+    _write(csv_path, keep)
+    pts = lab_fit.design(n, design_seed)
+    for point, seed in pairs:
+        run_point(point, pts[point], [seed], csv_path, out)
+    return pairs
 
 
 def _mean(values) -> float:
@@ -183,7 +258,7 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("part", choices=("design", "fit", "verify", "preset"))
+    ap.add_argument("part", choices=("design", "backfill", "reseat", "fit", "verify", "preset"))
     ap.add_argument("--csv", required=True, help="rows of the design (design, fit) or of the verification (verify)")
     ap.add_argument("--json", help="the fit's result (written by fit, read by verify)")
     ap.add_argument("--out", default=str(ROOT / "results" / "lab_calibration"), help="run folders")
@@ -198,6 +273,13 @@ def main(argv=None) -> int:
         for i, u in enumerate(pts):
             if args.only is None or i in args.only:
                 run_point(i, u, args.seeds, Path(args.csv), Path(args.out))
+        return 0
+    if args.part == "backfill":
+        print(f"{backfill(Path(args.csv), Path(args.out))} values filled in {args.csv}")
+        return 0
+    if args.part == "reseat":
+        pairs = reseat(Path(args.csv), Path(args.out), args.n, args.design_seed)
+        print(f"run again with {' '.join(STOP_KEYS)}: {pairs or 'no seating stop'}")
         return 0
     if args.part == "fit":
         result = fit(Path(args.csv))
