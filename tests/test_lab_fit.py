@@ -164,3 +164,32 @@ def test_a_ucs_test_without_a_modulus_is_left_out():
     bad["ucs_pa"], bad["young_pa"] = "11.5e6", ""
     _, _, y = study.point_means(rows)
     assert y[0, 0] == 200e6 and y[0, 1] == 69e9
+
+
+def test_reseat_runs_the_seating_stops_again_and_keeps_their_old_rows(tmp_path, monkeypatch):
+    """A UCS test without a modulus or a disc with fewer than MIN_SPLIT_BREAKS breaks is a seating stop:
+    its (point, seed) runs again with the end criteria's minimum strain; the old rows move to the side
+    file, every other row stays as it was."""
+    from studies import lab_calibration as study
+    csv_path = tmp_path / "design.csv"
+    u = lab_fit.design(6, 1)
+    good = [{"point": p, "test": t, "seed": 1, "young_pa": 7e10 if t == "ucs" else "", "ucs_pa": 2e8,
+             "broken_total": "" if t == "ucs" else 300, "tensile_strength_pa": 2e7} for p in (0, 1) for t in ("ucs", "brazilian")]
+    stopped = [{"point": 2, "test": "ucs", "seed": 1, "young_pa": "", "ucs_pa": 1.1e7, "broken_total": ""},
+               {"point": 2, "test": "brazilian", "seed": 1, "broken_total": 1, "tensile_strength_pa": 1.3e6}]
+    study._write(csv_path, good + stopped)
+    assert study.seating_stops(study._rows(csv_path)) == {(2, 1)}
+    calls = []
+
+    def fake_measure(files, overrides, seed, prefix, **kw):
+        calls.append((list(overrides), seed, prefix.name))
+        return [{"test": "ucs", "seed": seed, "young_pa": 7.1e10, "ucs_pa": 2.1e8, "cpu_s": 1.0},
+                {"test": "brazilian", "seed": seed, "broken_total": 250, "tensile_strength_pa": 1.8e7, "cpu_s": 1.0}]
+    monkeypatch.setattr(study, "measure", fake_measure)
+    assert study.reseat(csv_path, tmp_path, 6, 1) == [(2, 1)]
+    assert [c[1:] for c in calls] == [(1, "point2_seed1")]
+    assert set(study.STOP_KEYS) <= set(calls[0][0]) and set(lab_fit.overrides(u[2])) <= set(calls[0][0])
+    rows = study._rows(csv_path)
+    assert len(rows) == 6 and not study.seating_stops(rows)
+    assert [r["broken_total"] for r in study._rows(csv_path.with_name("design.csv.seating.csv"))] == ["", "1"]
+    assert study.reseat(csv_path, tmp_path, 6, 1) == []   # nothing left to run
