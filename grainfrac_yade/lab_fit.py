@@ -171,40 +171,53 @@ def unscaled(y) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Surrogate:
-    """Linear response surface y = intercept + slope u of each observable (OLS on the points where it
-    was measured), with its coefficient of determination r2 and residual sd (fit scale)."""
+    """Response surface y = intercept + slope u + curvature u_q^2 of each observable (OLS on the points
+    where it was measured; ``squared``: the indices q of the variables with a square term, none for a
+    linear surface), with its coefficient of determination r2 and residual sd (fit scale)."""
     intercept: np.ndarray   # (5,)
-    slope: np.ndarray       # (5, 5): slope[k, j] = d y_k / d u_j
+    slope: np.ndarray       # (5, 5): slope[k, j] = d y_k / d u_j at u_j = 0
     r2: np.ndarray          # (5,)
     residual_sd: np.ndarray  # (5,)
     n_points: np.ndarray    # (5,)
+    squared: tuple = ()     # indices of the variables with a square term
+    curvature: np.ndarray = None   # (5, len(squared)): coefficient of u_q^2
 
     def predict(self, u) -> np.ndarray:
-        return self.intercept + self.slope @ np.asarray(u, dtype=float)
+        u = np.asarray(u, dtype=float)
+        y = self.intercept + self.slope @ u
+        if self.squared:
+            y = y + self.curvature @ (u[list(self.squared)] ** 2)
+        return y
 
 
-def fit_surrogate(points, y) -> Surrogate:
+def fit_surrogate(points, y, squared=()) -> Surrogate:
     """OLS fit of :class:`Surrogate` to (m, 5) points and (m, 5) observables in the fit's scale; a NaN
-    observable (not measured at that point) drops that point for that observable only."""
+    observable (not measured at that point) drops that point for that observable only.  ``squared``:
+    indices of the variables that get a square term too (the Weibull axis: sigma_t falls steeply with
+    1/m); () is the linear surface."""
     points, y = np.asarray(points, dtype=float), np.asarray(y, dtype=float)
+    squared = tuple(int(q) for q in squared)
     n_var = points.shape[1]
+    n_terms = n_var + len(squared)
+    features = np.column_stack([points, points[:, list(squared)] ** 2]) if squared else points
     intercept, slope = np.zeros(y.shape[1]), np.zeros((y.shape[1], n_var))
+    curvature = np.zeros((y.shape[1], len(squared)))
     r2, sd, count = np.zeros(y.shape[1]), np.zeros(y.shape[1]), np.zeros(y.shape[1], dtype=int)
     for k in range(y.shape[1]):
         ok = np.isfinite(y[:, k])
-        if ok.sum() < n_var + 2:
-            raise ValueError(f"observable {OBSERVABLES[k][0]}: {ok.sum()} measured points, the linear surface "
-                             f"needs at least {n_var + 2}")
-        a = np.column_stack([np.ones(ok.sum()), points[ok]])
+        if ok.sum() < n_terms + 2:
+            raise ValueError(f"observable {OBSERVABLES[k][0]}: {ok.sum()} measured points, the surface "
+                             f"needs at least {n_terms + 2}")
+        a = np.column_stack([np.ones(ok.sum()), features[ok]])
         coef, *_ = np.linalg.lstsq(a, y[ok, k], rcond=None)
         fitted = a @ coef
         ss_res = float(((y[ok, k] - fitted) ** 2).sum())
         ss_tot = float(((y[ok, k] - y[ok, k].mean()) ** 2).sum())
-        intercept[k], slope[k] = coef[0], coef[1:]
+        intercept[k], slope[k], curvature[k] = coef[0], coef[1:n_var + 1], coef[n_var + 1:]
         r2[k] = 1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0
-        sd[k] = math.sqrt(ss_res / (ok.sum() - n_var - 1)) if ok.sum() > n_var + 1 else 0.0
+        sd[k] = math.sqrt(ss_res / (ok.sum() - n_terms - 1)) if ok.sum() > n_terms + 1 else 0.0
         count[k] = ok.sum()
-    return Surrogate(intercept, slope, r2, sd, count)
+    return Surrogate(intercept, slope, r2, sd, count, squared, curvature)
 
 
 def weighted_residuals(y, targets: LabTargets) -> np.ndarray:

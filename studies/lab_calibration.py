@@ -190,12 +190,14 @@ def point_means(rows) -> tuple:
     return points, np.array(us), np.array(ys)
 
 
-def fit(csv_path: Path, ucs_target=None) -> dict:
+def fit(csv_path: Path, ucs_target=None, squared=()) -> dict:
+    """The surface over the design's seed means and its optimum; ``squared``: names of the variables with a
+    square term (() : linear)."""
     points, u, y = point_means(_rows(csv_path))
     targets = lab_fit.lab_targets(ucs_value=ucs_target)
-    surface = lab_fit.fit_surrogate(u, lab_fit.scaled(y))
-    best, predicted = lab_fit.solve(surface, targets)
     names = [v.name for v in lab_fit.FIT_VARIABLES]
+    surface = lab_fit.fit_surrogate(u, lab_fit.scaled(y), [names.index(n) for n in squared])
+    best, predicted = lab_fit.solve(surface, targets)
     return {
         "design_csv": str(csv_path), "n_points": len(points),
         "targets": dict(zip(targets.names, targets.value.tolist())),
@@ -204,6 +206,7 @@ def fit(csv_path: Path, ucs_target=None) -> dict:
         "surface_r2": dict(zip(targets.names, surface.r2.tolist())),
         "surface_residual_sd": dict(zip(targets.names, surface.residual_sd.tolist())),
         "surface_slope_per_unit": {o: dict(zip(names, row)) for o, row in zip(targets.names, surface.slope.tolist())},
+        "surface_square_terms": {o: dict(zip(squared, row)) for o, row in zip(targets.names, surface.curvature.tolist())},
         "candidate_u": dict(zip(names, best.tolist())),
         "candidate_overrides": lab_fit.overrides(best),
         "predicted": dict(zip(targets.names, lab_fit.unscaled(surface.predict(best)).tolist())),
@@ -267,6 +270,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2], help="specimen seeds per point")
     ap.add_argument("--only", type=int, nargs="+", help="design points to run (default all)")
     ap.add_argument("--write", default=str(PRESET), help="the preset file (preset)")
+    ap.add_argument("--square", nargs="*", default=[], choices=[v.name for v in lab_fit.FIT_VARIABLES],
+                    help="variables with a square term in the surface (fit; default none: linear)")
     args = ap.parse_args(argv)
     if args.part == "design":
         pts = lab_fit.design(args.n, args.design_seed)
@@ -282,7 +287,7 @@ def main(argv=None) -> int:
         print(f"run again with {' '.join(STOP_KEYS)}: {pairs or 'no seating stop'}")
         return 0
     if args.part == "fit":
-        result = fit(Path(args.csv))
+        result = fit(Path(args.csv), squared=tuple(args.square))
         Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
         print(json.dumps({k: result[k] for k in ("surface_r2", "candidate_overrides", "predicted",
                                                   "predicted_weighted_residuals")}, indent=1))
