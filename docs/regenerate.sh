@@ -94,9 +94,9 @@ run_target() {
                cp results/paper_fem_creep/report/runs.csv docs/studies/paper_fem/runs.csv ;;
     lab_calibration) $PY -m studies.lab_calibration design --n 14 --seeds 1 2 --csv docs/studies/lab_calibration_design.csv
                      $PY -m studies.lab_calibration fit --csv docs/studies/lab_calibration_design.csv \
-                         --json docs/studies/lab_calibration_fit.json
-                     $PY -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit.json --seeds 1 2 3 \
-                         --csv docs/studies/lab_calibration_verify.csv ;;
+                         --json docs/studies/lab_calibration_fit_square.json --square inverse_weibull_modulus
+                     $PY -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit_square.json \
+                         --seeds 1 2 3 --csv docs/studies/lab_calibration_verify_square.csv ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
                               $PY -m grainfrac_yade analyze results/accuracy_cost_paper_size ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
