@@ -198,8 +198,8 @@ class BrazilianRun(LoadingCheckpoints):
                 if self.progress and len(cols["dem_step"]) % 50 == 0:
                     self.progress(f"strain {strain:.6f}  sigma {row['tensile_stress_pa'] / 1e6:6.2f} MPa  "
                                   f"broken {row['broken_total']}")
-                if strain >= bz.stop_min_strain and softened_past_peak(load, self.peak, row["broken_total"],
-                                                                       self.broken_at_peak, bz.stop_load_ratio):
+                if softened_past_peak(load, self.peak, row["broken_total"], self.broken_at_peak, bz.stop_load_ratio,
+                                      strain, bz.stop_min_strain):
                     peak_reached = True
                     end = f"post-peak: the load fell below {bz.stop_load_ratio:g} x its peak"
                     break

@@ -92,9 +92,8 @@ class UcsRun(LoadingCheckpoints):
                     self.peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
                 if self.progress and len(cols["dem_step"]) % 50 == 0:
                     self.progress(f"strain {strain:.5f}  stress {stress / 1e6:7.1f} MPa  broken {row['broken_total']}")
-                if strain >= ucs.stop_min_strain and softened_past_peak(
-                        stress - confining, self.peak - confining, row["broken_total"], self.broken_at_peak,
-                        ucs.stop_stress_ratio):
+                if softened_past_peak(stress - confining, self.peak - confining, row["broken_total"],
+                                      self.broken_at_peak, ucs.stop_stress_ratio, strain, ucs.stop_min_strain):
                     peak_reached = True
                     end = (f"post-peak: the axial stress fell below {ucs.stop_stress_ratio:g} x its peak"
                            if confining == 0 else
