@@ -94,20 +94,25 @@ def crack_location(bond_points, broken, break_step, centre, diameter: float) -> 
     return out
 
 
-def split_peak_index(load, broken, strain=None, min_strain: float = 0.0) -> tuple:
-    """(index of the failure load, index of the split or None): the split is the first row whose load is
-    below :data:`SPLIT_DROP_RATIO` x the peak of the rows before it with more broken bonds than at that
-    peak; the failure load is that peak.  No split: the largest load (a lower bound).
+def splits(load: float, peak_load: float, broken: int, broken_at_peak: int, strain: float = 0.0,
+           min_strain: float = 0.0) -> bool:
+    """Whether a row is the split: its load below :data:`SPLIT_DROP_RATIO` x the peak of the rows before it,
+    with more broken bonds than at that peak, and (``min_strain`` > 0) at a diametral strain of at least
+    ``min_strain`` (``brazilian.stop_min_strain``: a drop in the start transient is not the split)."""
+    return ((min_strain <= 0 or strain >= min_strain) and load < SPLIT_DROP_RATIO * peak_load
+            and broken > broken_at_peak)
 
-    ``strain``, ``min_strain``: only rows at a diametral strain of ``min_strain`` or more count as the
-    drop (``brazilian.stop_min_strain``: a drop in the start transient is not the split); a transient
-    peak before them is then overtaken by the real one."""
+
+def split_peak_index(load, broken, strain=None, min_strain: float = 0.0) -> tuple:
+    """(index of the failure load, index of the split or None): the split is the first row that
+    :func:`splits` against the peak of the rows before it; the failure load is that peak.  No split: the
+    largest load (a lower bound).  ``strain`` (needed if ``min_strain`` > 0), ``min_strain``: as
+    :func:`splits`; a transient peak before ``min_strain`` is then overtaken by the real one."""
     load, broken = np.asarray(load, float), np.asarray(broken)
-    late = (np.ones(len(load), bool) if strain is None or min_strain <= 0
-            else np.asarray(strain, float) >= min_strain)
+    strain = np.zeros(len(load)) if strain is None or min_strain <= 0 else np.asarray(strain, float)
     ip = 0
     for i in range(1, len(load)):
-        if late[i] and load[i] < SPLIT_DROP_RATIO * load[ip] and broken[i] > broken[ip]:
+        if splits(load[i], load[ip], broken[i], broken[ip], strain[i], min_strain):
             return ip, i
         if load[i] > load[ip]:
             ip = i

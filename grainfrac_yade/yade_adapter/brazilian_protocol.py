@@ -37,7 +37,7 @@ import time
 
 import numpy as np
 
-from ..brazilian_analysis import SPLIT_DROP_RATIO, tensile_stress
+from ..brazilian_analysis import splits, tensile_stress
 from ..disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
 from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays
@@ -188,8 +188,8 @@ class BrazilianRun(LoadingCheckpoints):
                     cols[k].append(v)
                 if self.snapshot is not None:
                     self.snapshot.row(scene, len(cols["dem_step"]), strain)
-                if (self.split_snapshot is None and strain >= bz.stop_min_strain and load < SPLIT_DROP_RATIO * self.peak
-                        and row["broken_total"] > self.broken_at_peak):   # the split: the failure load is behind us
+                if self.split_snapshot is None and splits(load, self.peak, row["broken_total"], self.broken_at_peak,
+                                                          strain, bz.stop_min_strain):   # the failure load is behind us
                     self.split_snapshot = self.peak_snapshot
                 if load > self.peak:
                     self.peak, self.broken_at_peak = load, row["broken_total"]
