@@ -35,6 +35,7 @@ declare -A WHAT=(
   [lab_bands]="docs/studies/lab_bands.md: grain-size CV against lloyd_iterations (no YADE, seconds) and paired fem UCS (5 x 10 mm) and Brazilian (10 mm disc) runs per lever on the contacts: about 10 min on one core"
   [paper_fem]="docs/studies/paper_fem.md tables: docs/studies/paper_fem/ucs_runs.csv (params/paper_fem_ucs.table, about 6 CPU h) and docs/studies/paper_fem/runs.csv (params/paper_fem_creep.table, 9 paper-size fem creep runs: more than 1.2 CPU h each, not all measured)"
   [lab_calibration]="docs/studies/lab_calibration.md: the joint calibration's design (15 points x 2 seeds of a 10 x 20 mm fem UCS and a 10 mm disc, about 90 CPU s each), its fit and the candidate on seeds 1-3: about 50 min on one core"
+  [lab_disc_size]="docs/studies/lab_calibration.md disc-size probe: fem Brazilian discs of 10, 20 and 31.7 mm (params/lab_disc_size.table, 14 discs: 43-57 CPU s at 10 mm, 6-12 CPU min at 20 mm, 31.7 mm not measured)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -97,6 +98,8 @@ run_target() {
                          --json docs/studies/lab_calibration_fit_square.json --square inverse_weibull_modulus
                      $PY -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit_square.json \
                          --seeds 1 2 3 --csv docs/studies/lab_calibration_verify_square.csv ;;
+    lab_disc_size) batch params/lab_disc_size.table brazilian.py lab_disc_size
+                   $PY -m studies.brazilian_table results/lab_disc_size ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
                               $PY -m grainfrac_yade analyze results/accuracy_cost_paper_size ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
@@ -110,7 +113,7 @@ fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
-                           regularisation lab_bands lab_calibration paper_fem)
+                           regularisation lab_bands lab_calibration lab_disc_size paper_fem)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
