@@ -33,6 +33,8 @@ import math
 
 import numpy as np
 
+from .post_peak import dropped_past_peak
+
 #: Half-width of the central band about the loaded diameter, as a fraction of the diameter.
 CENTRAL_BAND_HALF_WIDTH = 1.0 / 6.0
 #: The split: the load falls below this fraction of its peak so far, with bonds broken since that peak.
@@ -96,11 +98,10 @@ def crack_location(bond_points, broken, break_step, centre, diameter: float) -> 
 
 def splits(load: float, peak_load: float, broken: int, broken_at_peak: int, strain: float = 0.0,
            min_strain: float = 0.0) -> bool:
-    """Whether a row is the split: its load below :data:`SPLIT_DROP_RATIO` x the peak of the rows before it,
-    with more broken bonds than at that peak, and (``min_strain`` > 0) at a diametral strain of at least
-    ``min_strain`` (``brazilian.stop_min_strain``: a drop in the start transient is not the split)."""
-    return ((min_strain <= 0 or strain >= min_strain) and load < SPLIT_DROP_RATIO * peak_load
-            and broken > broken_at_peak)
+    """Whether a row is the split: :func:`grainfrac_yade.post_peak.dropped_past_peak` at
+    :data:`SPLIT_DROP_RATIO` against the peak of the rows before it (``min_strain``:
+    ``brazilian.stop_min_strain``, a drop in the start transient is not the split)."""
+    return dropped_past_peak(load, peak_load, broken, broken_at_peak, SPLIT_DROP_RATIO, strain, min_strain)
 
 
 def split_peak_index(load, broken, strain=None, min_strain: float = 0.0) -> tuple:

@@ -272,16 +272,6 @@ def broken_counts(scene, broken=None) -> dict:
             "broken_inter": int((b & inter).sum()), "broken_intra": int((b & ~inter).sum())}
 
 
-def softened_past_peak(value, peak, broken_now, broken_at_peak, stop_ratio, strain=0.0, min_strain=0.0) -> bool:
-    """True once a strain-controlled test's measured ``value`` has fallen below ``stop_ratio`` x its
-    ``peak`` with bonds broken since the peak, at a ``strain`` of ``min_strain`` or more.  This model
-    softens only as bonds break: a drop with no break since the peak is the elastic ringing of a
-    specimen set in motion from rest (measured on a one-cell-wide column: 3.4 MPa, then below 2.4 MPa,
-    no bond broken), not a post-peak branch; a drop before ``min_strain`` (``ucs.stop_min_strain``,
-    ``brazilian.stop_min_strain``) is the start transient, not the peak."""
-    return strain >= min_strain and peak > 0 and value < stop_ratio * peak and broken_now > broken_at_peak
-
-
 def bond_segments(scene, indices) -> np.ndarray:
     """(c, 2, 2) face pieces of bonds [m]: centred on the bond point, as long as the bond's share."""
     lay, t = scene.layout, scene.specimen.tessellation

@@ -22,11 +22,12 @@ import time
 import numpy as np
 
 from ..errors import NumericalFailure
+from ..post_peak import softened_past_peak
 from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_state, read, restore_platens,
                          restore_scene, resume_record, scene_arrays)
 from .confinement import Confinement, broken_apart_reason, consolidate
 from .platens import Platens
-from .scene import broken_counts, build_scene, check_value, softened_past_peak
+from .scene import broken_counts, build_scene, check_value
 
 #: Columns of a UCS history.
 HISTORY_COLUMNS = ("dem_step", "dem_time_s", "axial_strain", "lateral_strain", "axial_stress_pa", "broken_total",
