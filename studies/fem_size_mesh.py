@@ -14,6 +14,8 @@ import json
 import sys
 from pathlib import Path
 
+from grainfrac_yade.params.loading import flatten
+
 #: Parameter columns copied from each UCS run into its creep rows (the specimen, the mesh, the numerics).
 COPIED = ("resolution.grain_model", "resolution.nodes_per_face", "resolution.contact_inset",
           "numerics.verlet_radius_quantile", "numerics.density_scale", "calibration.strength_scale",
@@ -22,11 +24,6 @@ COPIED = ("resolution.grain_model", "resolution.nodes_per_face", "resolution.con
 #: enough for the 0.7 rows (10 x 20 mm fem lifetimes at 0.7 of the UCS were 1e5-9e5 s, regularisation.md).
 CREEP_KEYS = {"creep.servo_response_crossings": 2, "creep.max_relaxation_crossings": 20,
               "stress_corrosion.creep_time_limit": 1e13}
-
-
-def value(params: dict, path: str):
-    section, key = path.split(".")
-    return params[section][key]
 
 
 def cell(v) -> str:
@@ -49,12 +46,12 @@ def creep_rows(runs: list, ratios) -> tuple:
     columns = ["ratio", "ucs", *COPIED, *CREEP_KEYS, "seed", "study", "description"]
     rows = []
     for s in runs:
-        p = s["params"]
+        p = flatten(s["params"])
+        copied = [cell(p[c]) for c in COPIED] + [cell(v) for v in CREEP_KEYS.values()]
+        name = f"w{1e3 * p['specimen.width']:g}_k{p['resolution.nodes_per_face']}"
         for ratio in ratios:
-            k = p["resolution"]["nodes_per_face"]
-            desc = f"w{1e3 * p['specimen']['width']:g}_k{k}_r{ratio:g}_s{s['seed']}"
-            rows.append([f"{ratio:g}", f"{s['ucs_pa']:.6e}", *(cell(value(p, c)) for c in COPIED),
-                         *(cell(v) for v in CREEP_KEYS.values()), str(s["seed"]), "'fem_mesh_creep'", f"'{desc}'"])
+            rows.append([f"{ratio:g}", f"{s['ucs_pa']:.6e}", *copied, str(s["seed"]), "'fem_mesh_creep'",
+                         f"'{name}_r{ratio:g}_s{s['seed']}'"])
     return columns, rows
 
 
