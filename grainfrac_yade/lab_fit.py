@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -180,14 +180,12 @@ class Surrogate:
     residual_sd: np.ndarray  # (5,)
     n_points: np.ndarray    # (5,)
     squared: tuple = ()     # indices of the variables with a square term
-    curvature: np.ndarray = None   # (5, len(squared)): coefficient of u_q^2
+    #: (5, len(squared)): coefficient of u_q^2 (no columns for a linear surface)
+    curvature: np.ndarray = field(default_factory=lambda: np.zeros((len(OBSERVABLES), 0)))
 
     def predict(self, u) -> np.ndarray:
         u = np.asarray(u, dtype=float)
-        y = self.intercept + self.slope @ u
-        if self.squared:
-            y = y + self.curvature @ (u[list(self.squared)] ** 2)
-        return y
+        return self.intercept + self.slope @ u + self.curvature @ (u[list(self.squared)] ** 2)
 
 
 def fit_surrogate(points, y, squared=()) -> Surrogate:
