@@ -132,7 +132,7 @@ def test_confinement_forces_consolidation_and_a_higher_peak(tmp_path):
 def test_a_confined_creep_run_killed_mid_creep_resumes_to_the_uninterrupted_result(tmp_path):
     """The side-wall forces are YADE permanent forces, which O.save does not keep: the resume must set them
     again, or the resumed run would go on unconfined."""
-    from test_resume import TINY as CREEP_TINY, _assert_same_run, _cli, _creep_args, _start_and_kill
+    from test_resume import TINY as CREEP_TINY, _assert_same_run, _cli, _creep_args, _start_and_kill, mid_creep
     spec = dict(CREEP_TINY, ucs=320e6)
     confined = ["--confinement", "20"]
     ref = tmp_path / "uninterrupted"
@@ -141,8 +141,8 @@ def test_a_confined_creep_run_killed_mid_creep_resumes_to_the_uninterrupted_resu
     s = json.loads((ref / "summary.json").read_text())
     assert s["confining_stress_pa"] == 20 * MPA and s["consolidated"] and s["failed"]
     killed = tmp_path / "killed"
-    state = _start_and_kill(spec, killed, lambda st: st["phase"] == "event", extra=confined)
-    assert state["phase"] == "event"
+    state = _start_and_kill(spec, killed, mid_creep, extra=confined)
+    assert mid_creep(state)
     res = _cli("--resume", killed)
     assert res.returncode == 0, res.stderr
     _assert_same_run(ref, killed)

@@ -332,9 +332,9 @@ def test_truncated_and_garbage_checkpoints_are_one_line(tmp_path):
     """A tiny creep run killed mid-creep (test_resume's helper, a few seconds); its checkpoint's scene cut in
     half, then every checkpoint file replaced by garbage: each resume is one line naming what is wrong."""
     import shutil
-    from test_resume import TINY as CREEP_TINY, _start_and_kill
+    from test_resume import TINY as CREEP_TINY, _start_and_kill, mid_creep
     out = tmp_path / "killed"
-    _start_and_kill(CREEP_TINY, out, lambda st: st["phase"] == "event")
+    _start_and_kill(CREEP_TINY, out, mid_creep)
     keep = tmp_path / "copy"
     shutil.copytree(out, keep)
     scene = out / "checkpoint" / "scene.yade.gz"

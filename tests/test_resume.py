@@ -28,6 +28,12 @@ EVERY_SAFE_POINT = "numerics.checkpoint_interval=1e-6"
 #: UCS test of 3 x 6 mm, seed 1: 61,800 DEM steps, 309 history rows, the first crack near step 45k,
 #: 24 broken bonds at the end; about 3 s alone (12 s with a checkpoint before every row).
 UCS_TINY = {"width": 3e-3, "height": 6e-3, "seed": 1}
+def mid_creep(state):
+    """A checkpoint inside creep, after the first event. TINY's event phase lasts one safe point (about 10 ms,
+    too short for a poll to catch on a fast machine); the relaxation after it about 2 s (measured: ~190 polls)."""
+    return state["phase"] in ("event", "relaxation") and state["loop"]["n_events"] >= 1
+
+
 #: Columns that differ between two identical runs (wall time).
 WALL = ["wall_s"]
 
