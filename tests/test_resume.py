@@ -66,7 +66,7 @@ def _kill_when_ready(argv, out, ready, timeout):
             state = _state(out)
             if state is not None and ready(state):
                 break
-            time.sleep(0.01)
+            time.sleep(0.002)   # an event phase holds its checkpoint for about 10 ms
     finally:
         proc.send_signal(signal.SIGKILL)
         proc.wait()
