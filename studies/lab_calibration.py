@@ -214,9 +214,11 @@ def fit(csv_path: Path, ucs_target=None, squared=()) -> dict:
     }
 
 
-def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[0])) -> str:
+def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[0]), design_csv=None) -> str:
     """The preset: a header with the verified residuals, the base preset's model keys ([resolution],
-    [numerics]) and a [calibration] section with the candidate's keys and the verified mean UCS."""
+    [numerics]), a [calibration] section with the candidate's keys and the verified mean UCS, and the end
+    criteria's minimum strains the verification ran with (:data:`STOP_KEYS`). ``design_csv``: the design's
+    file as the header names it (default: the path the fit read)."""
     import tomllib
     targets = lab_fit.lab_targets()
     _, _, measured = point_means(verify_rows)
@@ -232,7 +234,7 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
     lines = ["# Finite-element grains calibrated jointly to Lac du Bonnet granite's lab bands (docs/studies/lab_calibration.md):",
              "# UCS, E, Brazilian tensile strength, CI/UCS and CD/UCS, by five contact levers ([calibration] below),",
              "# written by  python3 -m studies.lab_calibration preset  from the fit of",
-             f"#   {result['design_csv']} ({result['n_points']} design points)",
+             f"#   {design_csv or result['design_csv']} ({result['n_points']} design points)",
              f"# and its verification on seeds {seeds} (10 x 20 mm UCS at the preset's 0.5 /s, 10 mm Brazilian disc).",
              "# Targets: params/reference/ldb_lab_properties.csv (the lab's UCS 200 MPa, not the paper's simulated 234.5 MPa:",
              "# every other target is a lab property of one granite). Use with --params params/presets/ldb_lab.toml.",
@@ -243,6 +245,8 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
         lines.append(f"#   {name:18s} {targets.value[k] / f:8.3g} +- {targets.spread[k] / f:<7.3g} {unit:4s} "
                      f"{mean[k] / f:9.4g} {unit:4s}            {resid[k]:+6.2f}                 "
                      f"{result['predicted'][name] / f:.4g}")
+    lines += ["#   (tensile_strength from 10 mm discs, the design's; larger discs read it lower: the disc-size section",
+              "#   of docs/studies/lab_calibration.md)"]
     base = Path(base_preset).read_text()
     model = base[base.index("[resolution]"):base.index("[calibration]")].rstrip()
     cal = dict(o.split("=") for o in result["candidate_overrides"])
@@ -252,8 +256,15 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
         name = key.split(".", 1)[1]
         lines.append(f"{name} = {float(value)!r}    # 1, fitted: {doc[key].doc}")
     lines += ["stiffness_scale = 1.0    # 1, not fitted: Table 2 as printed",
-              f"reference_ucs = {mean[0]:.6g}    # Pa, the verified mean UCS above; what a driving-stress ratio refers to",
-              ""]
+              f"reference_ucs = {mean[0]:.6g}    # Pa, the verified mean UCS above; what a driving-stress ratio refers to"]
+    sections = {}
+    for key, value in (k.split("=") for k in STOP_KEYS):
+        section, name = key.split(".")
+        sections.setdefault(section, []).append(f"{name} = {float(value)!r}    # 1, as the verification ran: "
+                                                "the post-peak stop past the start transient")
+    for section, keys in sections.items():
+        lines += ["", f"[{section}]", *keys]
+    lines.append("")
     text = "\n".join(lines)
     tomllib.loads(text)   # a preset that does not parse is never written
     return text
@@ -270,6 +281,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2], help="specimen seeds per point")
     ap.add_argument("--only", type=int, nargs="+", help="design points to run (default all)")
     ap.add_argument("--write", default=str(PRESET), help="the preset file (preset)")
+    ap.add_argument("--design-csv", help="the design's CSV as the preset's header names it (preset; default: the "
+                                         "path the fit read)")
     ap.add_argument("--square", nargs="*", default=[], choices=[v.name for v in lab_fit.FIT_VARIABLES],
                     help="variables with a square term in the surface (fit; default none: linear)")
     args = ap.parse_args(argv)
@@ -297,7 +310,7 @@ def main(argv=None) -> int:
     if args.part == "verify":
         run_point(-1, u, args.seeds, Path(args.csv), Path(args.out) / "verify")
         return 0
-    Path(args.write).write_text(preset_text(result, _rows(Path(args.csv))))
+    Path(args.write).write_text(preset_text(result, _rows(Path(args.csv)), design_csv=args.design_csv))
     print(f"written {args.write}")
     return 0
 

@@ -140,6 +140,8 @@ def test_study_fit_and_preset_on_a_known_linear_law(tmp_path):
         float(expected["calibration.shear_stiffness_ratio_scale"]), rel=1e-5)
     assert p.calibration.reference_ucs == pytest.approx(200e6, rel=1e-5)
     assert p.resolution.grain_model == "fem"
+    # the end criteria the verification ran with travel with the preset
+    assert (p.ucs.stop_min_strain, p.brazilian.stop_min_strain) == (2e-4, 2e-4)
 
 
 def test_a_brazilian_peak_without_a_split_is_left_out():
@@ -209,3 +211,25 @@ def test_reseat_runs_the_seating_stops_again_and_keeps_their_old_rows(tmp_path, 
     assert len(rows) == 6 and not study.seating_stops(rows)
     assert [r["broken_total"] for r in study._rows(csv_path.with_name("design.csv.seating.csv"))] == ["", "1"]
     assert study.reseat(csv_path, tmp_path, 6, 1) == []   # nothing left to run
+
+
+def test_the_preset_creep_table_runs_the_preset():
+    """Every row of params/ldb_lab_creep.table gives the model of params/presets/ldb_lab.toml: the same
+    [resolution], [numerics] and [calibration] values, so its lifetimes are the preset's."""
+    import dataclasses
+    import tomllib
+
+    from conftest import ROOT
+    from grainfrac_yade.params import load_parameters
+    from grainfrac_yade.runs.batchrun import read_table_rows
+    preset_file = ROOT / "params" / "presets" / "ldb_lab.toml"
+    preset = load_parameters(extra_files=[str(preset_file)])
+    sections = [name for name in tomllib.loads(preset_file.read_text()) if name in ("resolution", "numerics",
+                                                                                    "calibration")]
+    columns, rows, problems = read_table_rows(ROOT / "params" / "ldb_lab_creep.table")
+    assert not problems and len(rows) == 9
+    for cells in rows.values():
+        keys = [c for c in columns if c.split(".")[0] in sections]
+        row = load_parameters(overrides=[f"{k}={cells[k].strip(chr(39))}" for k in keys])
+        for name in sections:
+            assert dataclasses.asdict(getattr(row, name)) == dataclasses.asdict(getattr(preset, name)), name
