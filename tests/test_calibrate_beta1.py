@@ -10,14 +10,14 @@ from grainfrac_yade.analysis.labdata import paper_reference
 from grainfrac_yade.params import load_parameters
 
 
-def _run(folder, seed, stress, lifetime, clock="event", beta1=1e-3):
+def _run(folder, seed, stress, lifetime, clock="event", beta1=1e-3, n_events=10):
     folder.mkdir(parents=True)
     (folder / "run.json").write_text(json.dumps({"command": "creep", "seed": seed}))
     (folder / "params.json").write_text(json.dumps({"stress_corrosion": {"beta1": beta1, "clock": clock,
                                                                          "mode": "strength"}}))
     (folder / "summary.json").write_text(json.dumps({
         "lifetime_s": lifetime, "failed": True, "failed_on_loading": False, "stress_pa": stress,
-        "clock": clock, "mode": "strength", "n_events": 10, "seed": seed}))
+        "clock": clock, "mode": "strength", "n_events": n_events, "seed": seed}))
 
 
 def test_factor_is_the_geometric_mean_over_the_paper_lifetime(tmp_path):
@@ -27,6 +27,7 @@ def test_factor_is_the_geometric_mean_over_the_paper_lifetime(tmp_path):
     _run(study / "b", 2, ref.stress_pa, 4e7)
     _run(study / "c", 3, ref.stress_pa, 1e3, clock="paper")     # other clock: not used
     _run(study / "d", 1, 0.8 * ref.stress_pa, 1e3)              # other load: not used
+    _run(study / "e", 4, ref.stress_pa, 0.0, n_events=0)       # ran away at creep time 0: failed at load, not used
     out = tmp_path / "cal.toml"
     res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "calibrate-beta1", str(study), "--out", str(out)],
                          capture_output=True, text=True, cwd=ROOT)

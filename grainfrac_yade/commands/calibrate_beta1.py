@@ -39,17 +39,18 @@ def beta1_factor(lifetimes, target_s: float) -> dict:
 
 
 def select_reference_runs(runs, stress_pa: float):
-    """Finished, failed (not on loading) event-clock creep runs of a strength law at ``stress_pa``."""
+    """Event-clock creep runs of a strength law at ``stress_pa`` that failed in creep: a positive lifetime,
+    as the lifetime analysis classifies them (a run that ran away at creep time 0 failed at load)."""
+    from ..analysis.lifetimes import outcome
     from ..law import scales_with_beta1
     from ..errors import GrainfracError
     need = ("stress_pa", "lifetime_s", "failed", "clock", "law")
     if runs.empty or any(c not in runs for c in need):
         raise GrainfracError("no finished creep runs in the folder; fix: run params/lifetime_ldb.table first")
-    sel = runs[(runs["status"] == "finished") & (runs["failed"] == True)  # noqa: E712 (pandas mask)
+    failed_in_creep = np.array([outcome(r) == "failed" for r in runs.to_dict("records")], bool)
+    sel = runs[failed_in_creep
                & np.isclose(runs["stress_pa"].astype(float), stress_pa, rtol=STRESS_MATCH_RTOL, atol=0)
                & (runs["clock"] == "event") & runs["law"].map(scales_with_beta1).astype(bool)]
-    if "failed_on_loading" in sel:
-        sel = sel[sel["failed_on_loading"] != True]  # noqa: E712
     if len(sel) < 2:
         raise GrainfracError(f"{len(sel)} failed event-clock strength-law run(s) at {stress_pa / 1e6:g} MPa; "
                              "fix: at least 2 seeds at the paper's load are needed (params/lifetime_ldb.table)")
