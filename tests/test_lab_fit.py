@@ -227,7 +227,7 @@ def test_the_preset_creep_table_runs_the_preset():
     sections = [name for name in tomllib.loads(preset_file.read_text()) if name in ("resolution", "numerics",
                                                                                     "calibration")]
     columns, rows, problems = read_table_rows(ROOT / "params" / "ldb_lab_creep.table")
-    assert not problems and len(rows) == 9
+    assert not problems and len(rows) == 18
     for cells in rows.values():
         keys = [c for c in columns if c.split(".")[0] in sections]
         row = load_parameters(overrides=[f"{k}={cells[k].strip(chr(39))}" for k in keys])
