@@ -213,9 +213,10 @@ def test_reseat_runs_the_seating_stops_again_and_keeps_their_old_rows(tmp_path, 
     assert study.reseat(csv_path, tmp_path, 6, 1) == []   # nothing left to run
 
 
-def test_the_preset_creep_table_runs_the_preset():
-    """Every row of params/ldb_lab_creep.table gives the model of params/presets/ldb_lab.toml: the same
-    [resolution], [numerics] and [calibration] values, so its lifetimes are the preset's."""
+@pytest.mark.parametrize("table, n_rows", [("ldb_lab_creep.table", 18), ("ldb_lab_rate_ucs.table", 3)])
+def test_the_preset_tables_run_the_preset(table, n_rows):
+    """Every row of the preset's creep and rate tables gives the model of params/presets/ldb_lab.toml: the
+    same [resolution], [numerics] and [calibration] values, so its lifetimes and strengths are the preset's."""
     import dataclasses
     import tomllib
 
@@ -226,8 +227,8 @@ def test_the_preset_creep_table_runs_the_preset():
     preset = load_parameters(extra_files=[str(preset_file)])
     sections = [name for name in tomllib.loads(preset_file.read_text()) if name in ("resolution", "numerics",
                                                                                     "calibration")]
-    columns, rows, problems = read_table_rows(ROOT / "params" / "ldb_lab_creep.table")
-    assert not problems and len(rows) == 18
+    columns, rows, problems = read_table_rows(ROOT / "params" / table)
+    assert not problems and len(rows) == n_rows
     for cells in rows.values():
         keys = [c for c in columns if c.split(".")[0] in sections]
         row = load_parameters(overrides=[f"{k}={cells[k].strip(chr(39))}" for k in keys])
