@@ -9,6 +9,9 @@ Four parts, run in this order; each reads what the one before wrote and writes p
 * ``reseat``: the (point, seed) pairs whose UCS test or disc stopped in its seating, run again with the end
   criteria's minimum strain (:data:`STOP_KEYS`); their old rows are kept in ``<csv>.seating.csv``.
 * ``fit``: the linear response surface and its least-squares optimum: JSON with the candidate's keys.
+* ``best``: the alternative to ``fit`` once a fit's candidate has missed: the design point whose *measured*
+  seed means lie nearest the lab (smallest sum of squared residuals in lab spreads, every observable
+  measured), as JSON of the same form, its design rows copied into the verification CSV (``--verify-csv``).
 * ``verify``: the candidate on more seeds (same specimens): rows into a CSV of their own.
 * ``preset``: ``params/presets/ldb_lab.toml``, the fem preset with the candidate's keys and the verified
   measurements and residuals beside each target.
@@ -21,6 +24,8 @@ Four parts, run in this order; each reads what the one before wrote and writes p
         --seeds 1 2 3 --csv docs/studies/lab_calibration_verify.csv --out results/lab_calibration
     /usr/bin/python3 -m studies.lab_calibration preset --json docs/studies/lab_calibration_fit.json \\
         --csv docs/studies/lab_calibration_verify.csv
+    /usr/bin/python3 -m studies.lab_calibration best --csv docs/studies/lab_calibration_design.csv \\
+        --json docs/studies/lab_calibration_best.json --verify-csv docs/studies/lab_calibration_verify_best.csv
 """
 from __future__ import annotations
 
@@ -214,6 +219,38 @@ def fit(csv_path: Path, ucs_target=None, squared=()) -> dict:
     }
 
 
+def measured_cost(rows) -> tuple:
+    """(points, seed means (m, 5), weighted residuals (m, 5), sum of their squares (m,)): each design point's
+    measured distance from the lab's targets; a point with an observable not measured has cost NaN."""
+    points, _, y = point_means(rows)
+    resid = lab_fit.weighted_residuals(lab_fit.scaled(y), lab_fit.lab_targets())
+    cost = np.where(np.isfinite(resid).all(axis=1), np.nansum(resid ** 2, axis=1), np.nan)
+    return points, y, resid, cost
+
+
+def best_point(csv_path: Path) -> dict:
+    """The design point nearest the lab as measured (:func:`measured_cost`), as a result of the form of
+    :func:`fit`: its keys, and its design seed means as what is expected before the check."""
+    rows = _rows(csv_path)
+    points, y, resid, cost = measured_cost(rows)
+    if not np.isfinite(cost).any():
+        raise SystemExit(f"{csv_path}: no design point has all five observables measured; fix: run the design first")
+    k = int(np.nanargmin(cost))
+    targets = lab_fit.lab_targets()
+    u = np.array([float(next(r for r in rows if int(r["point"]) == points[k])[f"u_{v.name}"])
+                  for v in lab_fit.FIT_VARIABLES])
+    return {
+        "design_csv": str(csv_path), "n_points": len(points), "design_point": points[k],
+        "targets": dict(zip(targets.names, targets.value.tolist())),
+        "target_spreads": dict(zip(targets.names, targets.spread.tolist())),
+        "candidate_u": dict(zip((v.name for v in lab_fit.FIT_VARIABLES), u.tolist())),
+        "candidate_overrides": lab_fit.overrides(u),
+        "predicted": dict(zip(targets.names, y[k].tolist())),
+        "predicted_weighted_residuals": dict(zip(targets.names, resid[k].tolist())),
+        "measured_cost_per_point": {str(p): (None if not np.isfinite(c) else float(c)) for p, c in zip(points, cost)},
+    }
+
+
 def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[0]), design_csv=None) -> str:
     """The preset: a header with the verified residuals, the base preset's model keys ([resolution],
     [numerics]), a [calibration] section with the candidate's keys and the verified mean UCS, and the end
@@ -239,7 +276,7 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
              "# Targets: params/reference/ldb_lab_properties.csv (the lab's UCS 200 MPa, not the paper's simulated 234.5 MPa:",
              "# every other target is a lab property of one granite). Use with --params params/presets/ldb_lab.toml.",
              "#",
-             "# target             lab value +- spread       verified mean (seeds)     residual [lab spreads]   surface predicted"]
+             "# target             lab value +- spread       verified mean (seeds)     residual [lab spreads]   expected before the check"]
     for k, name in enumerate(targets.names):
         f, unit = units[name]
         lines.append(f"#   {name:18s} {targets.value[k] / f:8.3g} +- {targets.spread[k] / f:<7.3g} {unit:4s} "
@@ -272,7 +309,7 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("part", choices=("design", "backfill", "reseat", "fit", "verify", "preset"))
+    ap.add_argument("part", choices=("design", "backfill", "reseat", "fit", "best", "verify", "preset"))
     ap.add_argument("--csv", required=True, help="rows of the design (design, fit) or of the verification (verify)")
     ap.add_argument("--json", help="the fit's result (written by fit, read by verify)")
     ap.add_argument("--out", default=str(ROOT / "results" / "lab_calibration"), help="run folders")
@@ -281,6 +318,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2], help="specimen seeds per point")
     ap.add_argument("--only", type=int, nargs="+", help="design points to run (default all)")
     ap.add_argument("--write", default=str(PRESET), help="the preset file (preset)")
+    ap.add_argument("--verify-csv", help="best: the verification CSV that receives the chosen point's design rows")
     ap.add_argument("--design-csv", help="the design's CSV as the preset's header names it (preset; default: the "
                                          "path the fit read)")
     ap.add_argument("--square", nargs="*", default=[], choices=[v.name for v in lab_fit.FIT_VARIABLES],
@@ -303,6 +341,15 @@ def main(argv=None) -> int:
         result = fit(Path(args.csv), squared=tuple(args.square))
         Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
         print(json.dumps({k: result[k] for k in ("surface_r2", "candidate_overrides", "predicted",
+                                                  "predicted_weighted_residuals")}, indent=1))
+        return 0
+    if args.part == "best":
+        result = best_point(Path(args.csv))
+        Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
+        if args.verify_csv and not Path(args.verify_csv).exists():
+            chosen = [dict(r, point=-1) for r in _rows(Path(args.csv)) if int(r["point"]) == result["design_point"]]
+            _write(Path(args.verify_csv), chosen)
+        print(json.dumps({k: result[k] for k in ("design_point", "candidate_overrides", "predicted",
                                                   "predicted_weighted_residuals")}, indent=1))
         return 0
     result = json.loads(Path(args.json).read_text())
