@@ -204,7 +204,7 @@ def fit(csv_path: Path, ucs_target=None, squared=()) -> dict:
     surface = lab_fit.fit_surrogate(u, lab_fit.scaled(y), [names.index(n) for n in squared])
     best, predicted = lab_fit.solve(surface, targets)
     return {
-        "design_csv": str(csv_path), "n_points": len(points),
+        "design_csv": str(csv_path), "n_points": len(points), "method": FIT_METHOD,
         "targets": dict(zip(targets.names, targets.value.tolist())),
         "target_spreads": dict(zip(targets.names, targets.spread.tolist())),
         "target_sources": dict(zip(targets.names, targets.sources)),
@@ -217,6 +217,11 @@ def fit(csv_path: Path, ucs_target=None, squared=()) -> dict:
         "predicted": dict(zip(targets.names, lab_fit.unscaled(surface.predict(best)).tolist())),
         "predicted_weighted_residuals": dict(zip(targets.names, predicted.tolist())),
     }
+
+
+#: How a result's candidate was chosen, as the preset's header says it (``fit`` and ``best``).
+FIT_METHOD = "the least-squares optimum of the response surface fitted to"
+BEST_METHOD = "design point {point}, the one whose measured seed means lie nearest the lab's targets, of"
 
 
 def measured_cost(rows) -> tuple:
@@ -241,6 +246,7 @@ def best_point(csv_path: Path) -> dict:
                   for v in lab_fit.FIT_VARIABLES])
     return {
         "design_csv": str(csv_path), "n_points": len(points), "design_point": points[k],
+        "method": BEST_METHOD.format(point=points[k]),
         "targets": dict(zip(targets.names, targets.value.tolist())),
         "target_spreads": dict(zip(targets.names, targets.spread.tolist())),
         "candidate_u": dict(zip((v.name for v in lab_fit.FIT_VARIABLES), u.tolist())),
@@ -270,7 +276,7 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
              "ci_over_ucs": (1.0, ""), "cd_over_ucs": (1.0, "")}
     lines = ["# Finite-element grains calibrated jointly to Lac du Bonnet granite's lab bands (docs/studies/lab_calibration.md):",
              "# UCS, E, Brazilian tensile strength, CI/UCS and CD/UCS, by five contact levers ([calibration] below),",
-             "# written by  python3 -m studies.lab_calibration preset  from the fit of",
+             f"# written by  python3 -m studies.lab_calibration preset  from {result['method']}",
              f"#   {design_csv or result['design_csv']} ({result['n_points']} design points)",
              f"# and its verification on seeds {seeds} (10 x 20 mm UCS at the preset's 0.5 /s, 10 mm Brazilian disc).",
              "# Targets: params/reference/ldb_lab_properties.csv (the lab's UCS 200 MPa, not the paper's simulated 234.5 MPa:",

@@ -144,6 +144,36 @@ def test_study_fit_and_preset_on_a_known_linear_law(tmp_path):
     assert (p.ucs.stop_min_strain, p.brazilian.stop_min_strain) == (2e-4, 2e-4)
 
 
+def test_best_picks_the_measured_point_nearest_the_lab_and_skips_incomplete_points(tmp_path):
+    """best: of three measured points, the one at the lab's values (cost 0), not the one nearer in four
+    observables whose disc did not split (no sigma_t: no cost); its rows become the verification's start."""
+    import csv
+    import json
+    from studies import lab_calibration as study
+    values = {0: [260e6, 75e9, 30e6, 0.60, 0.95], 1: [200e6, 69e9, 9e6, 0.45, 0.75], 2: [200e6, 69e9, 9e6, 0.45, 0.75]}
+    pts = [lab_fit.AS_PRINTED, np.full(5, 0.25), np.full(5, 0.75)]
+    rows = _synthetic_rows(pts, lambda u: values[[tuple(q) for q in pts].index(tuple(u))])
+    for r in rows:
+        if r["point"] == "2" and r["test"] == "brazilian":
+            r["broken_total"] = "1"
+        if r["point"] == "1" and r["test"] == "ucs":
+            r["ucs_pa"] = str(1.1 * 200e6)      # +0.95 lab spreads in ln UCS
+    design = tmp_path / "design.csv"
+    with design.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(study.POINT_FIELDS))
+        w.writeheader()
+        w.writerows({k: r.get(k, "") for k in study.POINT_FIELDS} for r in rows)
+    out, verify = tmp_path / "best.json", tmp_path / "verify.csv"
+    assert study.main(["best", "--csv", str(design), "--json", str(out), "--verify-csv", str(verify)]) == 0
+    best = json.loads(out.read_text())
+    assert best["design_point"] == 1 and best["measured_cost_per_point"]["2"] is None
+    assert best["predicted_weighted_residuals"]["ucs"] == pytest.approx(np.log(1.1) / np.log1p(22 / 200))
+    assert [float(best["candidate_u"][v.name]) for v in lab_fit.FIT_VARIABLES] == [0.25] * 5
+    copied = study._rows(verify)
+    assert len(copied) == 4 and {r["point"] for r in copied} == {"-1"}
+    assert "design point 1" in study.preset_text(best, copied)
+
+
 def test_a_brazilian_peak_without_a_split_is_left_out():
     """Fewer bonds broken than grains on the diameter: a seating transient, not a tensile strength."""
     from studies import lab_calibration as study
