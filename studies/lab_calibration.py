@@ -297,7 +297,7 @@ def preset_text(result: dict, verify_rows, base_preset: Path = Path(BASE_PARAMS[
     lines += ["", "# the model's keys, as " + str(Path(base_preset).relative_to(ROOT)), model, "", "[calibration]"]
     for key, value in cal.items():
         name = key.split(".", 1)[1]
-        lines.append(f"{name} = {float(value)!r}    # 1, fitted: {doc[key].doc}")
+        lines.append(f"{name} = {float(value)!r}    # 1, calibrated: {doc[key].doc}")
     lines += ["stiffness_scale = 1.0    # 1, not fitted: Table 2 as printed",
               f"reference_ucs = {mean[0]:.6g}    # Pa, the verified mean UCS above; what a driving-stress ratio refers to"]
     sections = {}
