@@ -243,7 +243,7 @@ def test_reseat_runs_the_seating_stops_again_and_keeps_their_old_rows(tmp_path, 
     assert study.reseat(csv_path, tmp_path, 6, 1) == []   # nothing left to run
 
 
-@pytest.mark.parametrize("table, n_rows", [("ldb_lab_creep.table", 9), ("ldb_lab_rate_ucs.table", 3)])
+@pytest.mark.parametrize("table, n_rows", [("ldb_lab_creep.table", 18), ("ldb_lab_rate_ucs.table", 3)])
 def test_the_preset_tables_run_the_preset(table, n_rows):
     """Every row of the preset's creep and rate tables gives the model of params/presets/ldb_lab.toml: the
     same [resolution], [numerics] and [calibration] values, so its lifetimes and strengths are the preset's."""
