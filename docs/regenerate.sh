@@ -35,6 +35,8 @@ declare -A WHAT=(
   [lab_bands]="docs/studies/lab_bands.md: grain-size CV against lloyd_iterations (no YADE, seconds) and paired fem UCS (5 x 10 mm) and Brazilian (10 mm disc) runs per lever on the contacts: about 10 min on one core"
   [paper_fem]="docs/studies/paper_fem.md tables: docs/studies/paper_fem/ucs_runs.csv (params/paper_fem_ucs.table, about 6 CPU h) and docs/studies/paper_fem/runs.csv (params/paper_fem_creep.table, 9 paper-size fem creep runs: more than 1.2 CPU h each, not all measured)"
   [lab_calibration]="docs/studies/lab_calibration.md: the joint calibration's design (15 points x 2 seeds of a 10 x 20 mm fem UCS and a 10 mm disc, about 90 CPU s each), its fit and the candidate on seeds 1-3: about 50 min on one core"
+  [lab_creep]="docs/studies/lab_calibration.md creep of the preset and of the corner candidate, and the preset's rate check (params/ldb_lab_creep.table, lab_corner_creep.table, ldb_lab_rate_ucs.table; 10 x 20 mm fem: 47-520 CPU s per creep row, the 0.4 rows the dearest): about 1.5 h on one core"
+  [fem_mesh]="docs/studies/paper_fem.md mesh resolution: 10 x 20 mm fem UCS at 2 and 3 bonds per face (the first 6 rows of params/fem_size_mesh_ucs.table: 94-164 and about 500 CPU s) and the creep rows at 0.7 and 0.85 of each run's own UCS that studies/fem_size_mesh.py writes from them"
   [lab_disc_size]="docs/studies/lab_calibration.md disc-size probe: fem Brazilian discs of 10, 20 and 31.7 mm (params/lab_disc_size.table, 14 discs: 43-57 CPU s at 10 mm, 6-12 CPU min at 20 mm, 31.7 mm not measured)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
@@ -97,7 +99,25 @@ run_target() {
                      $PY -m studies.lab_calibration fit --csv docs/studies/lab_calibration_design.csv \
                          --json docs/studies/lab_calibration_fit_square.json --square inverse_weibull_modulus
                      $PY -m studies.lab_calibration verify --json docs/studies/lab_calibration_fit_square.json \
-                         --seeds 1 2 3 --csv docs/studies/lab_calibration_verify_square.csv ;;
+                         --seeds 1 2 3 --csv docs/studies/lab_calibration_verify_square.csv
+                     $PY -m studies.lab_calibration best --csv docs/studies/lab_calibration_design.csv \
+                         --json docs/studies/lab_calibration_best.json --verify-csv docs/studies/lab_calibration_verify_best.csv
+                     $PY -m studies.lab_calibration verify --json docs/studies/lab_calibration_best.json \
+                         --seeds 1 2 3 --csv docs/studies/lab_calibration_verify_best.csv
+                     $PY -m studies.lab_calibration preset --json docs/studies/lab_calibration_best.json \
+                         --csv docs/studies/lab_calibration_verify_best.csv --design-csv docs/studies/lab_calibration_design.csv ;;
+    lab_creep) $PY -m grainfrac_yade batch params/ldb_lab_creep.table --jobs 1
+               $PY -m grainfrac_yade batch params/lab_corner_creep.table --jobs 1
+               $PY -m grainfrac_yade batch params/ldb_lab_rate_ucs.table --jobs 1 --test ucs
+               $PY -m grainfrac_yade analyze results/ldb_lab_creep
+               $PY -m grainfrac_yade analyze results/lab_corner_creep
+               $PY -m grainfrac_yade analyze-ucs results/ldb_lab_rate_ucs ;;
+    fem_mesh) mkdir -p results && head -16 params/fem_size_mesh_ucs.table > results/fem_size_mesh_ucs_10mm.table
+              $PY -m grainfrac_yade batch results/fem_size_mesh_ucs_10mm.table --jobs 1 --test ucs
+              $PY -m grainfrac_yade analyze-ucs results/fem_size_mesh_ucs
+              $PY -m studies.fem_size_mesh results/fem_size_mesh_ucs --out results/fem_mesh_creep.table
+              $PY -m grainfrac_yade batch results/fem_mesh_creep.table --jobs 1
+              $PY -m grainfrac_yade analyze results/fem_mesh_creep ;;
     lab_disc_size) batch params/lab_disc_size.table brazilian.py lab_disc_size
                    $PY -m studies.brazilian_table results/lab_disc_size ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
@@ -113,7 +133,7 @@ fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
-                           regularisation lab_bands lab_calibration lab_disc_size paper_fem)
+                           regularisation lab_bands lab_calibration lab_creep lab_disc_size fem_mesh paper_fem)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
