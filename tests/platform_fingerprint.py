@@ -4,7 +4,10 @@ A one-thread YADE run is deterministic on one machine, but not across CPUs: nump
 ufuncs (exp, log, ...) to the widest SIMD extension the CPU has, and glibc picks its libm variants
 by CPU, so a last bit can differ, and past the first bond break the DEM is chaotic.  Measured: the
 reference creep runs made on an Intel Xeon, rerun on an AMD EPYC with AVX-512 (same Debian
-packages), gave lifetimes x 2.2 and x 1.001 apart and a 6 x 12 mm UCS 1e-6 apart.  So exact
+packages), gave lifetimes x 2.2 and x 1.001 apart and a 6 x 12 mm UCS 1e-6 apart.  Two AMD EPYCs with
+the same model string and SIMD target differ too (a CPU of family 26 did not reproduce the set written
+on an earlier "AMD EPYC, AVX512_ICL": lifetimes x 2.2 apart), so the fingerprint holds the CPU's family,
+model and stepping as well (``cpu_id``, from /proc/cpuinfo).  So exact
 results are stored per fingerprint under ``tests/data/reference/<set>/`` and compared exactly only
 on a machine with the same fingerprint; elsewhere each test states what it compares instead.
 """
@@ -22,7 +25,9 @@ from grainfrac_yade.commands.bench import cpu_model  # noqa: E402  (the CPU's mo
 
 REFERENCE = Path(__file__).resolve().parent / "data" / "reference"
 #: What must be equal for an exact comparison (see module doc).
-FINGERPRINT_KEYS = ("machine", "cpu", "simd", "libc", "python", "numpy", "yade_package")
+FINGERPRINT_KEYS = ("machine", "cpu", "cpu_id", "simd", "libc", "python", "numpy", "yade_package")
+#: /proc/cpuinfo fields that tell CPUs with one model string apart.
+CPU_ID_FIELDS = ("cpu family", "model", "stepping")
 
 
 def numpy_simd() -> str:
@@ -35,9 +40,19 @@ def numpy_simd() -> str:
     return usable[-1] if usable else "baseline"
 
 
+def cpu_id() -> str:
+    """The first CPU's family, model and stepping from /proc/cpuinfo ("unknown" where it is not readable)."""
+    try:
+        lines = Path("/proc/cpuinfo").read_text().split("\n\n")[0].splitlines()
+    except OSError:
+        return "unknown"
+    fields = {k.strip(): v.strip() for k, _, v in (line.partition(":") for line in lines)}
+    return " ".join(f"{k.split()[-1]} {fields[k]}" for k in CPU_ID_FIELDS if k in fields) or "unknown"
+
+
 def this_platform() -> dict:
     yade = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "yade"], capture_output=True, text=True).stdout
-    return {"machine": platform.machine(), "cpu": cpu_model(), "simd": numpy_simd(),
+    return {"machine": platform.machine(), "cpu": cpu_model(), "cpu_id": cpu_id(), "simd": numpy_simd(),
             "libc": "-".join(platform.libc_ver()), "python": platform.python_version(), "numpy": np.__version__,
             "yade_package": yade}
 
