@@ -36,7 +36,7 @@ declare -A WHAT=(
   [paper_fem]="docs/studies/paper_fem.md tables: docs/studies/paper_fem/ucs_runs.csv (params/paper_fem_ucs.table, about 6 CPU h) and docs/studies/paper_fem/runs.csv (params/paper_fem_creep.table, 9 paper-size fem creep runs: more than 1.2 CPU h each, not all measured)"
   [lab_calibration]="docs/studies/lab_calibration.md: the joint calibration's design (15 points x 2 seeds of a 10 x 20 mm fem UCS and a 10 mm disc, about 90 CPU s each), its fit and the candidate on seeds 1-3: about 50 min on one core"
   [lab_creep]="docs/studies/lab_calibration.md creep of the preset and of the corner candidate, and the preset's rate check (params/ldb_lab_creep.table, lab_corner_creep.table, ldb_lab_rate_ucs.table; 10 x 20 mm fem: 47-520 CPU s per creep row, the 0.4 rows the dearest): about 1.5 h on one core"
-  [fem_mesh]="docs/studies/paper_fem.md mesh resolution: 10 x 20 mm fem UCS at 2 and 3 bonds per face (the first 6 rows of params/fem_size_mesh_ucs.table: 94-164 and about 500 CPU s) and the creep rows at 0.7 and 0.85 of each run's own UCS that studies/fem_size_mesh.py writes from them"
+  [fem_mesh]="docs/studies/paper_fem.md mesh resolution: 10 x 20 mm fem UCS at 2 and 3 bonds per face (the 10 x 20 mm rows of params/fem_size_mesh_ucs.table: 94-164 and about 500 CPU s) and the creep rows at 0.7 and 0.85 of each run's own UCS that studies/fem_size_mesh.py writes from them"
   [lab_disc_size]="docs/studies/lab_calibration.md disc-size probe: fem Brazilian discs of 10, 20 and 31.7 mm (params/lab_disc_size.table, 14 discs: 43-57 CPU s at 10 mm, 6-12 CPU min at 20 mm, 31.7 mm not measured)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
@@ -112,7 +112,7 @@ run_target() {
                $PY -m grainfrac_yade analyze results/ldb_lab_creep
                $PY -m grainfrac_yade analyze results/lab_corner_creep
                $PY -m grainfrac_yade analyze-ucs results/ldb_lab_rate_ucs ;;
-    fem_mesh) mkdir -p results && head -16 params/fem_size_mesh_ucs.table > results/fem_size_mesh_ucs_10mm.table
+    fem_mesh) mkdir -p results && grep -v "'w20_" params/fem_size_mesh_ucs.table > results/fem_size_mesh_ucs_10mm.table
               $PY -m grainfrac_yade batch results/fem_size_mesh_ucs_10mm.table --jobs 1 --test ucs
               $PY -m grainfrac_yade analyze-ucs results/fem_size_mesh_ucs
               $PY -m studies.fem_size_mesh results/fem_size_mesh_ucs --out results/fem_mesh_creep.table

@@ -224,26 +224,25 @@ FIT_METHOD = "the least-squares optimum of the response surface fitted to"
 BEST_METHOD = "design point {point}, the one whose measured seed means lie nearest the lab's targets, of"
 
 
-def measured_cost(rows) -> tuple:
-    """(points, seed means (m, 5), weighted residuals (m, 5), sum of their squares (m,)): each design point's
-    measured distance from the lab's targets; a point with an observable not measured has cost NaN."""
-    points, _, y = point_means(rows)
-    resid = lab_fit.weighted_residuals(lab_fit.scaled(y), lab_fit.lab_targets())
+def measured_cost(rows, targets) -> tuple:
+    """(points, u (m, 5), seed means (m, 5), weighted residuals (m, 5), sum of their squares (m,)): each
+    design point's measured distance from ``targets``; a point with an observable not measured has cost NaN."""
+    points, u, y = point_means(rows)
+    resid = lab_fit.weighted_residuals(lab_fit.scaled(y), targets)
     cost = np.where(np.isfinite(resid).all(axis=1), np.nansum(resid ** 2, axis=1), np.nan)
-    return points, y, resid, cost
+    return points, u, y, resid, cost
 
 
-def best_point(csv_path: Path) -> dict:
-    """The design point nearest the lab as measured (:func:`measured_cost`), as a result of the form of
-    :func:`fit`: its keys, and its design seed means as what is expected before the check."""
-    rows = _rows(csv_path)
-    points, y, resid, cost = measured_cost(rows)
+def best_point(rows, csv_path: Path) -> dict:
+    """The design point of ``rows`` (read from ``csv_path``) nearest the lab as measured
+    (:func:`measured_cost`), as a result of the form of :func:`fit`: its keys, and its design seed means as
+    what is expected before the check."""
+    targets = lab_fit.lab_targets()
+    points, us, y, resid, cost = measured_cost(rows, targets)
     if not np.isfinite(cost).any():
         raise SystemExit(f"{csv_path}: no design point has all five observables measured; fix: run the design first")
     k = int(np.nanargmin(cost))
-    targets = lab_fit.lab_targets()
-    u = np.array([float(next(r for r in rows if int(r["point"]) == points[k])[f"u_{v.name}"])
-                  for v in lab_fit.FIT_VARIABLES])
+    u = us[k]
     return {
         "design_csv": str(csv_path), "n_points": len(points), "design_point": points[k],
         "method": BEST_METHOD.format(point=points[k]),
@@ -350,10 +349,11 @@ def main(argv=None) -> int:
                                                   "predicted_weighted_residuals")}, indent=1))
         return 0
     if args.part == "best":
-        result = best_point(Path(args.csv))
+        rows = _rows(Path(args.csv))
+        result = best_point(rows, Path(args.csv))
         Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
         if args.verify_csv and not Path(args.verify_csv).exists():
-            chosen = [dict(r, point=-1) for r in _rows(Path(args.csv)) if int(r["point"]) == result["design_point"]]
+            chosen = [dict(r, point=-1) for r in rows if int(r["point"]) == result["design_point"]]
             _write(Path(args.verify_csv), chosen)
         print(json.dumps({k: result[k] for k in ("design_point", "candidate_overrides", "predicted",
                                                   "predicted_weighted_residuals")}, indent=1))

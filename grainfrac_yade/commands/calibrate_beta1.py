@@ -41,14 +41,14 @@ def beta1_factor(lifetimes, target_s: float) -> dict:
 def select_reference_runs(runs, stress_pa: float):
     """Event-clock creep runs of a strength law at ``stress_pa`` that failed in creep: a positive lifetime,
     as the lifetime analysis classifies them (a run that ran away at creep time 0 failed at load)."""
-    from ..analysis.lifetimes import outcome
+    from ..analysis.lifetimes import classify_runs
     from ..law import scales_with_beta1
     from ..errors import GrainfracError
     need = ("stress_pa", "lifetime_s", "failed", "clock", "law")
     if runs.empty or any(c not in runs for c in need):
         raise GrainfracError("no finished creep runs in the folder; fix: run params/lifetime_ldb.table first")
-    failed_in_creep = np.array([outcome(r) == "failed" for r in runs.to_dict("records")], bool)
-    sel = runs[failed_in_creep
+    runs = classify_runs(runs)
+    sel = runs[(runs["outcome"] == "failed")
                & np.isclose(runs["stress_pa"].astype(float), stress_pa, rtol=STRESS_MATCH_RTOL, atol=0)
                & (runs["clock"] == "event") & runs["law"].map(scales_with_beta1).astype(bool)]
     if len(sel) < 2:
