@@ -44,7 +44,7 @@ def renamed_key_fix(dotted: str) -> str | None:
 
 #: Keys added to the schema after runs were made, with the value every run before had by construction
 #: (no such knob then): params.json of older runs read them so (:func:`migrate_tree`).
-ADDED_KEYS = {"specimen.min_edge_fraction": 0.0, "numerics.keep_intact_joints": False,
+ADDED_KEYS = {"numerics.engine": "yade", "specimen.min_edge_fraction": 0.0, "numerics.keep_intact_joints": False,
               "creep.servo_response_crossings": 0.0, "creep.max_relaxation_crossings": 0.0,
               "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
               "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0}

@@ -178,8 +178,7 @@ def scene_arrays(scene) -> dict:
 
 
 def platen_state(platens) -> dict:
-    return {"velocity": platens.velocity, "y0_top": float(platens.y0_top), "y0_bottom": float(platens.y0_bottom),
-            "x0_gap": float(platens.x0_gap), "reaction_pa": float(platens.axial_stress())}
+    return platens.state_dict()
 
 
 def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") -> tuple:
@@ -244,25 +243,7 @@ def read(run_folder, test: str = "creep") -> tuple:
 
 def rebind_scene(scene):
     """After ``O.load``: fetch the scene's bond and link interactions and its law and integrator anew."""
-    from yade import wrapper as w
-    O = scene.O
-    body = scene.sphere_body
-
-    def pairs(spheres):
-        out = []
-        for i, j in spheres:
-            try:
-                out.append(O.interactions[int(body[i]), int(body[j])])
-            except (IndexError, KeyError, RuntimeError, ValueError):
-                raise GrainfracError(f"checkpoint: no interaction between bodies {int(body[i])} and {int(body[j])} "
-                                     "after O.load; fix: start the run again with --overwrite") from None
-        return out
-
-    scene.interactions = pairs(scene.layout.bond_spheres)
-    loops = [e for e in O.engines if isinstance(e, w.InteractionLoop)]
-    scene.law = next(f for f in loops[0].lawDispatcher.functors
-                     if isinstance(f, w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM))
-    scene.newton = next(e for e in O.engines if isinstance(e, w.NewtonIntegrator))
+    scene.rebind()
 
 
 def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .scene import check_value, mean_bond_force, resultant_forces
+from .measures import check_value, mean_bond_force, resultant_forces
 
 #: DOFs blocked on platen cells: y prescribed, z and all rotations blocked (pseudo-2D, flat platen).
 PLATEN_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -68,6 +68,11 @@ class Platens:
             for bodies in (self._top_bodies, self._bottom_bodies, self._left_bodies, self._right_bodies))
         self._cache_handles()
         self._restored_reaction = (O.iter, float(reaction))
+
+    def state_dict(self) -> dict:
+        """Speed, reference positions and the last reaction [Pa] (what a checkpoint keeps of the platens)."""
+        return {"velocity": self.velocity, "y0_top": float(self.y0_top), "y0_bottom": float(self.y0_bottom),
+                "x0_gap": float(self.x0_gap), "reaction_pa": float(self.axial_stress())}
 
     def _cache_handles(self):
         """Body ids and state handles of the platen bodies, fetched once: the servo reads their forces

@@ -28,17 +28,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..engines import SceneState
 from ..errors import GrainfracError, NumericalFailure
 from ..grains import GrainModel, layout_for, model_of
-from ..law import check_finite
+from ..law import MODE_NEVER, MODE_SHEAR, MODE_TENSION
 from ..layout import BondProperties, ClumpLayout, bond_properties
 from ..params import Parameters
 from ..specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
+from .confinement import Confinement
 from .joints import IntactJointGuard
+from .platens import Platens
+from .measures import BOND_FORCE_SAMPLE, check_value, mean_bond_force, resultant_forces  # noqa: F401
 
-#: Bond break modes, the codes of YADE's JCFpm crack file.
-INTACT, TENSION, SHEAR = 0, 1, 2
+#: Bond break modes: the degradation laws' codes (:mod:`grainfrac_yade.law`), which are YADE's JCFpm crack file's.
+INTACT, TENSION, SHEAR = MODE_NEVER, MODE_TENSION, MODE_SHEAR
 #: Material type shared by all cells: JCFpm bonds only form between equal types.
 COHESIVE_TYPE = 1
 #: The YADE side of each grain model, by ``ClumpLayout.model`` (the same names as :mod:`grainfrac_yade.grains`).
@@ -79,6 +83,12 @@ class GrainScene:
     #: bonds YADE's smooth-joint law erased by their cumulative sliding path, not by a strength
     #: criterion (:mod:`.joints`), as far as synced; :meth:`sliding_erasures` adds those not synced yet
     erased_by_sliding: int = 0
+    #: steps and time of the state a scene was built from (:func:`scene_from_state`), added to YADE's
+    #: ``O.iter`` and ``O.time`` (which cannot be set); 0 for a scene built from the specimen
+    step_offset: int = 0
+    time_offset: float = 0.0
+    #: (n_nodes, 3) where the nodes were built [m] (:meth:`node_bodies`), the origin of their displacements
+    node_origin: np.ndarray = None
     _cracks_seen: int = 0
     _tens_seen: int = 0
 
@@ -117,7 +127,39 @@ class GrainScene:
         """YADE engines (class names), then the Python-side drivers and extras."""
         return [type(e).__name__ for e in self.O.engines] + [d.name for d in self.drivers + self.extras]
 
+    def counts(self) -> dict:
+        """YADE's bodies, real interactions and the breakable bonds."""
+        return {"n_bodies": len(self.O.bodies), "n_interactions": self.O.interactions.countReal(),
+                "n_bonds": self.n_bonds}
+
+    # ------------------------------------------------------------------ counters
+    @property
+    def steps(self) -> int:
+        """DEM steps so far (``O.iter``, from the state the scene was built from)."""
+        return self.O.iter + self.step_offset
+
+    @property
+    def time(self) -> float:
+        """DEM time so far [s] (``O.time``, from the state the scene was built from)."""
+        return self.O.time + self.time_offset
+
+    @property
+    def dt(self) -> float:
+        """The DEM step [s]."""
+        return self.O.dt
+
     # ------------------------------------------------------------------ stepping
+    def equilibrate(self, balanced, check_steps: int, max_steps: int):
+        """Dynamic relaxation: DEM steps under the current loads, ``check_steps`` at a time, until
+        ``balanced()``; the steps it took, None if it did not hold within ``max_steps``."""
+        done = 0
+        while done < max_steps:
+            self.run(check_steps)
+            done += check_steps
+            if balanced():
+                return done
+        return None
+
     def run(self, n_steps: int):
         """Advance ``n_steps`` DEM steps; drivers act before each step, breaks are synced after.
 
@@ -160,7 +202,7 @@ class GrainScene:
             self.break_mode[k] = mode
             phys.tanFrictionAngle = float(self.tan_residual[k])
         self.broken[new] = True
-        self.break_step[new] = self.O.iter
+        self.break_step[new] = self.steps
         self._cracks_seen = n_tens + n_shear
         self._tens_seen = n_tens
         return new
@@ -186,9 +228,32 @@ class GrainScene:
             ph.tanFrictionAngle = float(self.tan_residual[k])
             self.broken[k] = True
             self.break_mode[k] = mode
-            self.break_step[k] = self.O.iter
+            self.break_step[k] = self.steps
+
+    def write_bond_strengths(self, indices, tensile, cohesion):
+        """Intact bonds ``indices`` carry ``tensile`` strength and ``cohesion`` [Pa] per intact area from now on
+        (JCFpm's ``FnMax``, ``FsMax``: strength x area); broken bonds keep none."""
+        area = self.layout.bond_area
+        for k, jt, jc in zip(np.atleast_1d(indices), np.atleast_1d(tensile), np.atleast_1d(cohesion)):
+            ph = self.interactions[int(k)].phys
+            if ph.isCohesive:
+                ph.FnMax, ph.FsMax = float(jt * area[k]), float(jc * area[k])
 
     # ------------------------------------------------------------------ reading state
+    def bond_stresses(self, indices=None):
+        """(normal stress, tension positive; shear stress) [Pa] per intact area of bonds ``indices``."""
+        idx = np.arange(self.n_bonds) if indices is None else np.asarray(indices, dtype=np.int64)
+        fn, fs = self.bond_forces(idx)
+        area = self.layout.bond_area[idx]
+        return fn / area, fs / area
+
+    def bond_strengths(self, indices=None):
+        """(tensile strength, cohesion) [Pa] per intact area that bonds ``indices`` carry now (0 once broken)."""
+        idx = np.arange(self.n_bonds) if indices is None else np.asarray(indices, dtype=np.int64)
+        cap = np.array([(self.interactions[k].phys.FnMax, self.interactions[k].phys.FsMax) for k in idx]).reshape(-1, 2)
+        area = self.layout.bond_area[idx]
+        return cap[:, 0] / area, cap[:, 1] / area
+
     def bond_forces(self, indices=None):
         """Normal force (tension positive) and shear force magnitude [N] of bonds.
 
@@ -227,38 +292,140 @@ class GrainScene:
         cells = np.arange(self.specimen.n_cells) if cells is None else np.asarray(cells)
         return self.cells.cell_positions(self, cells)
 
+    # ------------------------------------------------------------------ platens and confinement
+    def attach_platens(self, lateral: str = "free") -> Platens:
+        """Rigid platens on the end cells (:class:`.platens.Platens`), listed among the scene's engines."""
+        platens = Platens(self, lateral)
+        self.extras.append(platens)
+        return platens
+
+    def confine(self, stress: float) -> Confinement:
+        """Confining stress sigma_3 [Pa] on the side walls (:class:`.confinement.Confinement`: permanent forces)."""
+        confinement = Confinement(self, stress)
+        self.extras.append(confinement)
+        return confinement
+
+    # ------------------------------------------------------------------ state
+    def node_bodies(self) -> np.ndarray:
+        """The bodies that move the cells, cell by cell (one per rigid cell, one per sphere of an fem cell)."""
+        return np.concatenate([np.atleast_1d(b) for b in self.cell_bodies]).astype(np.int64)
+
+    def node_cells(self) -> np.ndarray:
+        """The cell of each of :meth:`node_bodies`."""
+        return np.repeat(np.arange(len(self.cell_bodies)), [len(np.atleast_1d(b)) for b in self.cell_bodies])
+
+    def node_positions(self) -> np.ndarray:
+        """(n_nodes, 3) current positions of :meth:`node_bodies` [m]."""
+        bodies = self.O.bodies
+        return np.array([tuple(bodies[int(b)].state.pos) for b in self.node_bodies()])
+
+    def save(self, path):
+        """``O.save``: YADE's whole scene (bodies, interactions, engines, counters; no forces), exact doubles."""
+        self.O.save(str(path))
+
+    def restore(self, path):
+        """``O.load`` of a scene :meth:`save` wrote from a scene of the same specimen and parameters, and the
+        handles fetched anew (:func:`.checkpoint.rebind_scene`); the bond bookkeeping is the caller's."""
+        self.O.load(str(path))
+        self.rebind()
+
+    def rebind(self):
+        """After ``O.load``: fetch the bond interactions, the law and the integrator anew (the replaced scene's
+        handles are stale); GrainfracError if a bond's interaction is missing."""
+        from yade import wrapper as w
+        O = self.O
+        body = self.sphere_body
+
+        def pairs(spheres):
+            out = []
+            for i, j in spheres:
+                try:
+                    out.append(O.interactions[int(body[i]), int(body[j])])
+                except (IndexError, KeyError, RuntimeError, ValueError):
+                    raise GrainfracError(f"checkpoint: no interaction between bodies {int(body[i])} and "
+                                         f"{int(body[j])} after O.load; fix: start the run again with --overwrite") from None
+            return out
+
+        self.interactions = pairs(self.layout.bond_spheres)
+        loops = [e for e in O.engines if isinstance(e, w.InteractionLoop)]
+        self.law = next(f for f in loops[0].lawDispatcher.functors
+                        if isinstance(f, w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM))
+        self.newton = next(e for e in O.engines if isinstance(e, w.NewtonIntegrator))
+
+    def export_state(self, platens=None) -> SceneState:
+        """The scene's state in the engine-neutral form (:class:`grainfrac_yade.engines.SceneState`)."""
+        bodies = self.O.bodies
+        states = [bodies[int(b)].state for b in self.node_bodies()]
+        pos = np.array([tuple(st.pos) for st in states]).reshape(-1, 3)
+        phys = [i.phys for i in self.interactions]
+        normal = np.array([tuple(ph.normalForce) for ph in phys]).reshape(-1, 3)
+        shear = np.array([tuple(ph.shearForce) for ph in phys]).reshape(-1, 3)
+        return SceneState(
+            steps=int(self.steps), time=float(self.time), node_cell=self.node_cells(), node_position=pos,
+            node_displacement=pos - self.node_origin,
+            node_velocity=np.array([tuple(st.vel) for st in states]).reshape(-1, 3),
+            node_rotation=np.array([_z_angle(st.ori) for st in states]),
+            node_angular_velocity=np.array([st.angVel[2] for st in states]),
+            bond_broken=self.broken.copy(), bond_mode=self.break_mode.copy(), bond_break_step=self.break_step.copy(),
+            bond_tensile_capacity=np.array([ph.FnMax for ph in phys]),
+            bond_cohesive_capacity=np.array([ph.FsMax for ph in phys]),
+            bond_normal_stiffness=np.array([ph.kn for ph in phys]), bond_shear_stiffness=np.array([ph.ks for ph in phys]),
+            bond_tan_friction=np.array([ph.tanFrictionAngle for ph in phys]),
+            bond_normal_force=-normal, bond_shear_force=-shear,
+            bond_reference_gap=np.array([ph.initD for ph in phys]),
+            bond_slip=np.array([ph.jointCumulativeSliding for ph in phys]),
+            platens=None if platens is None else platens.state_dict())
+
+    def apply_state(self, state: SceneState):
+        """Put ``state`` (of a scene of the same specimen, layout and parameters, from any engine) into this
+        freshly built scene, before its first step: nodes, bonds, counters.  The bonds are marked as not
+        fresh, so that YADE's law keeps their reference gap and forces instead of zeroing them."""
+        nodes = self.node_bodies()
+        if len(nodes) != len(state.node_position) or self.n_bonds != len(state.bond_broken):
+            raise GrainfracError(f"a state of {len(state.node_position)} nodes and {len(state.bond_broken)} bonds "
+                                 f"does not fit this scene ({len(nodes)} nodes, {self.n_bonds} bonds); fix: build "
+                                 "the scene from the specimen, layout and parameters the state was made with")
+        from yade import Quaternion, Vector3
+        bodies = self.O.bodies
+        for n, b in enumerate(nodes):
+            body = bodies[int(b)]
+            st = body.state
+            st.pos = Vector3(*state.node_position[n])
+            st.ori = Quaternion(Vector3(0, 0, 1), float(state.node_rotation[n]))
+            st.vel = Vector3(*state.node_velocity[n])
+            st.angVel = Vector3(0, 0, float(state.node_angular_velocity[n]))
+            if body.isClump:   # members follow the clump's pose (YADE moves them only in a step)
+                for member, (rel_pos, rel_ori) in body.shape.members.items():
+                    ms = bodies[member].state
+                    ms.pos = st.pos + st.ori * rel_pos
+                    ms.ori = st.ori * rel_ori
+        for k, inter in enumerate(self.interactions):
+            ph = inter.phys
+            ph.FnMax, ph.FsMax = float(state.bond_tensile_capacity[k]), float(state.bond_cohesive_capacity[k])
+            ph.kn, ph.ks = float(state.bond_normal_stiffness[k]), float(state.bond_shear_stiffness[k])
+            ph.tanFrictionAngle = float(state.bond_tan_friction[k])
+            ph.normalForce = Vector3(*(-state.bond_normal_force[k]))
+            ph.shearForce = Vector3(*(-state.bond_shear_force[k]))
+            ph.initD = float(state.bond_reference_gap[k])
+            ph.jointCumulativeSliding = float(state.bond_slip[k])
+            if state.bond_broken[k]:
+                ph.isCohesive, ph.isBroken = False, True
+            inter.iterMadeReal = -1   # not fresh: the law would reset initD and the forces in the next step
+        self.broken = np.array(state.bond_broken, dtype=bool)
+        self.break_mode = np.array(state.bond_mode, dtype=np.int8)
+        self.break_step = np.array(state.bond_break_step, dtype=np.int64)
+        self.step_offset, self.time_offset = int(state.steps), float(state.time)
+
     def cell_forces(self, cells) -> np.ndarray:
         """(n, 3) resultant interaction force on each cell (summed over its bodies) from the last step [N]."""
         f = self.O.forces.f
         return np.array([np.sum([tuple(f(int(b))) for b in self.bodies_of([c])], axis=0) for c in cells])
 
 
-def check_value(name, value, dem_step):
-    """NumericalFailure if a measured value is NaN or infinite."""
-    if not math.isfinite(value):
-        raise NumericalFailure(f"{name} is {value} at DEM step {dem_step}")
-
-
-def resultant_forces(scene, body_ids) -> tuple:
-    """(largest, mean) resultant force on ``body_ids`` from the last DEM step [N]; NumericalFailure
-    if one is NaN or infinite."""
-    f = scene.O.forces.f
-    res = np.array([f(b).norm() for b in body_ids])
-    check_finite("resultant force", res, body_ids, item="body")
-    return res.max(), res.mean()
-
-
-#: Bonds sampled for the mean bond force (every k-th of the given ones, k = len // this).
-BOND_FORCE_SAMPLE = 500
-
-
-def mean_bond_force(scene, bonds) -> float:
-    """Mean magnitude of the bond force [N] over a sample of ``bonds`` (about BOND_FORCE_SAMPLE of
-    them), the scale that unbalanced forces are measured against; 0 if there are none."""
-    sample = bonds[:: max(1, len(bonds) // BOND_FORCE_SAMPLE)]
-    fn, fs = scene.bond_forces(sample)
-    check_finite("bond force", np.hypot(fn, fs), sample)
-    return float(np.mean(np.hypot(fn, fs))) if len(sample) else 0.0
+def _z_angle(ori) -> float:
+    """Rotation [rad] of a quaternion about z (a plane model's bodies rotate about z only)."""
+    axis, angle = ori.toAxisAngle()
+    return float(angle if axis[2] >= 0 else -angle)
 
 
 def broken_counts(scene, broken=None) -> dict:
@@ -291,6 +458,14 @@ def verlet_distance(layout: ClumpLayout, numerics) -> float:
     if numerics.verlet_radius_quantile == 0:
         return -numerics.verlet_fraction
     return float(numerics.verlet_fraction * np.quantile(layout.sphere_radius, numerics.verlet_radius_quantile))
+
+
+def scene_from_state(specimen: Specimen, params: Parameters, state: SceneState,
+                     layout: ClumpLayout | None = None) -> GrainScene:
+    """A YADE scene of ``specimen`` in ``state`` (:meth:`GrainScene.export_state` of this or another engine)."""
+    scene = build_scene(specimen, params, layout)
+    scene.apply_state(state)
+    return scene
 
 
 def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | None = None) -> GrainScene:
@@ -356,6 +531,7 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
                        cell_body=bodies.cell_body, cell_bodies=bodies.cell_bodies, sphere_body=bodies.sphere_body,
                        interactions=interactions, law=law, newton=newton, model=model, cells=cells,
                        dt_critical=dt_crit)
+    scene.node_origin = scene.node_positions()
     if model.bonds_on_faces and params.numerics.keep_intact_joints:
         scene.drivers.append(IntactJointGuard(scene))
     return scene

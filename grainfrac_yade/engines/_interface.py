@@ -1,0 +1,200 @@
+"""What every mechanical engine offers the test protocols: a scene, and its state in an engine-neutral form.
+
+An engine turns a specimen, its parameters and a grain layout (:mod:`grainfrac_yade.grains`) into a
+*scene*: bodies (the grain model's nodes) joined by breakable bonds (one per layout bond, Table 2),
+loaded by platens.  Two kinds are meant to implement it:
+
+* a dynamic engine (YADE, :mod:`grainfrac_yade.yade_adapter`): explicit integration of Newton's law
+  with Cundall's non-viscous damping; :meth:`Scene.run` advances DEM steps and
+  :meth:`Scene.equilibrate` is dynamic relaxation until the project's equilibrium criterion (mean
+  resultant force on the free bodies over the mean bond force, ``creep.equilibrium_tolerance``);
+* a quasi-static engine: :meth:`Scene.run` applies load increments, each solved, and
+  :meth:`Scene.equilibrate` is one solve.
+
+Counters: :attr:`Scene.steps` counts DEM steps (dynamic) or solves (static); :attr:`Scene.time` is
+the engine's own time (DEM time; a static engine's load parameter), both written to the histories
+as ``step`` and ``time_s``.  Creep time is separate from both (the clocks of :mod:`grainfrac_yade.clocks`).
+
+Bond quantities follow the layout's bond order (``layout.bond_spheres``): forces in N, tension
+positive for the normal force; strengths per intact bond area ``layout.bond_area`` in Pa; break
+modes the codes of :mod:`grainfrac_yade.law` (``MODE_TENSION``, ``MODE_SHEAR``).
+
+:class:`SceneState` is the state that one engine exports (:meth:`Scene.export_state`) and another
+builds its scene from (the engine module's ``scene_from_state``), so that a run can change engine
+mid-way, e.g. a quasi-static engine handing a collapse to a dynamic one and taking the result back.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Callable, Protocol, runtime_checkable
+
+import numpy as np
+
+
+@dataclass
+class SceneState:
+    """The mechanical state of a scene, engine-neutral (numpy arrays; SI units).
+
+    Nodes are the grain model's moving bodies, cell by cell (``node_cell``): one per rigid cell, one
+    per sphere of an fem cell.  Positions are in the specimen's frame; displacements from where the
+    scene was built; rotations about the out-of-plane axis z [rad].  Velocities are zero for a static
+    engine (and read as such by a dynamic one: a relaxed state).
+
+    Bonds follow the layout's bond order.  ``bond_normal_force`` and ``bond_shear_force`` are the
+    force vectors the bond's second sphere exerts on its first [N], in the specimen's frame;
+    ``bond_reference_gap`` the bond's stress-free normal gap (overlap positive) [m]; ``bond_slip`` the
+    path the bond's faces slid [m] (0 where an engine does not track it).  Capacities are what the
+    bond can carry now [N], in tension and in cohesion (strength x intact area ``layout.bond_area``;
+    0 once broken), kept as forces so that a state passes between engines bit for bit.
+    ``platens``: the platens' state (reference positions, speed, last reaction), None without platens.
+    """
+    steps: int
+    time: float
+    node_cell: np.ndarray
+    node_position: np.ndarray
+    node_displacement: np.ndarray
+    node_velocity: np.ndarray
+    node_rotation: np.ndarray
+    node_angular_velocity: np.ndarray
+    bond_broken: np.ndarray
+    bond_mode: np.ndarray
+    bond_break_step: np.ndarray
+    bond_tensile_capacity: np.ndarray
+    bond_cohesive_capacity: np.ndarray
+    bond_normal_stiffness: np.ndarray
+    bond_shear_stiffness: np.ndarray
+    bond_tan_friction: np.ndarray
+    bond_normal_force: np.ndarray
+    bond_shear_force: np.ndarray
+    bond_reference_gap: np.ndarray
+    bond_slip: np.ndarray
+    platens: dict | None = field(default=None)
+
+    def arrays(self) -> dict:
+        """The array fields by name (for an ``.npz``)."""
+        return {f.name: np.asarray(getattr(self, f.name)) for f in fields(self) if f.name != "platens"}
+
+    @classmethod
+    def from_arrays(cls, arrays: dict, platens: dict | None = None) -> "SceneState":
+        """The inverse of :meth:`arrays` (``steps`` and ``time`` back as Python numbers)."""
+        values = {k: np.asarray(arrays[k]) for k in (f.name for f in fields(cls)) if k != "platens"}
+        values["steps"], values["time"] = int(values["steps"]), float(values["time"])
+        return cls(**values, platens=platens)
+
+    def differences(self, other: "SceneState") -> list:
+        """Names of the fields in which ``other`` differs from this state, bit for bit ([] if none)."""
+        out = [name for name, a in self.arrays().items()
+               if not np.array_equal(a, other.arrays()[name], equal_nan=a.dtype.kind == "f")]
+        return out + (["platens"] if self.platens != other.platens else [])
+
+
+@runtime_checkable
+class PlatenDrive(Protocol):
+    """The rigid platens on the top and bottom cells of a specimen (and its side cells' measures)."""
+    height: float
+    velocity: float
+
+    def set_axial_velocity(self, closing_speed: float) -> None:
+        """Displacement control: the platens approach each other at ``closing_speed`` [m/s] (half each)."""
+
+    def shift(self, closing: float) -> None:
+        """Move the platens towards each other by ``closing`` [m] in one jump."""
+
+    def axial_strain(self) -> float:
+        """Platen closure over the specimen's height (shortening positive) [1]."""
+
+    def lateral_strain(self) -> float:
+        """Change of the side cells' distance over the width (compression positive) [1]."""
+
+    def axial_stress(self) -> float:
+        """Mean reaction of the two platens over the cross-section (compression positive) [Pa]."""
+
+
+@runtime_checkable
+class Scene(Protocol):
+    """A built scene of one engine: what the test protocols read and drive.
+
+    Attributes every scene has: ``specimen``, ``layout``, ``params``, ``n_bonds``, and the per-bond
+    bookkeeping ``broken`` (bool), ``break_mode`` (law's mode codes) and ``break_step`` (the
+    :attr:`steps` count at the break, -1 if intact).
+    """
+    specimen: object
+    layout: object
+    params: object
+    broken: np.ndarray
+    break_mode: np.ndarray
+    break_step: np.ndarray
+
+    # ------------------------------------------------------------------ counters
+    @property
+    def steps(self) -> int:
+        """DEM steps (dynamic engine) or solves (static engine) so far."""
+
+    @property
+    def time(self) -> float:
+        """The engine's time [s]: DEM time, or a static engine's load parameter."""
+
+    @property
+    def n_bonds(self) -> int:
+        """Breakable bonds (the layout's)."""
+
+    # ------------------------------------------------------------------ advancing
+    def run(self, n_steps: int) -> None:
+        """Advance ``n_steps`` steps (DEM steps, or solved load increments); breaks are synced after each."""
+
+    def equilibrate(self, balanced: Callable[[], bool], check_steps: int, max_steps: int) -> int | None:
+        """Bring the scene to equilibrium under its current loads: the steps it took, None if
+        ``balanced()`` did not hold within ``max_steps`` (dynamic relaxation, checked every
+        ``check_steps``; a static engine solves once)."""
+
+    # ------------------------------------------------------------------ bonds
+    def bond_forces(self, indices=None) -> tuple:
+        """(normal force, tension positive; shear force magnitude) [N] of bonds ``indices`` (all: None)."""
+
+    def bond_stresses(self, indices=None) -> tuple:
+        """(normal stress, tension positive; shear stress) [Pa] per intact area of bonds ``indices``."""
+
+    def bond_strengths(self, indices=None) -> tuple:
+        """(tensile strength, cohesion) [Pa] per intact area that bonds ``indices`` carry now."""
+
+    def write_bond_strengths(self, indices, tensile, cohesion) -> None:
+        """Set what intact bonds ``indices`` can carry: tensile strength and cohesion [Pa] per intact area."""
+
+    def break_bonds(self, indices, mode: int) -> None:
+        """Break bonds ``indices`` in ``mode``: no cohesion or tension left, residual friction."""
+
+    def bond_separated(self, indices) -> np.ndarray:
+        """(n,) True where a bond's crack is open (its spheres further apart than when it was made)."""
+
+    def sliding_erasures(self) -> int:
+        """Bonds that lost their cohesion by the engine's own rule rather than a strength criterion."""
+
+    # ------------------------------------------------------------------ cells, platens, confinement
+    def cell_positions(self, cells=None) -> np.ndarray:
+        """(n, 3) current positions of cells [m]."""
+
+    def attach_platens(self, lateral: str) -> PlatenDrive:
+        """Rigid platens on the end cells (``lateral``: "free" smooth or "fixed" rough), listed among the
+        scene's engines; their speed and forces are driven by the protocol."""
+
+    def confine(self, stress: float) -> object:
+        """Force control on the side walls: a lateral confining stress sigma_3 [Pa] held on the side cells."""
+
+    def engine_names(self) -> list:
+        """The engines and drivers acting on the scene, by name (what the run records)."""
+
+    def counts(self) -> dict:
+        """Sizes of the scene as the engine holds it: ``n_bodies``, ``n_interactions`` (real), ``n_bonds``."""
+
+    # ------------------------------------------------------------------ state
+    def save(self, path) -> None:
+        """Write the engine's whole scene to ``path`` (a checkpoint: resuming from it is exact)."""
+
+    def restore(self, path) -> None:
+        """Replace this scene (built from the same specimen and parameters) by the one saved at ``path``."""
+
+    def export_state(self, platens: PlatenDrive | None = None) -> SceneState:
+        """The scene's state in the engine-neutral form (with ``platens``' state if given)."""
+
+
+__all__ = ["PlatenDrive", "Scene", "SceneState"]

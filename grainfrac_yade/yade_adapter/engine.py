@@ -1,0 +1,27 @@
+"""The YADE engine: what :func:`grainfrac_yade.engines.engine` returns for ``numerics.engine = "yade"``.
+
+Explicit DEM (YADE's JCFpm bonds, Cundall's non-viscous damping) with dynamic relaxation: a scene
+(:class:`.scene.GrainScene`, which implements :class:`grainfrac_yade.engines.Scene`) advances DEM
+steps, and equilibrium is reached by relaxing until the project's criterion holds.  Importing this
+module does not import YADE: :func:`.load_yade` does, when the first scene is built.
+
+The test runners (UCS, Brazilian, creep), their VTK series, the Brazilian levers, yade-batch rows and
+the timings of ``bench`` are this engine's, listed here so that the commands reach them through the
+engine registry and never import this package.
+"""
+from __future__ import annotations
+
+from . import load_yade, use_default_threads  # noqa: F401
+from .batch import read_table, row_errors, row_plan, run_folder_name  # noqa: F401
+from .bench_timing import TimedCreepRun, loading_step_cost, time_bond_io, time_stepping  # noqa: F401
+from .brazilian_protocol import resume_brazilian, run_brazilian  # noqa: F401
+from .creep_protocol import resume_creep, run_creep  # noqa: F401
+from .levers import Levers, new_breaks  # noqa: F401
+from .scene import GrainScene, build_scene, scene_from_state  # noqa: F401
+from .ucs_protocol import resume_ucs, run_ucs  # noqa: F401
+from .vtk_output import AXIAL_STRAIN, DIAMETRAL_STRAIN, StrainSeries, write_life_series  # noqa: F401
+
+#: The value of ``numerics.engine`` that selects this engine.
+NAME = "yade"
+#: Time-stepping dynamics (inertia, waves): the paper clock's unbalanced-force criterion needs it.
+DYNAMIC = True
