@@ -43,7 +43,7 @@ def guess_test(columns, name: str = "") -> str:
 
 def row_columns(test: str) -> dict:
     """The run-control columns of a kind of row, with defaults (parameters aside)."""
-    from ..yade_adapter.batch import RUN_COLUMNS
+    from ..runs.batchrun import RUN_COLUMNS
     if test == "creep":
         from .creep import CREEP_ROW_COLUMNS
         return dict(RUN_COLUMNS, **CREEP_ROW_COLUMNS)
@@ -53,9 +53,8 @@ def row_columns(test: str) -> dict:
 def check_row(test: str, columns, cells: dict, where: str):
     """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
     (one line, naming ``where``) if the row would be refused."""
-    from ..runs.batchrun import cell_value
+    from ..runs.batchrun import ON_CHANGE, cell_value, check_columns
     from ..params import load_parameters, shipped_values
-    from ..yade_adapter.batch import ON_CHANGE, check_columns
     defaults, controls = shipped_values(), row_columns(test)
     check_columns(columns, {**defaults, **controls}, where)
     values = {}

@@ -189,12 +189,13 @@ def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
     """Ramp, hold and relax one scene as a creep run does; time a few events, then its stepping and bond I/O."""
     from ..errors import GrainfracError
     from ..specimen import build_specimen
-    from ..yade_adapter.bench_timing import TimedCreepRun, time_bond_io, time_stepping
+    from ..engines import engine_for
+    engine = engine_for(params)
     stress = ratio * params.calibration.reference_ucs
     specimen = build_specimen(params, seed)
-    run = TimedCreepRun(specimen, params, stress, max_events=settings.events,
-                        at_hold=lambda r: {**time_stepping(r, settings.window_s, settings.repeats),
-                                           **time_bond_io(r.corr, settings.repeats)})
+    run = engine.TimedCreepRun(specimen, params, stress, max_events=settings.events,
+                               at_hold=lambda r: {**engine.time_stepping(r, settings.window_s, settings.repeats),
+                                                  **engine.time_bond_io(r.corr, settings.repeats)})
     run.run()
     if run.measured is None:
         raise GrainfracError(f"bench: the scene ({params.resolution.grain_model} cells, "
@@ -203,8 +204,8 @@ def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
     sc = run.scene
     return {
         "grain_model": params.resolution.grain_model, "spheres_per_cell": params.resolution.spheres_per_cell,
-        "stress_pa": stress, "n_cells": specimen.n_cells, "n_bodies": len(sc.O.bodies),
-        "n_bonds": sc.n_bonds, "n_interactions": len(sc.O.interactions), "dem_timestep_s": sc.O.dt,
+        "stress_pa": stress, "n_cells": specimen.n_cells, "n_bodies": sc.counts()["n_bodies"],
+        "n_bonds": sc.n_bonds, "n_interactions": sc.counts()["n_interactions_listed"], "dem_timestep_s": sc.dt,
         "ramp_steps": run.rows[0]["dem_steps"], "ramp_wall_s": run.ramp_wall_s,
         "steps_to_first_equilibrium": run.hold_steps, "equilibrium_at_hold": run.initial_bond_stresses is not None,
         "held_after_events": not run.failed,
@@ -218,14 +219,14 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
     """Creep to failure with the event and with the paper clock, one run each, same specimen and load.
 
     ``params_for_clock(clock)`` gives the parameters with ``stress_corrosion.clock`` set."""
+    from ..engines import engine_for
     from ..specimen import build_specimen
-    from ..yade_adapter.bench_timing import TimedCreepRun
     out = {}
     for clock in ("event", "paper"):
         params = params_for_clock(clock)
         stress = out["stress_pa"] = ratio * params.calibration.reference_ucs
         t0, c0 = time.perf_counter(), time.process_time()
-        run = TimedCreepRun(build_specimen(params, seed), params, stress)
+        run = engine_for(params).TimedCreepRun(build_specimen(params, seed), params, stress)
         run.run()
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         first, last = run.rows[0], run.rows[-1]
@@ -234,7 +235,7 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
             "failed": bool(run.failed), "numerical_failure": bool(run.numerical_failure),
             "failure_reason": run.failure_reason or "not failed",
             ("lifetime_s" if run.failed else "creep_time_end_s"): last["creep_time_s"],
-            "n_events": run.n_events, "dem_steps": int(run.scene.O.iter), "wall_s": wall, "cpu_s": cpu,
+            "n_events": run.n_events, "dem_steps": int(run.scene.steps), "wall_s": wall, "cpu_s": cpu,
             "creep_dem_steps": creep_steps, "creep_wall_s": creep_wall, "creep_steps_per_s": creep_steps / creep_wall,
         }
         if clock == "event":
@@ -260,7 +261,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
     from ..grains import critical_dem_step
     from ..runs.runio import code_version, write_json
     from ..specimen import build_specimen
-    from ..yade_adapter.bench_timing import loading_step_cost
+    from ..engines import engine_for
     progress = progress or (lambda msg: None)
     if creep_stress_mpa is not None and not creep_stress_mpa > 0:
         raise GrainfracError(f"--creep-stress {creep_stress_mpa}: a creep stress must be positive [MPa]; fix: e.g. "
@@ -287,7 +288,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
             row = {"specimen": name, "seed": seed, "n_cells": specimen.n_cells,
                    "edges_collapsed": specimen.edges_collapsed,
                    "critical_step_core_s": critical_dem_step(specimen, params),
-                   **loading_step_cost(specimen, params, FEM_WARMUP_STEPS, FEM_TIMED_STEPS)}
+                   **engine_for(params).loading_step_cost(specimen, params, FEM_WARMUP_STEPS, FEM_TIMED_STEPS)}
             result["scenes"].append(row)
             progress(f"fem {name}, seed {seed}: critical step {row['critical_step_s']:.3g} s, "
                      f"{row['dem_steps_per_cpu_s']:.1f} DEM steps / CPU s, "
@@ -306,13 +307,13 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
 def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
     """One paper-size finite-element creep run to failure (seed 1, event clock): lifetime or what ended it, DEM
     steps, CPU time, and the relaxation steps per event."""
+    from ..engines import engine_for
     from ..specimen import build_specimen
-    from ..yade_adapter.bench_timing import TimedCreepRun
     _, width, height = FEM_SIZES[-1]
     params = scene_params(extra_files, (FEM_PRESET,), [f"specimen.width={width}", f"specimen.height={height}",
                                                       *overrides], ("stress_corrosion.clock=event",))
     t0, c0 = time.perf_counter(), time.process_time()
-    run = TimedCreepRun(build_specimen(params, FEM_SEEDS[0]), params, stress)
+    run = engine_for(params).TimedCreepRun(build_specimen(params, FEM_SEEDS[0]), params, stress)
     run.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     last = run.rows[-1]
@@ -320,7 +321,7 @@ def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
            "failure_reason": run.failure_reason or "not failed",
            "held_after_ramp": run.initial_bond_stresses is not None,
            ("lifetime_s" if run.failed else "creep_time_end_s"): last["creep_time_s"], "n_events": run.n_events,
-           "dem_steps": int(run.scene.O.iter), "ramp_steps": run.rows[0]["dem_steps"], "wall_s": wall, "cpu_s": cpu,
+           "dem_steps": int(run.scene.steps), "ramp_steps": run.rows[0]["dem_steps"], "wall_s": wall, "cpu_s": cpu,
            "events": run.event_costs()}
     progress(f"paper-size fem creep at {stress / 1e6:.0f} MPa: {out['failure_reason']} at {last['creep_time_s']:.4g} s "
              f"creep time, {out['dem_steps']} DEM steps, {cpu:.0f} CPU s")
@@ -370,11 +371,11 @@ def cpu_model() -> str:
 
 def machine() -> dict:
     import numpy
-    from ..yade_adapter import load_yade
-    yade = load_yade()
+    from ..engines import ENGINE_NAMES, engine
     return {"cpu_model": cpu_model(), "cores": os.cpu_count(), "cores_usable": len(os.sched_getaffinity(0)),
             "omp_num_threads": os.environ.get("OMP_NUM_THREADS", "unset"), "python": platform.python_version(),
-            "yade": yade.config.version, "numpy": numpy.__version__, "platform": platform.platform()}
+            **{name: engine(name).version() for name in ENGINE_NAMES}, "numpy": numpy.__version__,
+            "platform": platform.platform()}
 
 
 # ------------------------------------------------------------------------------------------- table

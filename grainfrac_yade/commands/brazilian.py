@@ -63,7 +63,7 @@ def cmd_brazilian(args) -> int:
         if args.tensile_scale is not None:
             extra += tensile_scale_overrides(params, args.tensile_scale)
         params = _reload(args, extra, params, args.tensile_scale)
-    from ..yade_adapter.levers import Levers
+    from ..protocols.levers import Levers
     levers = Levers(slit_fraction=args.slit_fraction, strength_cv=args.strength_cv, block_rotation=args.block_rotation)
     out = args.out or f"results/brazilian_seed{args.seed}"
     summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers,
@@ -149,21 +149,20 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     from ..analysis.figures import run_brazilian_load_figure
     from ..specimen import build_disc_specimen
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
-    from ..yade_adapter.brazilian_protocol import resume_brazilian, run_brazilian
-    from ..yade_adapter.levers import Levers, new_breaks
+    from ..engines import engine_for
+    from ..protocols.levers import Levers, new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
     if resume:
         out = Path(out)
-        history, result, scene, (broken_peak, mode_peak) = resume_brazilian(specimen, params, out, progress=progress)
+        history, result, scene, (broken_peak, mode_peak) = engine_for(params).resume_brazilian(specimen, params, out,
+                                                                                               progress=progress)
     else:
         out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
         levers = levers or Levers()
-        snapshot = None
-        if vtk_every:
-            from ..yade_adapter.vtk_output import DIAMETRAL_STRAIN, StrainSeries
-            snapshot = StrainSeries(out / "vtk", vtk_every, DIAMETRAL_STRAIN)
-        history, result, scene, (broken_peak, mode_peak) = run_brazilian(
+        engine = engine_for(params)
+        snapshot = engine.StrainSeries(out / "vtk", vtk_every, engine.DIAMETRAL_STRAIN) if vtk_every else None
+        history, result, scene, (broken_peak, mode_peak) = engine.run_brazilian(
             specimen, params, progress=progress, levers=levers, checkpoint_folder=out,
             run_values={"seed": seed, "levers": levers.to_dict()}, snapshot=snapshot)
     t = specimen.tessellation
@@ -200,21 +199,14 @@ def write_disc_cracks(path, scene):
     """cracks.csv: one row per bond broken during the test (DEM step, mode, kind, position, orientation, and
     whether it lies in the central band); slits (:mod:`~grainfrac_yade.yade_adapter.levers`) are left out."""
     from ..brazilian_analysis import in_central_band
+    from ..protocols.cracks import crack_table
+    from ..protocols.levers import new_breaks
     from ..runs.runio import write_csv
-    from ..yade_adapter.levers import new_breaks
-    from ..yade_adapter.scene import SHEAR
     idx = np.flatnonzero(new_breaks(scene))
     t = scene.specimen.tessellation
-    normal = t.face_normal[scene.layout.bond_face[idx]]
-    points = scene.layout.bond_point[idx]
-    write_csv(path, {
-        "bond": idx, "dem_step": scene.break_step[idx],
-        "mode": np.where(scene.break_mode[idx] == SHEAR, "shear", "tensile"),
-        "kind": np.where(scene.bond_is_inter[idx], "inter", "intra"),
-        "x_m": points[:, 0], "y_m": points[:, 1],
-        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
-        "central_band": in_central_band(points, t.centre, t.diameter),
-    })
+    table = crack_table(scene, idx)
+    write_csv(path, {"bond": table.pop("bond"), "dem_step": scene.break_step[idx], **table,
+                     "central_band": in_central_band(scene.layout.bond_point[idx], t.centre, t.diameter)})
 
 
 def band_guides(tessellation) -> np.ndarray:
@@ -230,7 +222,8 @@ def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     """crack_map_peak.png (broken bonds at the failure load, the peak before the split) and crack_map_end.png
     (at the end of the test), with the central band's edges dashed."""
     from ..plotting import crack_map
-    from ..yade_adapter.scene import bond_segments
+    from ..protocols.cracks import bond_segments
+    from ..protocols.levers import new_breaks
     specimen, seed = scene.specimen, summary["seed"]
     guides = band_guides(specimen.tessellation)
     sigma = summary["tensile_strength_pa"]
@@ -239,7 +232,6 @@ def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     idx = np.flatnonzero(broken_peak)
     crack_map(specimen, out / "crack_map_peak.png", bond_segments(scene, idx), mode_peak[idx],
               title=f"cracks at {at}, seed {seed}", guides=guides)
-    from ..yade_adapter.levers import new_breaks
     idx = np.flatnonzero(new_breaks(scene))
     frac = summary["central_band_fraction"]
     crack_map(specimen, out / "crack_map_end.png", bond_segments(scene, idx), scene.break_mode[idx],
@@ -247,14 +239,15 @@ def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
                     "|x - x_c| <= D/6", guides=guides)
 
 
-def run_brazilian_in_yade():
+def run_brazilian_in_yade(rows):
     """Entry of ``yade_scripts/brazilian.py``: parameters from the batch row (or defaults); a finished row
     is skipped or stops as a UCS row does, an unfinished one with a checkpoint of this row (no levers)
-    goes on from it (:mod:`grainfrac_yade.yade_adapter.batch`)."""
+    goes on from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
+    ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.yade_adapter.batch`)."""
     from ..params import load_parameters
-    from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
+    from ..protocols.levers import Levers
     from ..runs.runio import read_checkpoint_state
-    from ..yade_adapter.levers import Levers
+    read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name
     with row_errors():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)

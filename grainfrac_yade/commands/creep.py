@@ -361,8 +361,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
                          write_json)
     from ..specimen import build_specimen
     from ..wave import budget_fields
-    from ..yade_adapter.creep_protocol import resume_creep, run_creep
-    from ..yade_adapter.scene import bond_segments, broken_counts
+    from ..engines import engine_for
+    from ..protocols.cracks import bond_segments, broken_counts
     t0, c0 = time.time(), time.process_time()
     require_plane(params, "creep")
     out = Path(out) if resume else prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
@@ -379,13 +379,14 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         vtk_fractions = (state.get("run_values") or {}).get("vtk_fractions")
         if vtk_fractions:
             run_values["vtk_fractions"] = vtk_fractions   # kept in the checkpoints written from here on
-        run = resume_creep(specimen, params, stress, out, progress=progress, **outputs)
+        run = engine_for(params).resume_creep(specimen, params, stress, out, progress=progress, **outputs)
         t0 -= state.get("wall_s", 0.0)   # wall time of the run up to its checkpoint
         c0 -= state.get("cpu_s", 0.0)    # CPU time of this process up to it (checkpoints older than the key: 0)
     else:
         if vtk_times is not None or vtk_every:
             outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times or (), vtk_every=vtk_every or 0)
-        run = run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
+        run = engine_for(params).run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out,
+                                           **outputs)
     numerical = bool(run.numerical_failure)
     no_test = numerical or run.failed_before_test   # no creep result: neither a lifetime nor a survival
     if ucs_source is None:   # a resumed run, or a caller that did not say: the calibrated value or one given
@@ -417,7 +418,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "bonds_erased_by_sliding": run.scene.sliding_erasures(),
         **budget_fields(getattr(run, "hold_budget", None)),
-        "dem_steps": int(run.scene.O.iter), "wall_s": time.time() - t0,
+        "dem_steps": int(run.scene.steps), "wall_s": time.time() - t0,
         "cpu_s": time.process_time() - c0,
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
@@ -436,8 +437,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         run_strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
     if vtk_fractions:
-        from ..yade_adapter.vtk_output import write_life_series
-        write_life_series(run, out / "vtk", [f * t_ref for f in vtk_fractions], vtk_fractions)
+        engine_for(params).write_life_series(run, out / "vtk", [f * t_ref for f in vtk_fractions], vtk_fractions)
         summary["vtk_life_fractions"] = [float(f) for f in vtk_fractions]
     for frac in MAP_FRACTIONS:
         t = frac * t_ref
@@ -470,7 +470,7 @@ def _row_before_history(run, counts) -> dict:
     """Stand-in history row (creep time 0, no strain) for a run that ended before its first row
     (a numerical failure during the ramp); never written to history.csv."""
     return {"creep_time_s": 0.0, "axial_strain": 0.0, "lateral_strain": 0.0, "axial_stress_pa": 0.0, **counts,
-            "macrocracks": 0, "dem_steps": int(run.scene.O.iter), "wall_s": 0.0}
+            "macrocracks": 0, "dem_steps": int(run.scene.steps), "wall_s": 0.0}
 
 
 def history_columns(rows) -> dict:
@@ -482,20 +482,16 @@ def write_crack_list(path, run):
     """cracks.csv: bond, creep time (empty for a crack of the ramp), phase (``ramp`` or ``creep``), mode, kind,
     position, orientation, segment end points and the creep time its cells separated (macrocrack; empty if
     never); docs/output_files.md."""
+    from ..protocols.cracks import bond_segments, crack_table
     from ..runs.runio import write_csv
-    from ..yade_adapter.scene import SHEAR, bond_segments
     sc = run.scene
     idx = np.flatnonzero(sc.broken)
-    normal = sc.specimen.tessellation.face_normal[sc.layout.bond_face[idx]]
     seg = bond_segments(sc, idx)
     ramp = run.break_time[idx] < 0   # the driver marks cracks of the ramp with a negative creep time
+    table = crack_table(sc, idx)
     write_csv(path, {
-        "bond": idx, "creep_time_s": np.where(ramp, np.nan, run.break_time[idx]),
-        "phase": np.where(ramp, "ramp", "creep"),
-        "mode": np.where(sc.break_mode[idx] == SHEAR, "shear", "tensile"),
-        "kind": np.where(sc.bond_is_inter[idx], "inter", "intra"),
-        "x_m": sc.layout.bond_point[idx, 0], "y_m": sc.layout.bond_point[idx, 1],
-        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
+        "bond": table.pop("bond"), "creep_time_s": np.where(ramp, np.nan, run.break_time[idx]),
+        "phase": np.where(ramp, "ramp", "creep"), **table,
         "x0_m": seg[:, 0, 0], "y0_m": seg[:, 0, 1], "x1_m": seg[:, 1, 0], "y1_m": seg[:, 1, 1],
         "macro_time_s": run.macro_time[idx]})
 
@@ -504,7 +500,7 @@ def write_crack_list(path, run):
 CREEP_ROW_COLUMNS = {"ratio": 0.0, "stress": 0.0, "ucs": 0.0}
 
 
-def run_creep_in_yade():
+def run_creep_in_yade(rows):
     """Entry of ``yade_scripts/creep.py``: one creep run per yade-batch row.
 
     Columns: ``ratio`` (driving-stress ratio) or ``stress`` [Pa], optional ``ucs`` [Pa] that the
@@ -516,7 +512,7 @@ def run_creep_in_yade():
     load), else it is started again.
     """
     from ..params import load_parameters, require_plane
-    from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
+    read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name
     with row_errors():
         overrides, controls = read_table(CREEP_ROW_COLUMNS)
         params = load_parameters(overrides=overrides)

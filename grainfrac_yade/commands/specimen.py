@@ -56,18 +56,20 @@ def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bo
     return record
 
 
-def run_specimen_in_yade():
-    """Entry of ``yade_scripts/specimen.py``: parameters from the batch table; counts read from YADE."""
+def run_specimen_in_yade(rows):
+    """Entry of ``yade_scripts/specimen.py``: parameters from the batch table; counts read from the scene
+    its engine builds.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
+    ``run_folder_name``)."""
+    from ..engines import engine_for
     from ..params import load_parameters
-    from ..yade_adapter.batch import read_table, row_errors, run_folder_name
-    from ..yade_adapter.scene import build_scene
+    read_table, row_errors, run_folder_name = rows.read_table, rows.row_errors, rows.run_folder_name
     with row_errors():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)
         out = controls["out"] or f"results/{controls['study']}/{run_folder_name(controls, overrides)}"
         record = run_specimen(params, int(controls["seed"]), out, overwrite=False)
-    scene = build_scene(build_specimen(params, int(controls["seed"])), params)
-    record["n_bonds_yade"] = scene.O.interactions.countReal()   # breakable bonds
+    scene = engine_for(params).build_scene(build_specimen(params, int(controls["seed"])), params)
+    record["n_bonds_yade"] = scene.counts()["n_interactions"]   # breakable bonds
     record["engines"] = scene.engine_names()
     record["dt_critical_yade"] = scene.dt_critical   # equals critical_dem_step_s (the same arithmetic)
     write_json(Path(out) / "specimen.json", {k: v for k, v in record.items() if k != "out"})

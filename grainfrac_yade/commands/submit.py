@@ -58,7 +58,7 @@ def choose_script(table, script) -> Path:
 def check_table_columns(table, command: str) -> None:
     """Columns must be parameter paths or run columns the script reads (one line naming the column)."""
     from ..params import shipped_values
-    from ..yade_adapter.batch import RUN_COLUMNS, check_columns   # pure: no YADE import
+    from ..runs.batchrun import RUN_COLUMNS, check_columns
     extra = {}
     if command == "creep":
         from .creep import CREEP_ROW_COLUMNS

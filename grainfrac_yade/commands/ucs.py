@@ -81,23 +81,20 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     from ..plotting import crack_map
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..specimen import build_specimen
+    from ..engines import engine_for
+    from ..protocols.cracks import bond_segments
     from ..ucs_analysis import ucs_summary
-    from ..yade_adapter.scene import bond_segments
-    from ..yade_adapter import ucs_protocol
     require_plane(params, "ucs")
     out = Path(out) if resume else prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     outputs = {"checkpoint_folder": out, "run_values": {"seed": seed}}
+    engine = engine_for(params)
     if resume:
-        history, result, scene, (broken_peak, mode_peak) = ucs_protocol.resume_ucs(specimen, params, out,
-                                                                              progress=progress)
+        history, result, scene, (broken_peak, mode_peak) = engine.resume_ucs(specimen, params, out, progress=progress)
     else:
-        snapshot = None
-        if vtk_every:
-            from ..yade_adapter.vtk_output import AXIAL_STRAIN, StrainSeries
-            snapshot = StrainSeries(out / "vtk", vtk_every, AXIAL_STRAIN)
-        history, result, scene, (broken_peak, mode_peak) = ucs_protocol.run_ucs(specimen, params, progress=progress,
-                                                                           snapshot=snapshot, **outputs)
+        snapshot = engine.StrainSeries(out / "vtk", vtk_every, engine.AXIAL_STRAIN) if vtk_every else None
+        history, result, scene, (broken_peak, mode_peak) = engine.run_ucs(specimen, params, progress=progress,
+                                                                          snapshot=snapshot, **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
     no_result = result["numerical_failure"] or result.get("failed_before_test")
     summary = dict.fromkeys(MEASURES) if no_result else ucs_summary(history)
@@ -121,26 +118,20 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
 
 def write_cracks(path, scene):
     """cracks.csv: one row per broken bond (DEM step, mode, kind, position, orientation)."""
+    from ..protocols.cracks import crack_table
     from ..runs.runio import write_csv
-    from ..yade_adapter.scene import SHEAR
     idx = np.flatnonzero(scene.broken)
-    t = scene.specimen.tessellation
-    normal = t.face_normal[scene.layout.bond_face[idx]]
-    write_csv(path, {
-        "bond": idx, "dem_step": scene.break_step[idx],
-        "mode": np.where(scene.break_mode[idx] == SHEAR, "shear", "tensile"),
-        "kind": np.where(scene.bond_is_inter[idx], "inter", "intra"),
-        "x_m": scene.layout.bond_point[idx, 0], "y_m": scene.layout.bond_point[idx, 1],
-        "face_normal_angle_deg": np.degrees(np.arctan2(normal[:, 1], normal[:, 0])) % 180.0,
-    })
+    table = crack_table(scene, idx)
+    write_csv(path, {"bond": table.pop("bond"), "dem_step": scene.break_step[idx], **table})
 
 
-def run_ucs_in_yade():
+def run_ucs_in_yade(rows):
     """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults); a finished row
     is skipped or stops as a creep row does, an unfinished one with a checkpoint of this row goes on
-    from it (:mod:`grainfrac_yade.yade_adapter.batch`)."""
+    from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
+    ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.yade_adapter.batch`)."""
     from ..params import load_parameters, require_plane
-    from ..yade_adapter.batch import read_table, row_errors, row_plan, run_folder_name
+    read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name
     with row_errors():
         overrides, controls = read_table()
         params = load_parameters(overrides=overrides)

@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 from ..errors import GrainfracError
+from ..params import nearest_key, renamed_key_fix
 
 #: Seconds between checks of the run folders while a batch runs.
 POLL_S = 5.0
@@ -215,3 +216,24 @@ def cell_value(text: str):
     if tree is not None and all(isinstance(node, allowed) for node in ast.walk(tree)):
         return eval(compile(tree, "<cell>", "eval"), {"__builtins__": {}}, {})
     raise ValueError(f"{text!r} is not a number or a quoted text")
+
+
+#: Table columns that are not model parameters: run controls, with defaults.
+RUN_COLUMNS = {"seed": 1, "out": "", "study": "default", "description": "", "on_change": "stop"}
+#: What a row does when its folder holds a finished run with other parameters (column ``on_change``).
+ON_CHANGE = ("stop", "new_folder")
+
+
+def check_columns(columns, valid, where: str) -> None:
+    """GrainfracError naming the first column not in ``valid`` and the valid key it most likely misspells
+    (``where``: the table row, as YADE_BATCH names it)."""
+    for col in columns:
+        if col == "description" or col.startswith("!") or col in valid:
+            continue
+        renamed = renamed_key_fix(col)
+        if renamed:
+            raise GrainfracError(f"batch table {where}: column {col!r} is a renamed key; fix: {renamed}")
+        close = nearest_key(col, valid)
+        hint = f"did you mean {close}?" if close else ("columns are parameter paths (section.key, as in "
+                                                       "params/*.toml) or " + ", ".join(RUN_COLUMNS))
+        raise GrainfracError(f"batch table {where}: unknown column {col!r}; fix: {hint}")

@@ -21,32 +21,11 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..runs.batchrun import read_table_rows
+from ..runs.batchrun import ON_CHANGE, RUN_COLUMNS, check_columns, read_table_rows  # noqa: F401
 from ..errors import GrainfracError
-from ..params import nearest_key, renamed_key_fix, shipped_values
+from ..params import shipped_values
 from ..runs.runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
 from . import load_yade
-
-#: Table columns that are not model parameters: run controls, with defaults.
-RUN_COLUMNS = {"seed": 1, "out": "", "study": "default", "description": "", "on_change": "stop"}
-#: What a row does when its folder holds a finished run with other parameters (column ``on_change``).
-ON_CHANGE = ("stop", "new_folder")
-
-
-def check_columns(columns, valid, where: str) -> None:
-    """GrainfracError naming the first column not in ``valid`` and the valid key it most likely misspells
-    (``where``: the table row, as YADE_BATCH names it)."""
-    for col in columns:
-        if col == "description" or col.startswith("!") or col in valid:
-            continue
-        renamed = renamed_key_fix(col)
-        if renamed:
-            raise GrainfracError(f"batch table {where}: column {col!r} is a renamed key; fix: {renamed}")
-        close = nearest_key(col, valid)
-        hint = f"did you mean {close}?" if close else ("columns are parameter paths (section.key, as in "
-                                                       "params/*.toml) or " + ", ".join(RUN_COLUMNS))
-        raise GrainfracError(f"batch table {where}: unknown column {col!r}; fix: {hint}")
-
 
 def read_table(extra_columns=None) -> tuple:
     """Read this run's row (or the defaults outside a batch).

@@ -43,7 +43,8 @@ from ..errors import GrainfracError, NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays
 from .levers import Levers, apply_levers, new_breaks
-from .scene import broken_counts, build_scene, check_value
+from ..protocols.cracks import broken_counts
+from .scene import build_scene, check_value
 
 #: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
 JAW_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}

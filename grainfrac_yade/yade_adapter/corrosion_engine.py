@@ -1,7 +1,7 @@
 """Stress corrosion of the scene's cohesive bonds: the YADE side of a degradation law.
 
-The law (:mod:`grainfrac_yade.law`, built once from ``[stress_corrosion]``) and its per-bond state
-(:class:`~grainfrac_yade.law.BondState`) are pure numpy.  This adapter only reads bond forces
+The law and its per-bond state are pure numpy (:class:`grainfrac_yade.protocols.corrosion.BondCorrosion`,
+which :class:`StressCorrosion` extends).  This adapter only reads bond forces
 (:meth:`StressCorrosion.stresses`) and writes what the law says a bond can carry: ``FnMax`` and
 ``FsMax``, and ``kn``/``ks`` for a law that changes stiffness (the area law).
 
@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..law import MODE_CORRODED, MODE_TENSION, Stresses, build_law, check_finite, degrade_step
+from ..law import MODE_CORRODED, MODE_TENSION, Stresses, check_finite
+from ..protocols.corrosion import STATE_KEYS, BondCorrosion  # noqa: F401
 from .scene import SHEAR
 
 #: Relative margin below the current load given to a bond that has reached its strength,
@@ -31,29 +32,17 @@ BREAK_MARGIN = 1e-6
 #: Smallest strength written to YADE, relative to the bond's initial strength: JCFpm never
 #: breaks a bond with FnMax = 0 in tension.
 MIN_STRENGTH_FRACTION = 1e-9
-#: Names of the law's state arrays in checkpoints (state_dict), with the value of an intact bond.
-STATE_KEYS = {"tensile_strength": "tensile_strength_pa", "cohesion": "cohesion_pa", "area_fraction": "area_fraction"}
 
 
-class StressCorrosion:
-    """A degradation law's state on a scene's bonds, and the reads and writes the creep clocks need."""
+class StressCorrosion(BondCorrosion):
+    """A degradation law's state on a scene's bonds (:class:`BondCorrosion`), and the reads and writes of
+    YADE's bonds the creep clocks need."""
 
     name = "StressCorrosion"
 
     def __init__(self, scene, sc_params):
-        self.scene, self.p = scene, sc_params
-        self.law = build_law(sc_params)
-        props = scene.props
-        self.area0 = scene.layout.bond_area.copy()
-        self.tensile0 = props.tensile_strength.copy()
-        self.cohesion0 = props.cohesion.copy()
-        self.kn0 = props.normal_stiffness.copy()
-        self.ks0 = props.shear_stiffness.copy()
-        self.tan_phi = np.tan(props.friction_angle)
-        self.state = self.law.initial_state(self.tensile0, self.cohesion0, self.tan_phi)
-        self.creep_time = 0.0
-        #: broken bonds whose contact stiffness was given back (laws that change stiffness)
-        self.restored = np.zeros(scene.n_bonds, bool)
+        self.scene = scene
+        super().__init__(scene.layout, scene.props, sc_params)
 
     # ------------------------------------------------------------------ reading
     def stresses(self, idx) -> Stresses:
@@ -68,12 +57,6 @@ class StressCorrosion:
 
     def intact(self) -> np.ndarray:
         return np.flatnonzero(~self.scene.broken)
-
-    def strengths(self, idx=None):
-        """What bonds ``idx`` can carry now, per intact area: (J^T, J^C) [Pa] (all bonds by default)."""
-        state = self.state if idx is None else self.state.subset(idx)
-        jt, jc, _ = self.law.strengths(state)
-        return jt, jc
 
     # ------------------------------------------------------------------ writing
     def write(self, idx):
@@ -143,30 +126,14 @@ class StressCorrosion:
     # ------------------------------------------------------------------ law steps
     def degrade(self, dt, stresses: Stresses):
         """Apply the law for creep time ``dt`` under frozen ``stresses`` (the paper clock's step); write to YADE."""
-        self.state = degrade_step(self.law, self.state, stresses, dt)
-        self.creep_time += dt
+        self.advance(dt, stresses)
         self.write(stresses.index)
-
-    def state_dict(self) -> dict:
-        """Whole engine state (for checkpoints): the law's arrays as lists, creep time."""
-        out = {"creep_time": self.creep_time, "law": self.law.name, "restored": np.flatnonzero(self.restored).tolist()}
-        intact = {"tensile_strength": self.tensile0, "cohesion": self.cohesion0,
-                  "area_fraction": np.ones(len(self.restored))}
-        for name, key in STATE_KEYS.items():
-            values = self.state.arrays.get(name, intact[name])
-            out[key] = values.tolist()
-        return out
 
     def load_state(self, state: dict, write: bool = True):
         """Restore :meth:`state_dict` output; ``write``: push the strengths into YADE's bonds (False when
         the bonds come back with the scene, as after ``O.load`` of a checkpoint: a bond handed over
         at its failure point holds a strength the arrays do not, and must keep it)."""
-        self.creep_time = float(state["creep_time"])
-        arrays = {name: np.array(state[STATE_KEYS[name]], float) for name in self.law.state_names}
-        self.state = self.law.initial_state(self.tensile0, self.cohesion0, self.tan_phi).replaced(
-            np.arange(len(self.tensile0)), arrays)
-        self.restored = np.zeros(len(self.tensile0), bool)
-        self.restored[np.asarray(state.get("restored", []), dtype=np.int64)] = True
+        self.load_arrays(state)
         if write:
             self.write(self.intact())
 

@@ -50,7 +50,8 @@ from .checkpoint import Checkpointer, inexact_note, read, restore
 from .confinement import Confinement, broken_apart_reason, consolidate
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
-from .scene import broken_counts, build_scene, check_value, resultant_forces
+from ..protocols.cracks import broken_counts
+from .scene import build_scene, check_value, resultant_forces
 from .vtk_output import Series, write_creep_snapshot
 
 #: History rows between writes of the partial history (an interrupted run keeps what it measured).

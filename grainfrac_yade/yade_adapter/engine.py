@@ -25,3 +25,8 @@ from .vtk_output import AXIAL_STRAIN, DIAMETRAL_STRAIN, StrainSeries, write_life
 NAME = "yade"
 #: Time-stepping dynamics (inertia, waves): the paper clock's unbalanced-force criterion needs it.
 DYNAMIC = True
+
+
+def version() -> str:
+    """YADE's version (imports YADE)."""
+    return load_yade().config.version

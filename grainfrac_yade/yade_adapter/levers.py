@@ -26,40 +26,11 @@ Random draws use their own stream, seeded by the specimen's seed: the specimen i
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from ..errors import GrainfracError
-
-#: Break mode of a bond broken before loading (a slit); 1 = tension and 2 = shear are JCFpm's, 3 the
-#: corrosion law's "corroded".
-PRE_EXISTING = 4
-#: Second word of the random stream of the levers (the first is the specimen's seed).
-LEVER_STREAM = 20261127
-
-
-@dataclass(frozen=True)
-class Levers:
-    slit_fraction: float = 0.0      # 1, share of bonds broken before loading
-    strength_cv: float = 0.0        # 1, coefficient of variation of a per-bond strength factor (lognormal, mean 1)
-    block_rotation: bool = False    # cells do not rotate
-
-    def __post_init__(self):
-        if not (math.isfinite(self.slit_fraction) and 0 <= self.slit_fraction < 1):
-            raise GrainfracError(f"--slit-fraction {self.slit_fraction!r}: must lie in [0, 1); fix: give the share of "
-                                 "faces unbonded before loading, e.g. 0.3")
-        if not (math.isfinite(self.strength_cv) and self.strength_cv >= 0):
-            raise GrainfracError(f"--strength-cv {self.strength_cv!r}: must be >= 0; fix: give a coefficient of "
-                                 "variation, e.g. 0.5")
-
-    @property
-    def active(self) -> bool:
-        return self.slit_fraction > 0 or self.strength_cv > 0 or self.block_rotation
-
-    def to_dict(self) -> dict:
-        return asdict(self)
-
+from ..protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers, new_breaks  # noqa: F401
 
 def apply_levers(scene, levers: Levers, seed: int) -> dict:
     """Apply ``levers`` to ``scene`` (before its first step); return what was done (counts)."""
@@ -90,8 +61,3 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
             if "Z" not in st.blockedDOFs:
                 st.blockedDOFs = st.blockedDOFs + "Z"
     return done
-
-
-def new_breaks(scene) -> np.ndarray:
-    """(n_bonds,) True for bonds broken during the test (tension or shear), not slits."""
-    return scene.broken & (scene.break_mode != PRE_EXISTING)

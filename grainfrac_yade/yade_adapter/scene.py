@@ -34,6 +34,7 @@ from ..grains import GrainModel, layout_for, model_of
 from ..law import MODE_NEVER, MODE_SHEAR, MODE_TENSION
 from ..layout import BondProperties, ClumpLayout, bond_properties
 from ..params import Parameters
+from ..protocols.cracks import bond_is_inter
 from ..specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
 from .confinement import Confinement
@@ -112,7 +113,7 @@ class GrainScene:
     @property
     def bond_is_inter(self) -> np.ndarray:
         """(n_bonds,) True for inter-granular bonds (two minerals)."""
-        return self.specimen.face_is_inter[self.layout.bond_face]
+        return bond_is_inter(self)
 
     @property
     def bond_mineral_pair(self) -> np.ndarray:
@@ -128,9 +129,10 @@ class GrainScene:
         return [type(e).__name__ for e in self.O.engines] + [d.name for d in self.drivers + self.extras]
 
     def counts(self) -> dict:
-        """YADE's bodies, real interactions and the breakable bonds."""
+        """YADE's bodies, real interactions (and every interaction it lists, potential ones too) and the
+        breakable bonds."""
         return {"n_bodies": len(self.O.bodies), "n_interactions": self.O.interactions.countReal(),
-                "n_bonds": self.n_bonds}
+                "n_interactions_listed": len(self.O.interactions), "n_bonds": self.n_bonds}
 
     # ------------------------------------------------------------------ counters
     @property
@@ -426,28 +428,6 @@ def _z_angle(ori) -> float:
     """Rotation [rad] of a quaternion about z (a plane model's bodies rotate about z only)."""
     axis, angle = ori.toAxisAngle()
     return float(angle if axis[2] >= 0 else -angle)
-
-
-def broken_counts(scene, broken=None) -> dict:
-    """Broken bonds by mode (tensile, shear) and kind (inter-, intra-granular); ``broken``: a mask of
-    the bonds to count (default: every broken bond; a mode is set only on broken bonds)."""
-    b = scene.broken if broken is None else broken
-    inter = scene.bond_is_inter
-    return {"broken_total": int(b.sum()),
-            "broken_tensile": int((b & (scene.break_mode == TENSION)).sum()),
-            "broken_shear": int((b & (scene.break_mode == SHEAR)).sum()),
-            "broken_inter": int((b & inter).sum()), "broken_intra": int((b & ~inter).sum())}
-
-
-def bond_segments(scene, indices) -> np.ndarray:
-    """(c, 2, 2) face pieces of bonds [m]: centred on the bond point, as long as the bond's share."""
-    lay, t = scene.layout, scene.specimen.tessellation
-    idx = np.asarray(indices, dtype=np.int64)
-    normal = t.face_normal[lay.bond_face[idx]]
-    tangent = np.column_stack([-normal[:, 1], normal[:, 0]])
-    half = 0.5 * lay.bond_area[idx] / scene.specimen.thickness
-    p = lay.bond_point[idx, :2]
-    return np.stack([p - half[:, None] * tangent, p + half[:, None] * tangent], axis=1)
 
 
 def verlet_distance(layout: ClumpLayout, numerics) -> float:

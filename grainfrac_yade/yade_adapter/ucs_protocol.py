@@ -27,7 +27,8 @@ from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_st
                          restore_scene, resume_record, scene_arrays)
 from .confinement import Confinement, broken_apart_reason, consolidate
 from .platens import Platens
-from .scene import broken_counts, build_scene, check_value
+from ..protocols.cracks import broken_counts
+from .scene import build_scene, check_value
 
 #: Columns of a UCS history.
 HISTORY_COLUMNS = ("dem_step", "dem_time_s", "axial_strain", "lateral_strain", "axial_stress_pa", "broken_total",

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..vtkio import (BOND_KIND_NAMES, BOND_STATE_NAMES, rigid_motion, series_file,
                      time_field, write_polygons, write_pvd, write_segments)
-from .scene import bond_segments
+from ..protocols.cracks import bond_segments
 
 #: The time of each kind of run: (field-data name, unit) of the .pvd timestep.
 CREEP_TIME = ("creep_time", "s")
