@@ -44,7 +44,8 @@ from ..post_peak import softened_past_peak
 from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays
 from .levers import Levers, apply_levers, new_breaks
 from ..protocols.cracks import broken_counts
-from .scene import build_scene, check_value
+from ..protocols.loading import LoadingTest
+from .scene import build_scene
 
 #: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
 JAW_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -147,8 +148,10 @@ HISTORY_COLUMNS = ("dem_step", "dem_time_s", "diametral_strain", "horizontal_str
 HISTORY_ARRAY = "history_"
 
 
-class BrazilianRun(LoadingCheckpoints):
+class BrazilianRun(LoadingCheckpoints, LoadingTest):
     """State of one Brazilian test: scene, jaws, history so far, peak and snapshots so far."""
+
+    strain_column = "diametral_strain"
 
     def __init__(self, specimen, params, progress=None, scene=None, levers=None, checkpoint_folder=None,
                  run_values=None, apply=True):
@@ -180,16 +183,11 @@ class BrazilianRun(LoadingCheckpoints):
                 scene.run(self.steps_per_row)
                 load = jaws.load()
                 strain = jaws.diametral_strain()
-                row = dict(dem_step=scene.O.iter, dem_time_s=scene.O.time, diametral_strain=strain,
+                row = dict(dem_step=scene.steps, dem_time_s=scene.time, diametral_strain=strain,
                            horizontal_strain=jaws.horizontal_strain(), load_n=load,
                            tensile_stress_pa=float(tensile_stress(load, jaws.diameter, self.thickness)),
                            **crack_counts(scene))
-                for k, v in row.items():
-                    check_value(k, v, scene.O.iter)
-                for k, v in row.items():
-                    cols[k].append(v)
-                if self.snapshot is not None:
-                    self.snapshot.row(scene, len(cols["dem_step"]), strain)
+                self.add_row(scene, row)
                 if self.split_snapshot is None and splits(load, self.peak, row["broken_total"], self.broken_at_peak,
                                                           strain, bz.stop_min_strain):   # the failure load is behind us
                     self.split_snapshot = self.peak_snapshot
@@ -211,19 +209,10 @@ class BrazilianRun(LoadingCheckpoints):
                            "strength")
                     break
         except NumericalFailure as exc:
-            numerical, end = True, f"numerical failure: {exc}"
-            if self.progress:
-                self.progress(end)
-        if self.snapshot is not None and cols["dem_step"] and not numerical:
-            self.snapshot.write(scene, len(cols["dem_step"]), cols["diametral_strain"][-1])
-        result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0, "dem_timestep_s": scene.O.dt,
-                  "n_bonds": scene.n_bonds, **crack_counts(scene), "numerical_failure": numerical,
-                  "bonds_erased_by_sliding": scene.sliding_erasures(),
-                  "peak_reached": peak_reached, "end_reason": end,
-                  "jaw_cells": [len(jaws.top), len(jaws.bottom)], "loaded_arc_deg": jaws.loaded_arc_deg,
-                  **self.applied}
-        if self.resumes:
-            result["resumed_from"] = self.resumes
+            numerical, end = True, self.numerical_end(exc)
+        result = self.result(scene, crack_counts(scene), numerical, peak_reached, end, cpu=False,
+                             jaw_cells=[len(jaws.top), len(jaws.bottom)], loaded_arc_deg=jaws.loaded_arc_deg,
+                             **self.applied)
         return cols, result, scene, self.split_snapshot or self.peak_snapshot
 
 

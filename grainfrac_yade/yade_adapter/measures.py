@@ -6,14 +6,8 @@ import math
 
 import numpy as np
 
-from ..errors import NumericalFailure
 from ..law import check_finite
-
-
-def check_value(name, value, dem_step):
-    """NumericalFailure if a measured value is NaN or infinite."""
-    if not math.isfinite(value):
-        raise NumericalFailure(f"{name} is {value} at DEM step {dem_step}")
+from ..protocols.loading import check_value  # noqa: F401
 
 
 def resultant_forces(scene, body_ids) -> tuple:

@@ -28,7 +28,8 @@ from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_st
 from .confinement import Confinement, broken_apart_reason, consolidate
 from .platens import Platens
 from ..protocols.cracks import broken_counts
-from .scene import build_scene, check_value
+from ..protocols.loading import LoadingTest
+from .scene import build_scene
 
 #: Columns of a UCS history.
 HISTORY_COLUMNS = ("dem_step", "dem_time_s", "axial_strain", "lateral_strain", "axial_stress_pa", "broken_total",
@@ -37,8 +38,10 @@ HISTORY_COLUMNS = ("dem_step", "dem_time_s", "axial_strain", "lateral_strain", "
 HISTORY_ARRAY = "history_"
 
 
-class UcsRun(LoadingCheckpoints):
+class UcsRun(LoadingCheckpoints, LoadingTest):
     """State of one compression test: scene, platens, history so far, peak so far."""
+
+    strain_column = "axial_strain"
 
     def __init__(self, specimen, params, progress=None, scene=None, checkpoint_folder=None, run_values=None):
         self.t0, self.c0 = time.time(), time.process_time()
@@ -81,14 +84,9 @@ class UcsRun(LoadingCheckpoints):
                 scene.run(self.steps_per_row)
                 stress = platens.axial_stress()
                 strain = platens.axial_strain()
-                row = dict(dem_step=scene.O.iter, dem_time_s=scene.O.time, axial_strain=strain,
+                row = dict(dem_step=scene.steps, dem_time_s=scene.time, axial_strain=strain,
                            lateral_strain=platens.lateral_strain(), axial_stress_pa=stress, **broken_counts(scene))
-                for k, v in row.items():
-                    check_value(k, v, scene.O.iter)
-                for k, v in row.items():
-                    cols[k].append(v)
-                if self.snapshot is not None:
-                    self.snapshot.row(scene, len(cols["dem_step"]), strain)
+                self.add_row(scene, row)
                 if stress > self.peak:
                     self.peak, self.broken_at_peak = stress, row["broken_total"]
                     self.peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
@@ -106,20 +104,9 @@ class UcsRun(LoadingCheckpoints):
                            f"{ucs.stop_stress_ratio:g} x its peak: the largest stress is a lower bound of the strength")
                     break
         except NumericalFailure as exc:
-            numerical, end = True, f"numerical failure: {exc}"
-            if self.progress:
-                self.progress(end)
-        if self.snapshot is not None and cols["dem_step"] and not numerical:
-            self.snapshot.write(scene, len(cols["dem_step"]), cols["axial_strain"][-1])
-        result = {"dem_steps": int(scene.O.iter), "wall_s": time.time() - self.t0,
-                  "cpu_s": time.process_time() - self.c0, "dem_timestep_s": scene.O.dt,
-                  "n_bonds": scene.n_bonds, **broken_counts(scene), "numerical_failure": numerical,
-                  "bonds_erased_by_sliding": scene.sliding_erasures(),
-                  "peak_reached": peak_reached, "end_reason": end, "failed_before_test": bool(broken_apart),
-                  "confining_stress_pa": confining,
-                  **self.consolidation}
-        if self.resumes:
-            result["resumed_from"] = self.resumes
+            numerical, end = True, self.numerical_end(exc)
+        result = self.result(scene, broken_counts(scene), numerical, peak_reached, end,
+                             failed_before_test=bool(broken_apart), confining_stress_pa=confining, **self.consolidation)
         return cols, result, scene, self.peak_snapshot
 
 

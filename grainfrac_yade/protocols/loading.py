@@ -1,0 +1,63 @@
+"""What every strain-controlled test (UCS, Brazilian) does with a history row and at its end, written once.
+
+A test's runner keeps its history as columns (``cols``), an optional VTK series (``snapshot``: told of
+each row and of the end; it only reads the scene) and the checkpoints it went on from (``resumes``).
+Each row is refused whole if one of its values is NaN or infinite (a DEM that blew up): the run then
+ends as a numerical failure, with the rows before it kept and no result measured.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+from ..errors import NumericalFailure
+
+#: History column of the step count (DEM steps, or solves of a static engine).
+STEP_COLUMN = "dem_step"
+
+
+def check_value(name, value, step):
+    """NumericalFailure if a measured value is NaN or infinite."""
+    if not math.isfinite(value):
+        raise NumericalFailure(f"{name} is {value} at DEM step {step}")
+
+
+class LoadingTest:
+    """The rows and the end of a strain-controlled test; ``strain_column``: the history column of its strain."""
+
+    strain_column = ""
+
+    def add_row(self, scene, row: dict):
+        """Append ``row`` to the history (NumericalFailure, and no row, if a value is not finite) and tell the
+        VTK series."""
+        for k, v in row.items():
+            check_value(k, v, scene.steps)
+        for k, v in row.items():
+            self.cols[k].append(v)
+        if self.snapshot is not None:
+            self.snapshot.row(scene, len(self.cols[STEP_COLUMN]), row[self.strain_column])
+
+    def numerical_end(self, exc: NumericalFailure) -> str:
+        """The end reason of a numerical failure (told to the progress callback)."""
+        end = f"numerical failure: {exc}"
+        if self.progress:
+            self.progress(end)
+        return end
+
+    def result(self, scene, counts: dict, numerical: bool, peak_reached: bool, end: str, cpu: bool = True,
+               **extra) -> dict:
+        """The result dict of the test (after the VTK series' last snapshot, unless it ended in a numerical
+        failure): steps, wall (and CPU) time, DEM step, bonds and ``counts`` of broken ones, how it ended,
+        then ``extra``, and the checkpoints it went on from."""
+        cols = self.cols
+        if self.snapshot is not None and cols[STEP_COLUMN] and not numerical:
+            self.snapshot.write(scene, len(cols[STEP_COLUMN]), cols[self.strain_column][-1])
+        result = {"dem_steps": int(scene.steps), "wall_s": time.time() - self.t0}
+        if cpu:
+            result["cpu_s"] = time.process_time() - self.c0
+        result.update({"dem_timestep_s": scene.dt, "n_bonds": scene.n_bonds, **counts,
+                       "numerical_failure": numerical, "bonds_erased_by_sliding": scene.sliding_erasures(),
+                       "peak_reached": peak_reached, "end_reason": end, **extra})
+        if self.resumes:
+            result["resumed_from"] = self.resumes
+        return result
