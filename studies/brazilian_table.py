@@ -70,7 +70,7 @@ def main(roots):
               f"| {np.mean([s['central_band_fraction'] for s in ok]):.2f} / "
               f"{np.mean([s['central_band_fraction_at_peak'] for s in ok]):.2f} "
               f"| {np.median([s['first_cracks_radius_ratio'] for s in ok]):.2f} "
-              f"| {np.mean([s['broken_total'] for s in ok]):.0f} | {np.mean([s['dem_steps'] for s in ok]):.0f} "
+              f"| {np.mean([s['broken_total'] for s in ok]):.0f} | {np.mean([s.get('steps', s.get('dem_steps')) for s in ok]):.0f} "
               f"| {np.mean([s['wall_s'] for s in ok]):.0f} |")
     if "d31.7_base" in bz:
         ok = [s for s in bz["d31.7_base"].values() if s.get("tensile_strength_pa")]

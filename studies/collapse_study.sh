@@ -80,8 +80,8 @@ def frame(base):
         rows.append({"setting": f.parent.parent.name, "increment": float(m.group(2) or 0),
                      "stress_ratio": float(m.group(3) or 1), "max_steps": int(m.group(4)), "seed": int(s["seed"]),
                      "ratio": round(float(s["driving_stress_ratio"]), 3), "lifetime_s": s["lifetime_s"],
-                     "n_events": s["n_events"], "dem_steps": s["dem_steps"],
-                     "final_steps": int(h["dem_steps"].iloc[-1] - h["dem_steps"].iloc[-2]), "ended_by": kind,
+                     "n_events": s["n_events"], "dem_steps": s.get("steps", s.get("dem_steps")),
+                     "final_steps": int(h[("step" if "step" in h else "dem_steps")].iloc[-1] - h[("step" if "step" in h else "dem_steps")].iloc[-2]), "ended_by": kind,
                      "wall_s": s["wall_s"]})
     if not rows:
         return None
@@ -159,7 +159,7 @@ if paper:
     print("|---|---|---|---|---|")
     for f in paper:
         s, h, kind = read(f)
-        print(f"| {f.parent.name[3:]} | {s['lifetime_s']:.10g} | {s['dem_steps']:,} | {kind} | {s['failure_reason']} |")
+        print(f"| {f.parent.name[3:]} | {s['lifetime_s']:.10g} | {s.get('steps', s.get('dem_steps')):,} | {kind} | {s['failure_reason']} |")
 EOF
 cat docs/collapse_study.md
 }

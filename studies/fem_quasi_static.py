@@ -30,7 +30,7 @@ def runs(folders):
             crossings = (s["peak_axial_strain"] / rate) / (p["specimen"]["height"] / c)
             yield {"rate": rate, "ds": ds, "seed": s["seed"], "ucs": s["ucs_pa"] / 1e6, "young": s["young_pa"] / 1e9,
                    "ci": s["crack_initiation_pa"] / s["ucs_pa"], "cd": s["crack_damage_pa"] / s["ucs_pa"],
-                   "steps": s["dem_steps"], "cpu": s["cpu_s"], "crossings": crossings,
+                   "steps": s.get("steps", s.get("dem_steps")), "cpu": s["cpu_s"], "crossings": crossings,
                    "verlet_q": p["numerics"].get("verlet_radius_quantile", 0.0), "run": f.parent.name}
 
 

@@ -55,7 +55,7 @@ def measure(runs: Path) -> list:
                 rows.append({"variant": variant[0], "seed": seed, "min_edge_fraction": float(f),
                              "ucs_pa": s["ucs_pa"], "young_pa": s["young_pa"], "broken_total": s.get("broken_total"),
                              "bonds_erased_by_sliding": s.get("bonds_erased_by_sliding"),
-                             "dem_steps": s.get("dem_steps"), "cpu_s": s.get("cpu_s")})
+                             "dem_steps": s.get("steps", s.get("dem_steps")), "cpu_s": s.get("cpu_s")})
                 write(rows)          # partial results as they come
     return rows
 

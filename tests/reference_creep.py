@@ -28,7 +28,7 @@ RUNS = {
 UCS = 300e6
 #: summary.json keys compared (everything a run computes; not wall time)
 SUMMARY_KEYS = ("lifetime_s", "failed", "failure_reason", "n_events", "broken_ramp", "broken_creep", "broken_total",
-                "macrocracks", "n_bonds", "dem_steps", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
+                "macrocracks", "n_bonds", "steps", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
                 "shear_stress_p99_pa", "shear_stress_max_pa", "shear_utilisation_max")
 #: history.csv columns that differ between identical runs
 WALL = ["wall_s"]
@@ -72,12 +72,16 @@ def stored_crack_format(cracks):
 
 
 def stored(name, folder):
-    """(summary, history, cracks) of reference ``name`` in the stored set ``folder``."""
+    """(summary, history, cracks) of reference ``name`` in the stored set ``folder``, the stored files' older
+    column and key names (``dem_steps``) read as today's (the stored data are not rewritten)."""
     import json
 
     import pandas as pd
-    summary = json.loads((folder / f"reference_creep_{name}.json").read_text())
-    history = pd.read_csv(folder / f"reference_creep_{name}_history.csv", float_precision="round_trip")
+    sys.path.insert(0, str(ROOT))
+    from grainfrac_yade.protocols.columns import history_as_today, summary_as_today
+    summary = summary_as_today(json.loads((folder / f"reference_creep_{name}.json").read_text()))
+    history = history_as_today(pd.read_csv(folder / f"reference_creep_{name}_history.csv",
+                                           float_precision="round_trip"))
     cracks = pd.read_csv(folder / f"reference_creep_{name}_cracks.csv", float_precision="round_trip")
     return summary, history, cracks
 
@@ -88,7 +92,7 @@ def write(name, tmp, folder):
     (folder / f"reference_creep_{name}.json").write_text(json.dumps(summary, indent=1) + "\n")
     history.to_csv(folder / f"reference_creep_{name}_history.csv", index=False)
     cracks.to_csv(folder / f"reference_creep_{name}_cracks.csv", index=False)
-    print(name, summary["lifetime_s"], summary["n_events"], summary["dem_steps"])
+    print(name, summary["lifetime_s"], summary["n_events"], summary["steps"])
 
 
 #: The reproducible UCS run of tests/test_reproducible.py (one thread).

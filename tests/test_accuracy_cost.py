@@ -199,7 +199,7 @@ def test_creep_strain_before_tertiary_is_read_from_the_history():
 
 def test_steps_per_relaxation_count_the_relaxations_to_equilibrium_of_the_event_clock():
     history = pd.DataFrame({"creep_time_s": [0.0, 0.0, 5.0, 9.0], "axial_strain": [1e-3] * 4,
-                            "dem_steps": [40000, 40600, 41500, 52000]})
+                            "step": [40000, 40600, 41500, 52000]})
     m = history_measures(history, None, "event")
     # rows: after the ramp, after each relaxation; the last relaxation (10,500 steps) is the collapse
     assert m["creep_dem_steps"] == 12000 and m["final_relaxation_steps"] == 10500

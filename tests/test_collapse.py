@@ -217,4 +217,4 @@ def test_a_tiny_specimen_ends_by_collapse_early_with_the_lifetime_of_the_criteri
     assert on.rows[-1]["creep_time_s"] == off.rows[-1]["creep_time_s"] > 0
     assert on.n_events == off.n_events
     assert [r["creep_time_s"] for r in on.rows] == [r["creep_time_s"] for r in off.rows]
-    assert on.rows[-1]["dem_steps"] < off.rows[-1]["dem_steps"]
+    assert on.rows[-1]["step"] < off.rows[-1]["step"]

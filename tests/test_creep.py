@@ -56,7 +56,7 @@ def test_creep_cli_writes_the_run_folder(tmp_path, small_ucs):
     assert res.returncode == 0, res.stderr
     s = json.loads((out / "summary.json").read_text())
     for key in ("lifetime_s", "failed", "stress_pa", "driving_stress_ratio", "ucs_pa", "clock", "n_events",
-                "dem_steps", "wall_s", "primary_end_s", "tertiary_start_s", "params", "seed", "code_version"):
+                "steps", "wall_s", "primary_end_s", "tertiary_start_s", "params", "seed", "code_version"):
         assert key in s
     assert s["failed"] and s["lifetime_s"] > 0 and s["driving_stress_ratio"] == pytest.approx(0.9)
     h = pd.read_csv(out / "history.csv")

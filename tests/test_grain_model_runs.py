@@ -141,32 +141,32 @@ def fake_scene(specimen, layout):
     n = layout.n_bonds
     return SimpleNamespace(specimen=specimen, layout=layout, n_bonds=n, broken=np.zeros(n, bool),
                            break_step=np.full(n, -1), break_mode=np.zeros(n, int), bond_is_inter=np.zeros(n, bool),
-                           O=SimpleNamespace(iter=1000), sliding_erasures=lambda: 0)
+                           steps=1000, sliding_erasures=lambda: 0)
 
 
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):
     from grainfrac_yade.commands.creep import run_creep_to_folder
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
-    from grainfrac_yade.yade_adapter import creep_protocol, ucs_protocol
+    from grainfrac_yade.yade_adapter import engine
     params, specimen, lay = fem
     scene = fake_scene(specimen, lay)
     strain = np.linspace(0.0, 5e-3, 26)
     stress = np.where(strain <= 4e-3, 70e9 * strain, 0.5 * 280e6)
     zeros = np.zeros(len(strain), int)
-    history = {"dem_step": np.arange(len(strain)), "dem_time_s": strain, "axial_strain": strain,
+    history = {"step": np.arange(len(strain)), "time_s": strain, "axial_strain": strain,
                "lateral_strain": -0.2 * strain, "axial_stress_pa": stress, "broken_total": np.arange(len(strain)),
                "broken_tensile": zeros, "broken_shear": zeros, "broken_inter": zeros, "broken_intra": zeros}
-    result = {"dem_steps": 1000, "wall_s": 0.1, "dem_timestep_s": 1e-9, "n_bonds": lay.n_bonds,
+    result = {"steps": 1000, "wall_s": 0.1, "dem_timestep_s": 1e-9, "n_bonds": lay.n_bonds,
               "numerical_failure": False, "peak_reached": True, "end_reason": "post-peak"}
-    monkeypatch.setattr(ucs_protocol, "run_ucs", lambda specimen, params, progress=None, **outputs:
+    monkeypatch.setattr(engine, "run_ucs", lambda specimen, params, progress=None, **outputs:
                         (history, result, scene, (scene.broken, scene.break_mode)))
     rows = [{"creep_time_s": t, "axial_strain": 2e-3 + 1e-9 * t, "lateral_strain": -4e-4, "axial_stress_pa": 200e6,
-             "broken_total": 3, "macrocracks": 0, "dem_steps": 1000, "wall_s": 0.1} for t in (0.0, 10.0, 20.0)]
+             "broken_total": 3, "macrocracks": 0, "step": 1000, "wall_s": 0.1} for t in (0.0, 10.0, 20.0)]
     run = SimpleNamespace(rows=rows, ramp_broken=3, failed=False, failure_reason="", failed_on_loading=False,
                           failed_before_test=False,
                           numerical_failure=False, n_events=2, scene=scene, vtk_written=[], initial_bond_stresses=None,
                           break_time=np.full(lay.n_bonds, np.nan), macro_time=np.full(lay.n_bonds, np.nan))
-    monkeypatch.setattr(creep_protocol, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
+    monkeypatch.setattr(engine, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     run_ucs_to_folder(params, SEED, tmp_path / "ucs")
     run_creep_to_folder(params, SEED, tmp_path / "creep", 200e6, 0.7, 285e6)
     for name in ("ucs", "creep"):

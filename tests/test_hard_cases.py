@@ -148,7 +148,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_a_numerical_failure_of_creep(t
     assert (s["numerical_failure"], s["failed"], s["lifetime_s"], s["failed_on_loading"]) == (True, None, None, False)
     assert s["end_reason"] == s["failure_reason"]
     assert s["end_reason"].startswith("numerical failure: DEM step ") and "critical step" in s["end_reason"]
-    assert s["dem_steps"] == 0 and s["creep_time_end_s"] == 0.0
+    assert s["steps"] == 0 and s["creep_time_end_s"] == 0.0
     assert outcome_in_analysis(tmp_path) == ["numerical failure"]
 
 
@@ -160,7 +160,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
     from grainfrac_yade.commands.analyze_ucs import cmd_analyze_ucs
     from grainfrac_yade.commands.ucs import MEASURES
     s = ucs_folder(load_parameters(overrides=TINY), tmp_path / "run", captured, MEASURES)
-    assert s["numerical_failure"] is True and s["ucs_pa"] is None and s["dem_steps"] == 0
+    assert s["numerical_failure"] is True and s["ucs_pa"] is None and s["steps"] == 0
     assert s["end_reason"].startswith("numerical failure: DEM step ")
     cmd_analyze_ucs(SimpleNamespace(folder=str(tmp_path)))
     assert f"numerical failure (no result, not counted): run: {s['end_reason']}" in \

@@ -89,7 +89,7 @@ def test_the_default_collapse_criterion_changes_only_the_final_collapse(tmp_path
     ref_summary, ref_history, _ = stored(name, SET)
     assert summary["failure_reason"].startswith("collapse: ")
     assert ref_summary["failure_reason"].startswith("no equilibrium")
-    assert summary["dem_steps"] < ref_summary["dem_steps"]
+    assert summary["steps"] < ref_summary["steps"]
     if name.startswith("event"):
         assert summary["lifetime_s"] == ref_summary["lifetime_s"] and summary["n_events"] == ref_summary["n_events"]
         before = len(ref_history) - 1   # every row before the final relaxation's

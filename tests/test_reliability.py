@@ -231,7 +231,7 @@ def stand_in_run(tiny, rows, failed=False, numerical=False, reason=""):
     broken[:2] = True
     scene = SimpleNamespace(specimen=specimen, layout=layout, n_bonds=n, broken=broken, break_step=np.full(n, -1),
                             break_mode=np.where(broken, 1, 0), bond_is_inter=np.zeros(n, bool),
-                            O=SimpleNamespace(iter=1234), sliding_erasures=lambda: 0)
+                            steps=1234, sliding_erasures=lambda: 0)
     return SimpleNamespace(rows=rows, ramp_broken=2, failed=failed, failure_reason=reason, failed_on_loading=False,
                            failed_before_test=False,
                            numerical_failure=numerical, n_events=0, scene=scene, vtk_written=[],
@@ -242,7 +242,7 @@ def stand_in_run(tiny, rows, failed=False, numerical=False, reason=""):
 def history_row(t, strain=2e-3):
     return {"creep_time_s": t, "axial_strain": strain, "lateral_strain": -4e-4, "axial_stress_pa": 2e8,
             "broken_total": 2, "broken_tensile": 2, "broken_shear": 0, "broken_inter": 0, "broken_intra": 2,
-            "macrocracks": 0, "dem_steps": 1000, "wall_s": 0.1}
+            "macrocracks": 0, "step": 1000, "wall_s": 0.1}
 
 
 def _no_nan(path):
@@ -254,8 +254,8 @@ def _no_nan(path):
 
 def _creep_folder(tmp_path, monkeypatch, tiny, run):
     from grainfrac_yade.commands.creep import run_creep_to_folder
-    from grainfrac_yade.yade_adapter import creep_protocol
-    monkeypatch.setattr(creep_protocol, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
+    from grainfrac_yade.yade_adapter import engine
+    monkeypatch.setattr(engine, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     out = tmp_path / "run"
     run_creep_to_folder(tiny[0], 1, out, 200e6, 0.7, 285e6)
     return out
@@ -513,7 +513,7 @@ def test_yade_nan_ends_the_run_as_a_numerical_failure(tmp_path, monkeypatch, pha
     s = run_creep_to_folder(params, 1, tmp_path / "run", 0.7 * 300e6, 0.7, 300e6)
     assert s["numerical_failure"] is True and s["failed"] is None and s["lifetime_s"] is None
     assert not s["failed_on_loading"] and s["creep_time_end_s"] == 0.0
-    assert s["failure_reason"] == "numerical failure: " + reason.format(n=s["n_bonds"], steps=s["dem_steps"])
+    assert s["failure_reason"] == "numerical failure: " + reason.format(n=s["n_bonds"], steps=s["steps"])
     assert _no_nan(tmp_path / "run" / "summary.json")["numerical_failure"] is True
     if phase == "ramp":
         assert not (tmp_path / "run" / "history.csv").exists()

@@ -95,11 +95,11 @@ def _reference(spec, out):
 def _assert_same_run(a, b):
     sa, sb = (json.loads((f / "summary.json").read_text()) for f in (a, b))
     for key in ("lifetime_s", "failed", "failure_reason", "n_events", "broken_ramp", "broken_creep", "macrocracks",
-                "dem_steps", "creep_time_end_s", "primary_end_s", "tertiary_start_s", "shear_stress_p99_pa"):
+                "steps", "creep_time_end_s", "primary_end_s", "tertiary_start_s", "shear_stress_p99_pa"):
         assert sa[key] == sb[key], key
     ha, hb = (pd.read_csv(f / "history.csv").drop(columns=WALL) for f in (a, b))
     pd.testing.assert_frame_equal(ha, hb, check_exact=True)          # no row missing, none twice, every bit equal
-    assert np.all(np.diff(hb["dem_steps"]) > 0) and np.all(np.diff(hb["creep_time_s"]) >= 0)
+    assert np.all(np.diff(hb["step"]) > 0) and np.all(np.diff(hb["creep_time_s"]) >= 0)
     for name in ("cracks.csv", "bond_stresses_start.csv"):
         assert (a / name).read_text() == (b / name).read_text(), name
 
@@ -123,7 +123,7 @@ def test_a_run_killed_mid_creep_resumes_to_the_uninterrupted_result(tmp_path):
     assert not (killed / "checkpoint").exists()
     if partial is not None:   # the partial history the killed run left is a prefix of the final one
         full = pd.read_csv(killed / "history.csv")
-        assert full["dem_steps"].iloc[:len(partial)].tolist() == partial["dem_steps"].tolist()
+        assert full["step"].iloc[:len(partial)].tolist() == partial["step"].tolist()
     again = _cli("--resume", killed)                                 # finished: says so, changes nothing
     assert again.returncode == 0 and "already finished" in again.stdout
 
@@ -384,7 +384,7 @@ def test_a_ucs_test_killed_mid_loading_resumes_to_the_uninterrupted_result(tmp_p
     killed = tmp_path / "killed"
     state = _start_and_kill_command("ucs", ["--width", UCS_TINY["width"], "--height", UCS_TINY["height"]], killed,
                                     _ucs_mid_loading)
-    assert state["test"] == "ucs" and state["phase"] == "loading" and 0 < state["dem_steps"] < s["dem_steps"]
+    assert state["test"] == "ucs" and state["phase"] == "loading" and 0 < state["dem_steps"] < s["steps"]
     refused = subprocess.run([sys.executable, "-m", "grainfrac_yade", "ucs", "--out", str(killed)],
                              capture_output=True, text=True, cwd=ROOT)
     assert refused.returncode == 2 and f"ucs --resume {killed}" in refused.stderr

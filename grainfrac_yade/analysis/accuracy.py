@@ -60,7 +60,7 @@ def history_measures(history: pd.DataFrame | None, tertiary_start_s, clock: str)
            "steps_per_relaxation": float("nan")}
     if history is None or len(history) < 2:
         return out
-    steps = history["dem_steps"].to_numpy(float)
+    steps = history["step"].to_numpy(float)
     out["creep_dem_steps"] = float(steps[-1] - steps[0])
     if clock == "event":
         out["final_relaxation_steps"] = float(steps[-1] - steps[-2])
@@ -143,7 +143,7 @@ def _row(study, labelled, life, measures, knob, setting, ref) -> dict:
         out[key] = _mean([measures.get((setting.name, r, s), {}).get(key) for r, s in pairs])
     done = creep[creep["status"] == "finished"] if len(creep) else creep
     for col, name in (("broken_total", "microcracks_at_end"), ("macrocracks", "macrocracks_at_end"),
-                      ("n_events", "events"), ("dem_steps", "dem_steps_per_run"), ("wall_s", "wall_s_per_run"),
+                      ("n_events", "events"), ("steps", "dem_steps_per_run"), ("wall_s", "wall_s_per_run"),
                       ("cpu_s", "cpu_s_per_run")):
         out[name] = _mean(done[col].astype(float)) if len(done) and col in done else float("nan")
     notes = []

@@ -8,6 +8,7 @@ import pandas as pd
 
 from ..params import RENAMED_KEYS, migrate_tree
 from ..params import flatten as flatten_tree
+from ..protocols.columns import summary_as_today
 
 #: Parameter paths copied from each run's params.json into the table (older params.json are read through
 #: :func:`~grainfrac_yade.params.migrate_tree`: ``stress_corrosion.mode`` becomes ``stress_corrosion.law``).
@@ -78,7 +79,7 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
                 row.update(flatten(params) if all_params else {k: _get(params, k) for k in PARAM_COLUMNS})
             summary_file = folder / "summary.json"
             if summary_file.exists():
-                summary = _read_json(summary_file)
+                summary = summary_as_today(_read_json(summary_file))   # keys of older runs by today's names
                 if "mode" in summary and "law" not in summary:
                     summary["law"] = _SUMMARY_LAW.get(summary.pop("mode"))
                 row.update({k: v for k, v in summary.items() if not isinstance(v, (dict, list))})

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
+from ..protocols.columns import history_as_today
 from ..runs.runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crack_phases, crackmaps, figures, rescale
 from .collect import code_version_note, collect_runs, flatten
@@ -35,7 +36,7 @@ CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure",
 RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
              "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
-             "tertiary_start_s", "dem_steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
+             "tertiary_start_s", "steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
              "resolution.grain_model", "calibration.strength_scale", "calibration.stiffness_scale",
              "stress_corrosion.beta1", "stress_corrosion.beta2", "specimen.min_edge_fraction", "creep.ramp_strain_rate",
              "numerics.density_scale", "study", "beta1_run", "time_factor", "code_version", "problem")
@@ -177,7 +178,7 @@ def load_studies(folders, beta1: float | None = None) -> pd.DataFrame:
 def _read_csv(path: Path, required) -> pd.DataFrame | None:
     """A run's CSV, or None if missing, unreadable or lacking ``required`` columns (never raises)."""
     try:
-        frame = pd.read_csv(path)
+        frame = history_as_today(pd.read_csv(path))   # step columns of older runs by today's names
     except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError):
         return None
     return frame if all(c in frame for c in required) else None

@@ -15,7 +15,7 @@ LOADING_VARIANT = ("calibration.strength_scale", "calibration.stiffness_scale", 
                    "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")
 #: The confining stress column: the envelope's abscissa.
 CONFINEMENT = "confinement.stress"
-MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "dem_steps")
+MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "steps")
 
 
 def _mean_sd(mean, sd, unit) -> str:
@@ -60,7 +60,7 @@ def cmd_analyze_ucs(args) -> int:
             f"| {_mean_sd(r['young_pa_mean'], r['young_pa_std'], 1e9)} | {r['poisson_mean']:.3f} "
             f"| {r['crack_initiation_pa_mean'] / r['ucs_pa_mean']:.2f} "
             f"| {r['crack_damage_pa_mean'] / r['ucs_pa_mean']:.2f} "
-            f"| {r['dem_steps_mean']:.0f} | {r['wall_s_mean']:.1f} |")
+            f"| {r['steps_mean']:.0f} | {r['wall_s_mean']:.1f} |")
     failed = runs[runs.get("numerical_failure", pd.Series(False, index=runs.index)).eq(True)]
     if len(failed):   # no UCS (null): left out of n and of every mean
         lines.append("")

@@ -206,7 +206,7 @@ def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
         "grain_model": params.resolution.grain_model, "spheres_per_cell": params.resolution.spheres_per_cell,
         "stress_pa": stress, "n_cells": specimen.n_cells, "n_bodies": sc.counts()["n_bodies"],
         "n_bonds": sc.n_bonds, "n_interactions": sc.counts()["n_interactions_listed"], "dem_timestep_s": sc.dt,
-        "ramp_steps": run.rows[0]["dem_steps"], "ramp_wall_s": run.ramp_wall_s,
+        "ramp_steps": run.rows[0]["step"], "ramp_wall_s": run.ramp_wall_s,
         "steps_to_first_equilibrium": run.hold_steps, "equilibrium_at_hold": run.initial_bond_stresses is not None,
         "held_after_events": not run.failed,
         **run.measured,
@@ -230,7 +230,7 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
         run.run()
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         first, last = run.rows[0], run.rows[-1]
-        creep_steps, creep_wall = last["dem_steps"] - first["dem_steps"], last["wall_s"] - first["wall_s"]
+        creep_steps, creep_wall = last["step"] - first["step"], last["wall_s"] - first["wall_s"]
         out[clock] = {
             "failed": bool(run.failed), "numerical_failure": bool(run.numerical_failure),
             "failure_reason": run.failure_reason or "not failed",
@@ -321,7 +321,7 @@ def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
            "failure_reason": run.failure_reason or "not failed",
            "held_after_ramp": run.initial_bond_stresses is not None,
            ("lifetime_s" if run.failed else "creep_time_end_s"): last["creep_time_s"], "n_events": run.n_events,
-           "dem_steps": int(run.scene.steps), "ramp_steps": run.rows[0]["dem_steps"], "wall_s": wall, "cpu_s": cpu,
+           "dem_steps": int(run.scene.steps), "ramp_steps": run.rows[0]["step"], "wall_s": wall, "cpu_s": cpu,
            "events": run.event_costs()}
     progress(f"paper-size fem creep at {stress / 1e6:.0f} MPa: {out['failure_reason']} at {last['creep_time_s']:.4g} s "
              f"creep time, {out['dem_steps']} DEM steps, {cpu:.0f} CPU s")

@@ -89,7 +89,7 @@ def format_result(summary, out) -> str:
             f"(P/t {summary['peak_load_per_thickness_n_per_m'] / 1e3:.1f} kN/m, D {summary['diameter_m'] * 1e3:g} mm), "
             f"calibration.reference_ucs / sigma_t {'-' if ratio is None else f'{ratio:.1f}'}; central band "
             f"{summary['central_band_fraction']:.2f} of {summary['broken_total']} broken bonds "
-            f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
+            f"({summary['steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
 
 
 def tensile_scale_overrides(params, factor: float) -> list:
@@ -205,7 +205,7 @@ def write_disc_cracks(path, scene):
     idx = np.flatnonzero(new_breaks(scene))
     t = scene.specimen.tessellation
     table = crack_table(scene, idx)
-    write_csv(path, {"bond": table.pop("bond"), "dem_step": scene.break_step[idx], **table,
+    write_csv(path, {"bond": table.pop("bond"), "step": scene.break_step[idx], **table,
                      "central_band": in_central_band(scene.layout.bond_point[idx], t.centre, t.diameter)})
 
 

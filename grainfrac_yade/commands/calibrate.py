@@ -72,7 +72,7 @@ def cmd_calibrate(args, params) -> int:
             rows.append({"round": rnd, "seed": seed, "strength_scale": strength, "stiffness_scale": stiffness,
                          "ucs_pa": s["ucs_pa"], "young_pa": s["young_pa"], "poisson": s["poisson"],
                          "crack_initiation_pa": s["crack_initiation_pa"], "crack_damage_pa": s["crack_damage_pa"],
-                         "n_cells": s["n_cells"], "dem_steps": s["dem_steps"], "wall_s": s["wall_s"]})
+                         "n_cells": s["n_cells"], "steps": s["steps"], "wall_s": s["wall_s"]})
             print(f"round {rnd} seed {seed}: UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {s['young_pa'] / 1e9:.1f} GPa "
                   f"(strength x{strength:.4g}, stiffness x{stiffness:.4g})", flush=True)
         write_csv(out / "calibration.csv", rows)

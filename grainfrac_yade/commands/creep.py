@@ -269,7 +269,7 @@ def cmd_creep(args, params) -> int:
             print(f"creep run already finished (summary.json): {args.resume}; nothing to resume")
             return 0
         print(f"creep {s['stress_pa'] / 1e6:.1f} MPa (ratio {s['driving_stress_ratio']:.3f}), {s['clock']} clock, "
-              f"resumed: {outcome(s)}, {s['n_events']} events, {s['broken_creep']} creep cracks, {s['dem_steps']} "
+              f"resumed: {outcome(s)}, {s['n_events']} events, {s['broken_creep']} creep cracks, {s['steps']} "
               f"DEM steps -> {args.resume}")
         return 0
     require_plane(params, "creep")
@@ -288,7 +288,7 @@ def cmd_creep(args, params) -> int:
         print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}): {outcome(s)} -> {out}")
         return 1
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
-          f"{s['broken_creep']} creep cracks, {s['dem_steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
+          f"{s['broken_creep']} creep cracks, {s['steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
     return 0
 
 
@@ -418,7 +418,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "bonds_erased_by_sliding": run.scene.sliding_erasures(),
         **budget_fields(getattr(run, "hold_budget", None)),
-        "dem_steps": int(run.scene.steps), "wall_s": time.time() - t0,
+        "steps": int(run.scene.steps), "wall_s": time.time() - t0,
         "cpu_s": time.process_time() - c0,
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
@@ -470,7 +470,7 @@ def _row_before_history(run, counts) -> dict:
     """Stand-in history row (creep time 0, no strain) for a run that ended before its first row
     (a numerical failure during the ramp); never written to history.csv."""
     return {"creep_time_s": 0.0, "axial_strain": 0.0, "lateral_strain": 0.0, "axial_stress_pa": 0.0, **counts,
-            "macrocracks": 0, "dem_steps": int(run.scene.steps), "wall_s": 0.0}
+            "macrocracks": 0, "step": int(run.scene.steps), "wall_s": 0.0}
 
 
 def history_columns(rows) -> dict:

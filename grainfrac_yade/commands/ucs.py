@@ -54,7 +54,7 @@ def cmd_ucs(args, params) -> int:
     print(f"{label} {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
           f"nu {_fmt(summary['poisson'], 1, 3)}, CI {_fmt(summary['crack_initiation_pa'])} MPa, "
           f"CD {_fmt(summary['crack_damage_pa'])} MPa, broken {summary['broken_total']} of {summary['n_bonds']} "
-          f"({summary['dem_steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
+          f"({summary['steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
     return 0
 
 
@@ -102,7 +102,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     summary.update(summary_header(params, seed), n_cells=specimen.n_cells)
     write_csv(out / "history.csv", history)
     write_cracks(out / "cracks.csv", scene)
-    if len(history["dem_step"]):   # none when the specimen broke apart before the axial stage
+    if len(history["step"]):   # none when the specimen broke apart before the axial stage
         run_stress_strain_figure(history, summary, out / "stress_strain.png")
     idx = np.flatnonzero(broken_peak)
     at = ("the end of the isotropic stage" if result.get("failed_before_test") else
@@ -117,12 +117,12 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
 
 
 def write_cracks(path, scene):
-    """cracks.csv: one row per broken bond (DEM step, mode, kind, position, orientation)."""
+    """cracks.csv: one row per broken bond (step of its break, mode, kind, position, orientation)."""
     from ..protocols.cracks import crack_table
     from ..runs.runio import write_csv
     idx = np.flatnonzero(scene.broken)
     table = crack_table(scene, idx)
-    write_csv(path, {"bond": table.pop("bond"), "dem_step": scene.break_step[idx], **table})
+    write_csv(path, {"bond": table.pop("bond"), "step": scene.break_step[idx], **table})
 
 
 def run_ucs_in_yade(rows):

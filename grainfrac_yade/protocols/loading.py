@@ -11,9 +11,7 @@ import math
 import time
 
 from ..errors import NumericalFailure
-
-#: History column of the step count (DEM steps, or solves of a static engine).
-STEP_COLUMN = "dem_step"
+from .columns import STEP, STEPS
 
 
 def check_value(name, value, step):
@@ -35,7 +33,7 @@ class LoadingTest:
         for k, v in row.items():
             self.cols[k].append(v)
         if self.snapshot is not None:
-            self.snapshot.row(scene, len(self.cols[STEP_COLUMN]), row[self.strain_column])
+            self.snapshot.row(scene, len(self.cols[STEP]), row[self.strain_column])
 
     def numerical_end(self, exc: NumericalFailure) -> str:
         """The end reason of a numerical failure (told to the progress callback)."""
@@ -50,9 +48,9 @@ class LoadingTest:
         failure): steps, wall (and CPU) time, DEM step, bonds and ``counts`` of broken ones, how it ended,
         then ``extra``, and the checkpoints it went on from."""
         cols = self.cols
-        if self.snapshot is not None and cols[STEP_COLUMN] and not numerical:
-            self.snapshot.write(scene, len(cols[STEP_COLUMN]), cols[self.strain_column][-1])
-        result = {"dem_steps": int(scene.steps), "wall_s": time.time() - self.t0}
+        if self.snapshot is not None and cols[STEP] and not numerical:
+            self.snapshot.write(scene, len(cols[STEP]), cols[self.strain_column][-1])
+        result = {STEPS: int(scene.steps), "wall_s": time.time() - self.t0}
         if cpu:
             result["cpu_s"] = time.process_time() - self.c0
         result.update({"dem_timestep_s": scene.dt, "n_bonds": scene.n_bonds, **counts,

@@ -41,7 +41,8 @@ from ..brazilian_analysis import splits, tensile_stress
 from ..disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
 from ..post_peak import softened_past_peak
-from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays
+from .checkpoint import (LoadingCheckpoints, base_state, history_arrays, read, restore_scene, resume_record,
+                         scene_arrays)
 from .levers import Levers, apply_levers, new_breaks
 from ..protocols.cracks import broken_counts
 from ..protocols.loading import LoadingTest
@@ -142,7 +143,7 @@ def crack_counts(scene) -> dict:
 
 
 #: Columns of a Brazilian history.
-HISTORY_COLUMNS = ("dem_step", "dem_time_s", "diametral_strain", "horizontal_strain", "load_n", "tensile_stress_pa",
+HISTORY_COLUMNS = ("step", "time_s", "diametral_strain", "horizontal_strain", "load_n", "tensile_stress_pa",
                    "broken_total", "broken_tensile", "broken_shear", "broken_inter", "broken_intra")
 #: Prefix of the history columns in a checkpoint's arrays.npz.
 HISTORY_ARRAY = "history_"
@@ -183,7 +184,7 @@ class BrazilianRun(LoadingCheckpoints, LoadingTest):
                 scene.run(self.steps_per_row)
                 load = jaws.load()
                 strain = jaws.diametral_strain()
-                row = dict(dem_step=scene.steps, dem_time_s=scene.time, diametral_strain=strain,
+                row = dict(step=scene.steps, time_s=scene.time, diametral_strain=strain,
                            horizontal_strain=jaws.horizontal_strain(), load_n=load,
                            tensile_stress_pa=float(tensile_stress(load, jaws.diameter, self.thickness)),
                            **crack_counts(scene))
@@ -195,7 +196,7 @@ class BrazilianRun(LoadingCheckpoints, LoadingTest):
                     self.peak, self.broken_at_peak = load, row["broken_total"]
                     if self.split_snapshot is None:
                         self.peak_snapshot = (new_breaks(scene), scene.break_mode.copy())
-                if self.progress and len(cols["dem_step"]) % 50 == 0:
+                if self.progress and len(cols["step"]) % 50 == 0:
                     self.progress(f"strain {strain:.6f}  sigma {row['tensile_stress_pa'] / 1e6:6.2f} MPa  "
                                   f"broken {row['broken_total']}")
                 if softened_past_peak(load, self.peak, row["broken_total"], self.broken_at_peak, bz.stop_load_ratio,
@@ -220,7 +221,7 @@ def capture(run, phase, loop, run_values, version="") -> tuple:
     """(state.json, arrays.npz) of Brazilian test ``run`` at a safe point."""
     state = {**base_state("brazilian", run, phase, loop, run_values, version),
              "run": {"peak": run.peak, "broken_at_peak": run.broken_at_peak, "applied": run.applied,
-                     "split": run.split_snapshot is not None, "rows": len(run.cols["dem_step"]),
+                     "split": run.split_snapshot is not None, "rows": len(run.cols["step"]),
                      "resumes": run.resumes},
              "jaws": run.jaws.state_dict()}
     arrays = {**scene_arrays(run.scene), "peak_broken": run.peak_snapshot[0], "peak_break_mode": run.peak_snapshot[1]}
@@ -242,7 +243,7 @@ def restore(run, where, state, arrays):
                           else None)
     if r["split"] and all(np.array_equal(a, b) for a, b in zip(run.split_snapshot, run.peak_snapshot)):
         run.split_snapshot = run.peak_snapshot   # the same snapshot, as in the uninterrupted run
-    run.cols = {k: arrays[HISTORY_ARRAY + k].tolist() for k in HISTORY_COLUMNS}
+    run.cols = history_arrays(arrays, HISTORY_ARRAY, HISTORY_COLUMNS)
     run.t0 = time.time() - state["wall_s"]
     run.c0 = time.process_time() - state["cpu_s"]
     run.resumes = r["resumes"] + [resume_record(state)]
@@ -274,6 +275,6 @@ def resume_brazilian(specimen, params, run_folder, progress=None):
                        apply=False)
     restore(run, where, state, arrays)
     if progress:
-        progress(f"resumed from the checkpoint at DEM step {state['dem_steps']} ({len(run.cols['dem_step'])} "
+        progress(f"resumed from the checkpoint at DEM step {state['dem_steps']} ({len(run.cols['step'])} "
                  "history rows)")
     return run.run()

@@ -53,6 +53,7 @@ import numpy as np
 from ..clocks import EventClock, PaperClock
 from ..errors import GrainfracError
 from ..grains import grain_model
+from ..protocols.columns import HISTORY_RENAMED, history_as_today
 from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
 from ..wave import HoldBudget
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
@@ -246,6 +247,13 @@ def rebind_scene(scene):
     scene.rebind()
 
 
+def history_arrays(arrays: dict, prefix: str, columns) -> dict:
+    """The history columns a checkpoint's arrays.npz holds under ``prefix``, by today's names (older checkpoints
+    hold some under their old names, :data:`grainfrac_yade.protocols.columns.HISTORY_RENAMED`)."""
+    old = {new: name for name, new in HISTORY_RENAMED.items() if prefix + name in arrays}
+    return {k: arrays[prefix + (k if prefix + k in arrays else old[k])].tolist() for k in columns}
+
+
 def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):
     """Replace scene ``sc`` (freshly built from the same specimen and parameters) by the checkpoint's
     (``O.load``), fetch its handles anew and restore its bond bookkeeping; ``confinement``: the
@@ -303,7 +311,7 @@ def restore(run, where, state: dict, arrays: dict):
     restore_scene(sc, where, state, arrays, run.confinement)
     restore_platens(pl, state["platens"])
     r = state["run"]
-    run.rows = r["rows"]
+    run.rows = [history_as_today(row) for row in r["rows"]]   # rows of older checkpoints: dem_steps
     run.ramp_broken, run.failed, run.failure_reason = r["ramp_broken"], r["failed"], r["failure_reason"]
     run.failed_on_loading, run.n_events = r["failed_on_loading"], r["n_events"]
     run.vtk_times, run.vtk_written, run._vtk_rows = r["vtk_times"], r["vtk_written"], r["vtk_rows"]

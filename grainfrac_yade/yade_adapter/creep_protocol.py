@@ -158,9 +158,9 @@ class CreepRun:
             "lateral_strain": self.platens.lateral_strain(),
             "axial_stress_pa": self.platens.axial_stress() if stress is None else stress,
             **broken_counts(self.scene), "macrocracks": self.count_macrocracks(creep_time),
-            "dem_steps": int(self.scene.O.iter), "wall_s": time.time() - self.t0}
+            "step": int(self.scene.steps), "wall_s": time.time() - self.t0}
         for key, value in row.items():
-            check_value(f"history {key}", value, row["dem_steps"])
+            check_value(f"history {key}", value, row["step"])
         self.rows.append(row)
 
     def count_macrocracks(self, creep_time):

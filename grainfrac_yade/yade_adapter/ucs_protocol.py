@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
-from .checkpoint import (LoadingCheckpoints, base_state, inexact_note, platen_state, read, restore_platens,
+from .checkpoint import (LoadingCheckpoints, base_state, history_arrays, inexact_note, platen_state, read, restore_platens,
                          restore_scene, resume_record, scene_arrays)
 from .confinement import Confinement, broken_apart_reason, consolidate
 from .platens import Platens
@@ -32,7 +32,7 @@ from ..protocols.loading import LoadingTest
 from .scene import build_scene
 
 #: Columns of a UCS history.
-HISTORY_COLUMNS = ("dem_step", "dem_time_s", "axial_strain", "lateral_strain", "axial_stress_pa", "broken_total",
+HISTORY_COLUMNS = ("step", "time_s", "axial_strain", "lateral_strain", "axial_stress_pa", "broken_total",
                    "broken_tensile", "broken_shear", "broken_inter", "broken_intra")
 #: Prefix of the history columns in a checkpoint's arrays.npz.
 HISTORY_ARRAY = "history_"
@@ -84,13 +84,13 @@ class UcsRun(LoadingCheckpoints, LoadingTest):
                 scene.run(self.steps_per_row)
                 stress = platens.axial_stress()
                 strain = platens.axial_strain()
-                row = dict(dem_step=scene.steps, dem_time_s=scene.time, axial_strain=strain,
+                row = dict(step=scene.steps, time_s=scene.time, axial_strain=strain,
                            lateral_strain=platens.lateral_strain(), axial_stress_pa=stress, **broken_counts(scene))
                 self.add_row(scene, row)
                 if stress > self.peak:
                     self.peak, self.broken_at_peak = stress, row["broken_total"]
                     self.peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
-                if self.progress and len(cols["dem_step"]) % 50 == 0:
+                if self.progress and len(cols["step"]) % 50 == 0:
                     self.progress(f"strain {strain:.5f}  stress {stress / 1e6:7.1f} MPa  broken {row['broken_total']}")
                 if softened_past_peak(stress - confining, self.peak - confining, row["broken_total"],
                                       self.broken_at_peak, ucs.stop_stress_ratio, strain, ucs.stop_min_strain):
@@ -114,7 +114,7 @@ def capture(run, phase, loop, run_values, version="") -> tuple:
     """(state.json, arrays.npz) of UCS test ``run`` at a safe point."""
     state = {**base_state("ucs", run, phase, loop, run_values, version),
              "run": {"peak": run.peak, "broken_at_peak": run.broken_at_peak, "consolidation": run.consolidation,
-                     "confined": run.confinement is not None, "rows": len(run.cols["dem_step"]),
+                     "confined": run.confinement is not None, "rows": len(run.cols["step"]),
                      "resumes": run.resumes},
              "platens": platen_state(run.platens)}
     arrays = {**scene_arrays(run.scene), "peak_broken": run.peak_snapshot[0], "peak_break_mode": run.peak_snapshot[1]}
@@ -133,7 +133,7 @@ def restore(run, where, state, arrays):
     restore_platens(run.platens, state["platens"])
     run.peak, run.broken_at_peak, run.consolidation = r["peak"], r["broken_at_peak"], r["consolidation"]
     run.peak_snapshot = (np.array(arrays["peak_broken"]), np.array(arrays["peak_break_mode"]))
-    run.cols = {k: arrays[HISTORY_ARRAY + k].tolist() for k in HISTORY_COLUMNS}
+    run.cols = history_arrays(arrays, HISTORY_ARRAY, HISTORY_COLUMNS)
     run.t0 = time.time() - state["wall_s"]
     run.c0 = time.process_time() - state["cpu_s"]
     run.resumes = r["resumes"] + [resume_record(state)]
@@ -162,7 +162,7 @@ def resume_ucs(specimen, params, run_folder, progress=None, run_values=None):
                  run_values=run_values if run_values is not None else state.get("run_values"))
     restore(run, where, state, arrays)
     if progress:
-        progress(f"resumed from the checkpoint at DEM step {state['dem_steps']} ({len(run.cols['dem_step'])} "
+        progress(f"resumed from the checkpoint at DEM step {state['dem_steps']} ({len(run.cols['step'])} "
                  "history rows)")
         if inexact_note(params):
             progress(f"note: not bit-identical: {inexact_note(params)}")
