@@ -27,19 +27,12 @@ class GrainModel:
         The value of ``resolution.grain_model`` that selects it (and ``ClumpLayout.model`` of its layouts).
     rotating : bool
         Its bodies rotate in the plane (sqrt(I/K_rot) bounds the step too).
-    ratcheting_guard : bool
-        ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` of its scenes (YADE's shear kinematics).
-    bonds_on_faces : bool
-        Its bonds act on their face's plane (YADE's smooth joint: normal and opening along the face
-        normal); False: along the line of the two sphere centres.
     resume_note : str
         "" if a resumed run of this model is bit-identical to the uninterrupted one (one thread),
         else why not.
     """
     name = ""
     rotating = True
-    ratcheting_guard = True
-    bonds_on_faces = False
     resume_note = ""
 
     def build_layout(self, specimen: Specimen, params: Parameters) -> ClumpLayout:

@@ -59,11 +59,6 @@ CONTACT_RADIUS_FRACTION = 0.5
 #: 0.208 against 0.209); "zXY" (free spin, as rigid cells) with YADE's default kinematics gave
 #: E 80.5 GPa, nu 0.255 and a DEM step 4.6 x shorter (the rotation of the smallest spheres sets it).
 BLOCKED_DOFS = "zXYZ"
-#: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in fem scenes.  YADE's default (True)
-#: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
-#: a spring between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
-#: False: the plain relative displacement, k_s as given, the static solve's kinematics.
-RATCHETING_GUARD = False
 #: Why a resumed run of fem cells is not bit-identical (measured: 3 x 6 mm fem UCS resumed at DEM step
 #: 20,179: E -6e-5, crack initiation -4e-5, peak +5e-7 relative, the same 26 bonds broken in the same
 #: modes, up to 17 DEM steps apart; docs/resuming.md).
@@ -198,8 +193,6 @@ class FemCells(GrainModel):
     """Each cell a cluster of spheres on its triangle mesh, held together by finite elements (module doc)."""
     name = NAME
     rotating = "Z" not in BLOCKED_DOFS
-    ratcheting_guard = RATCHETING_GUARD
-    bonds_on_faces = True
     resume_note = RESUME_NOTE
 
     def build_layout(self, specimen: Specimen, params: Parameters) -> FemLayout:

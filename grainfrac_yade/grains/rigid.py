@@ -162,8 +162,6 @@ class RigidCells(GrainModel):
     """Each cell one rigid body that translates and spins in the plane (see module doc)."""
     name = NAME
     rotating = True
-    ratcheting_guard = True     # YADE's default kinematics
-    bonds_on_faces = False
 
     def build_layout(self, specimen: Specimen, params: Parameters) -> ClumpLayout:
         return build_layout(specimen, params.resolution.spheres_per_cell)

@@ -5,7 +5,7 @@ Every layout sphere is a body of its own, translating in the plane only
 ``Lin4NodeTetra`` elements hold a cell's spheres together (each triangle a tetrahedron whose fourth
 node is lifted out of the plane, :func:`_append_fem_elements`), and ``FEInternalForceEngine`` applies
 their forces before the integrator.  The contact geometry takes the plain relative displacement
-(:data:`grainfrac_yade.grains.fem.RATCHETING_GUARD`) and the bonds act on their faces' planes (YADE's
+(:data:`RATCHETING_GUARD`) and the bonds act on their faces' planes (YADE's
 smooth joint, ``jointNormal`` the face normal): every bond is the two-node spring of the static
 solve.  The spheres are larger than their bond gaps, so each cell has its own collision mask
 (:func:`cell_mask`): spheres of one cell never touch.
@@ -19,9 +19,18 @@ import sys
 import numpy as np
 
 from ..errors import GrainfracError
-from ..grains.fem import BLOCKED_DOFS, MODEL, RATCHETING_GUARD, element_apex
+from ..grains.fem import BLOCKED_DOFS, MODEL, element_apex
 from ..vtkio import cluster_rigid_motion
 from .cell_bodies import CellBodies, cell_spheres, set_mass_inertia, sphere_positions
+
+#: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in fem scenes.  YADE's default (True)
+#: scales the relative translation of two spheres d apart by (r1 + r2)/d in the shear increment, so
+#: a spring between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
+#: False: the plain relative displacement, k_s as given, the static solve's kinematics.
+RATCHETING_GUARD = False
+#: The bonds act on their face's plane (YADE's smooth joint: normal and opening along the face normal,
+#: ``jointNormal``), as the static solve's two-node springs do.
+BONDS_ON_FACES = True
 
 #: Collision mask bit shared by every sphere of a scene with per-cell masks (and the collider's
 #: ``avoidSelfInteractionMask``): YADE makes no contact between two bodies of equal masks that

@@ -212,7 +212,7 @@ class GrainScene:
     def sliding_erasures(self) -> int:
         """Bonds erased by their sliding path so far (:mod:`.joints`): those synced as breaks, and the
         intact ones without cohesion that no strength break has synced yet; 0 without smooth joints."""
-        if not self.model.bonds_on_faces:
+        if not self.cells.BONDS_ON_FACES:
             return 0
         pending = sum(1 for k in np.flatnonzero(~self.broken) if not self.interactions[k].phys.isCohesive)
         return self.erased_by_sliding + pending
@@ -266,7 +266,7 @@ class GrainScene:
         fn = np.empty(len(idx))
         fs = np.empty(len(idx))
         inter = self.interactions
-        on_face = self.model.bonds_on_faces
+        on_face = self.cells.BONDS_ON_FACES
         for n, k in enumerate(idx):
             i = inter[k]
             phys = i.phys
@@ -279,7 +279,7 @@ class GrainScene:
         along the line of centres (penetration below its initial value), or across the face for bonds
         on their face's plane (YADE's smooth joint: |(x_b - x_a) . n| above its initial value)."""
         inter = self.interactions
-        if not self.model.bonds_on_faces:
+        if not self.cells.BONDS_ON_FACES:
             return np.array([inter[k].geom.penetrationDepth - inter[k].phys.initD < 0 for k in indices], dtype=bool)
         bodies = self.O.bodies
         out = []
@@ -471,7 +471,7 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             young=g.young, poisson=g.poisson, density=g.density, type=COHESIVE_TYPE,
             frictionAngle=c.friction_angle, residualFrictionAngle=c.residual_friction_angle,
             tensileStrength=1.0, cohesion=1.0)))
-    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True, smoothJoint=model.bonds_on_faces)
+    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True, smoothJoint=cells.BONDS_ON_FACES)
     geometry = w.Ig2_Sphere_Sphere_ScGeom()
     cells.configure_geometry(geometry)
     newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
@@ -512,6 +512,6 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
                        interactions=interactions, law=law, newton=newton, model=model, cells=cells,
                        dt_critical=dt_crit)
     scene.node_origin = scene.node_positions()
-    if model.bonds_on_faces and params.numerics.keep_intact_joints:
+    if cells.BONDS_ON_FACES and params.numerics.keep_intact_joints:
         scene.drivers.append(IntactJointGuard(scene))
     return scene
