@@ -31,7 +31,7 @@ def two_cell_specimen(params, mineral="quartz", thickness=1e-3, size=1e-3):
 
 
 class BondUnderForce:
-    """Holder for the creep-clock loops (:mod:`grainfrac_yade.creep_loops`): constant force on cell 1,
+    """Holder for the creep-clock loops (:mod:`grainfrac_yade.protocols.creep_loops`): constant force on cell 1,
     equilibrium by damped steps; no stress servo, no checkpoints."""
 
     servo = None

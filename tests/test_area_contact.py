@@ -19,7 +19,7 @@ def _corrode(normal_stress, shear_stress, restore=True, monkeypatch=None):
     """Corrode one bond under a constant force to its break; then AFTER_STEPS more DEM steps.
     Returns (holder, penetration at a = 1, at the break, after the steps, normal force after [N])."""
     from grainfrac_yade.clocks import EventClock
-    from grainfrac_yade.creep_loops import event_clock_loop
+    from grainfrac_yade.protocols.creep_loops import event_clock_loop
     from single_bond import BondUnderForce
     p = load_parameters(overrides=AREA)
     holder = BondUnderForce(p, normal_stress, shear_stress)

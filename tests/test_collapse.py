@@ -15,7 +15,7 @@ from conftest import needs_yade
 from grainfrac_yade.clocks import PaperClock
 from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.creep_loops import CollapseWatch, collapsing
+from grainfrac_yade.protocols.creep_loops import CollapseWatch, collapsing
 from grainfrac_yade.yade_adapter.platens import StressServo
 from test_reliability import JC, JT, StandInBonds, StandInHolder, loop_params
 
@@ -133,7 +133,7 @@ class CollapsingHolder(StandInHolder):
 
 
 def _paper(holder, increment, max_relaxation_steps=1000):
-    from grainfrac_yade.creep_loops import paper_clock_loop
+    from grainfrac_yade.protocols.creep_loops import paper_clock_loop
     clock = PaperClock(1e-5, 1e4, 1e-2)
     sc, cp = loop_params({"creep_time_limit": 1e9, "engine_period": 1, "unbalanced_engine_period": 1,
                           "unbalanced_force_reference": "relative"},

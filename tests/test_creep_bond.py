@@ -28,7 +28,7 @@ def _closed_form_shear(c0, tau, s_n, tan_phi):
 
 def _run(clock, sigma, tau, extra=()):
     from grainfrac_yade.clocks import EventClock, PaperClock
-    from grainfrac_yade.creep_loops import event_clock_loop, paper_clock_loop
+    from grainfrac_yade.protocols.creep_loops import event_clock_loop, paper_clock_loop
     from single_bond import BondUnderForce
     p = _params(clock, extra)
     holder = BondUnderForce(p, sigma, tau)

@@ -477,7 +477,7 @@ def bonds_left_whole(holder):
 
 
 def _clocked_breaks(clock_name, dt_max=1e8, limit=1e12):
-    from grainfrac_yade.creep_loops import event_clock_loop, paper_clock_loop
+    from grainfrac_yade.protocols.creep_loops import event_clock_loop, paper_clock_loop
     bonds = FrozenBonds(*frozen_bonds())
     if clock_name == "paper":
         clock = PaperClock(1e-5, dt_max, 1e-2)

@@ -8,7 +8,7 @@ import itertools
 import pytest
 
 from grainfrac_yade.clocks import PaperClock
-from grainfrac_yade.creep_loops import paper_clock_loop
+from grainfrac_yade.protocols.creep_loops import paper_clock_loop
 from test_reliability import JC, JT, StandInBonds, StandInHolder, loop_params
 
 

@@ -117,7 +117,7 @@ class StandInHolder:
 
 
 def _paper_loop(f_u, max_relaxation_steps=20, time_limit=1e5):
-    from grainfrac_yade.creep_loops import paper_clock_loop
+    from grainfrac_yade.protocols.creep_loops import paper_clock_loop
     holder = StandInHolder(itertools.repeat(f_u))
     bonds = StandInBonds([1e6, 2e6], [5e6, 5e6], JT, JC)
     clock = PaperClock(1e-5, 1e4, 1e-2)
@@ -149,7 +149,7 @@ def test_paper_clock_unbalanced_above_its_threshold_fails_after_the_set_steps():
 def test_paper_clock_loop_with_every_bond_broken_is_a_failure_not_an_infinite_force():
     """No intact bond: the relative F_u (mean resultant / mean bond force) would be inf, which the clock
     reads as a blown-up DEM; the loop ends the run as failed instead."""
-    from grainfrac_yade.creep_loops import paper_clock_loop
+    from grainfrac_yade.protocols.creep_loops import paper_clock_loop
     holder = StandInHolder(itertools.repeat(0.0))
     bonds = StandInBonds([1e6], [5e6], JT, JC)
     bonds.scene.broken[:] = True
@@ -166,7 +166,7 @@ def test_paper_clock_loop_on_a_nan_unbalanced_force_raises_numerical_failure():
 
 
 def _event_loop(bonds, holder=None):
-    from grainfrac_yade.creep_loops import event_clock_loop
+    from grainfrac_yade.protocols.creep_loops import event_clock_loop
     holder = holder or StandInHolder()
     clock = EventClock(0.1)
     n = event_clock_loop(holder, bonds, clock)
@@ -176,7 +176,7 @@ def _event_loop(bonds, holder=None):
 def test_repeated_zero_intervals_that_break_nothing_end_after_a_bounded_number():
     """sigma = 0 with J^T = 0: failed by the law (>=) at dt = 0, but a contact law that breaks only
     on F > FnMax never breaks it; the loop used to hand it over and relax forever."""
-    from grainfrac_yade.creep_loops import MAX_STALLED_INTERVALS
+    from grainfrac_yade.protocols.creep_loops import MAX_STALLED_INTERVALS
     bonds = StandInBonds([0.0], [0.0], 0.0, JC, breaks=False)
     holder = StandInHolder()
     with pytest.raises(NumericalFailure) as err:

@@ -42,7 +42,7 @@ import numpy as np
 
 from ..clocks import EventClock, PaperClock
 from ..errors import NumericalFailure
-from ..creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
+from ..protocols.creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
 from ..law import shear_strength
 from ..params import unbalanced_threshold
 from ..wave import hold_budget, scene_density

@@ -7,15 +7,17 @@ held load; ``safe_point(counters)`` is called between its checks, ``resume`` goe
 ``progress``, ``safe_point(phase, counters)`` (a checkpoint if one is due), ``platens``, ``servo``
 (None without a stress servo), ``failed``, ``failure_reason`` and ``last_relaxation_steps``.  The
 bonds are a stress-corrosion engine (:class:`grainfrac_yade.yade_adapter.corrosion_engine.StressCorrosion`):
-its law, state, stresses and writes.  The law is not here: :func:`grainfrac_yade.law.creep_step`
-(event clock) and the law's ``degrade`` (paper clock, through the engine).
+its law, state, stresses and writes; its ``scene`` is an engine's :class:`grainfrac_yade.engines.Scene`
+(``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
+(event clock) and the law's ``degrade`` (paper clock, through the engine).  The paper clock's
+unbalanced force needs a dynamic engine (one with inertia).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .errors import NumericalFailure
-from .law import creep_step
+from ..errors import NumericalFailure
+from ..law import creep_step
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
 #: is per metre of thickness; it is scaled by the layer thickness here.
