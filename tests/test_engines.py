@@ -67,3 +67,26 @@ def test_yade_state_round_trip():
     rebuilt.run(1)
     np.testing.assert_array_equal(rebuilt.export_state().bond_reference_gap, first.bond_reference_gap)
     assert rebuilt.steps == 301
+
+
+def test_engine_is_recorded_read_from_batch_tables_and_migrated():
+    """params.json records numerics.engine; a batch table may name it as a column; a params.json of a run made
+    before the choice existed reads as YADE's (every such run was)."""
+    from grainfrac_yade.params import migrate_tree, shipped_values
+    from grainfrac_yade.runs.batchrun import RUN_COLUMNS, check_columns
+    assert load_parameters().to_dict()["numerics"]["engine"] == "yade"
+    check_columns(["numerics.engine", "seed"], {**shipped_values(), **RUN_COLUMNS}, "t.table:2")   # quiet
+    assert load_parameters(overrides=[("numerics.engine", "yade")]).numerics.engine == "yade"
+    old = {"numerics": {"damping": 0.2}}
+    migrate_tree(old)
+    assert old["numerics"]["engine"] == "yade"
+
+
+def test_old_step_names_are_read_as_today():
+    """Histories and summaries of runs written before the step columns were renamed read as today's."""
+    import pandas as pd
+    from grainfrac_yade.protocols.columns import history_as_today, summary_as_today
+    frame = history_as_today(pd.DataFrame({"dem_step": [1, 2], "dem_time_s": [0.1, 0.2], "axial_strain": [0, 1]}))
+    assert list(frame.columns) == ["step", "time_s", "axial_strain"]
+    assert history_as_today({"creep_time_s": 0.0, "dem_steps": 7}) == {"creep_time_s": 0.0, "step": 7}
+    assert summary_as_today({"dem_steps": 5, "wall_s": 1.0}) == {"steps": 5, "wall_s": 1.0}

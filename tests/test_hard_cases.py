@@ -77,7 +77,7 @@ def no_negative_strength(scene, corr=None):
 @pytest.fixture
 def captured(monkeypatch):
     """The scene (and corrosion engine) of the next UCS or creep run made through the run-folder functions."""
-    from grainfrac_yade.yade_adapter import creep_protocol, ucs_protocol
+    from grainfrac_yade.yade_adapter import engine   # what the commands call (engines.engine_for)
     got = {}
 
     def keep(module, name, pick):
@@ -88,8 +88,8 @@ def captured(monkeypatch):
             got["scene"], got["corr"] = pick(result)
             return result
         monkeypatch.setattr(module, name, wrapper)
-    keep(creep_protocol, "run_creep", lambda run: (run.scene, run.corr))
-    keep(ucs_protocol, "run_ucs", lambda result: (result[2], None))
+    keep(engine, "run_creep", lambda run: (run.scene, run.corr))
+    keep(engine, "run_ucs", lambda result: (result[2], None))
     return got
 
 
