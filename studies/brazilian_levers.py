@@ -24,7 +24,7 @@ BLOCK = [("specimen.width", 10e-3), ("specimen.height", 20e-3)]
 def ucs_with_levers(params, seed, out, levers):
     """A UCS test whose scene gets ``levers`` before loading (as the brazilian command does)."""
     from grainfrac_yade.yade_adapter.scene import build_scene
-    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    from grainfrac_yade.protocols.ucs import run_ucs
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=True)
     specimen = build_specimen(params, seed)
     scene = build_scene(specimen, params)

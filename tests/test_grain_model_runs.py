@@ -147,6 +147,7 @@ def fake_scene(specimen, layout):
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):
     from grainfrac_yade.commands.creep import run_creep_to_folder
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols import ucs as ucs_test
     from grainfrac_yade.yade_adapter import engine
     params, specimen, lay = fem
     scene = fake_scene(specimen, lay)
@@ -158,7 +159,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
                "broken_tensile": zeros, "broken_shear": zeros, "broken_inter": zeros, "broken_intra": zeros}
     result = {"steps": 1000, "wall_s": 0.1, "dem_timestep_s": 1e-9, "n_bonds": lay.n_bonds,
               "numerical_failure": False, "peak_reached": True, "end_reason": "post-peak"}
-    monkeypatch.setattr(engine, "run_ucs", lambda specimen, params, progress=None, **outputs:
+    monkeypatch.setattr(ucs_test, "run_ucs", lambda specimen, params, progress=None, **outputs:
                         (history, result, scene, (scene.broken, scene.break_mode)))
     rows = [{"creep_time_s": t, "axial_strain": 2e-3 + 1e-9 * t, "lateral_strain": -4e-4, "axial_stress_pa": 200e6,
              "broken_total": 3, "macrocracks": 0, "step": 1000, "wall_s": 0.1} for t in (0.0, 10.0, 20.0)]

@@ -77,6 +77,7 @@ def no_negative_strength(scene, corr=None):
 @pytest.fixture
 def captured(monkeypatch):
     """The scene (and corrosion engine) of the next UCS or creep run made through the run-folder functions."""
+    from grainfrac_yade.protocols import ucs as ucs_test
     from grainfrac_yade.yade_adapter import engine   # what the commands call (engines.engine_for)
     got = {}
 
@@ -89,7 +90,7 @@ def captured(monkeypatch):
             return result
         monkeypatch.setattr(module, name, wrapper)
     keep(engine, "run_creep", lambda run: (run.scene, run.corr))
-    keep(engine, "run_ucs", lambda result: (result[2], None))
+    keep(ucs_test, "run_ucs", lambda result: (result[2], None))
     return got
 
 
@@ -125,7 +126,7 @@ def outcome_in_analysis(folder) -> list:
 def step_ten_times_critical(monkeypatch):
     """Scenes built for UCS and creep runs step at 10 x their critical DEM step (timestep_safety <= 1
     cannot ask for it: the step is set after the scene is built)."""
-    from grainfrac_yade.yade_adapter import creep_protocol, ucs_protocol
+    from grainfrac_yade.yade_adapter import creep_protocol, engine
 
     def stepping_up(build):
         def build_then_step_up(*args, **kwargs):
@@ -133,7 +134,7 @@ def step_ten_times_critical(monkeypatch):
             scene.O.dt = 10 * scene.dt_critical
             return scene
         return build_then_step_up
-    for module in (creep_protocol, ucs_protocol):
+    for module in (creep_protocol, engine):   # the creep runner's own build, the engine's for the UCS test
         monkeypatch.setattr(module, "build_scene", stepping_up(module.build_scene))
 
 
@@ -173,7 +174,7 @@ def rigid_ucs():
     """UCS of the 4 x 8 mm specimen, seed 1 (measured 251.8 MPa; 3 s)."""
     from grainfrac_yade.specimen import build_specimen
     from grainfrac_yade.ucs_analysis import ucs_summary
-    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=TINY)
     return ucs_summary(run_ucs(build_specimen(p, 1), p)[0])["ucs_pa"]
 
@@ -361,7 +362,7 @@ def test_f_a_strict_one_cell_column_ends_at_the_strain_cap_as_a_lower_bound(sphe
     elastic to the 2 % strain cap (1.8 GPa).  Neither breaks a bond.  Before, the first run 'failed'
     post-peak at 3.4 MPa after 376 DEM steps (the ringing read as softening).  1-2 s each."""
     from grainfrac_yade.ucs_analysis import ucs_summary
-    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=["specimen.width=2e-3", "specimen.height=8e-3", "specimen.grain_size=1.9e-3",
                                    f"resolution.spheres_per_cell={spheres_per_cell}"])
     history, result, scene, _ = run_ucs(column_specimen(p), p)

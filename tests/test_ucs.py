@@ -13,7 +13,7 @@ SMALL = ["specimen.width=6e-3", "specimen.height=12e-3"]
 
 
 def _ucs(overrides, seed=1):
-    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=SMALL + overrides)
     hist, result, scene, _ = run_ucs(build_specimen(p, seed), p)
     return ucs_summary(hist), result, scene
@@ -42,7 +42,7 @@ def test_ucs_scene_has_no_stress_corrosion_engine():
 def test_the_post_peak_stop_waits_for_the_minimum_strain():
     """``ucs.stop_min_strain`` past the default run's end: the same history up to that end, bit for bit
     (the key only moves the stop), then the test goes on to the minimum strain before it may stop."""
-    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    from grainfrac_yade.protocols.ucs import run_ucs
     tiny = ["specimen.width=3e-3", "specimen.height=6e-3"]
     p = load_parameters(overrides=tiny)
     h0, r0, _, _ = run_ucs(build_specimen(p, 1), p)
@@ -90,7 +90,7 @@ YOUNG_BAND_PA = (71.9e9 - 3 * 1.2e9, 71.9e9 + 3 * 1.2e9)
 
 
 def test_small_specimen_ucs_regression():
-    from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
+    from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3"])
     hist, result, _, _ = run_ucs(build_specimen(p, 1), p)
     s = ucs_summary(hist)

@@ -82,6 +82,7 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..specimen import build_specimen
     from ..engines import engine_for
+    from ..protocols import ucs as ucs_test
     from ..protocols.cracks import bond_segments
     from ..ucs_analysis import ucs_summary
     require_plane(params, "ucs")
@@ -90,11 +91,11 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     outputs = {"checkpoint_folder": out, "run_values": {"seed": seed}}
     engine = engine_for(params)
     if resume:
-        history, result, scene, (broken_peak, mode_peak) = engine.resume_ucs(specimen, params, out, progress=progress)
+        history, result, scene, (broken_peak, mode_peak) = ucs_test.resume_ucs(specimen, params, out, progress=progress)
     else:
         snapshot = engine.StrainSeries(out / "vtk", vtk_every, engine.AXIAL_STRAIN) if vtk_every else None
-        history, result, scene, (broken_peak, mode_peak) = engine.run_ucs(specimen, params, progress=progress,
-                                                                          snapshot=snapshot, **outputs)
+        history, result, scene, (broken_peak, mode_peak) = ucs_test.run_ucs(specimen, params, progress=progress,
+                                                                            snapshot=snapshot, **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing
     no_result = result["numerical_failure"] or result.get("failed_before_test")
     summary = dict.fromkeys(MEASURES) if no_result else ucs_summary(history)

@@ -193,6 +193,14 @@ class Scene(Protocol):
     def restore(self, path) -> None:
         """Replace this scene (built from the same specimen and parameters) by the one saved at ``path``."""
 
+    def checkpoint_state(self) -> dict:
+        """What a checkpoint keeps of the scene beside :meth:`save`'s file (its size, its break bookkeeping)."""
+
+    def restore_checkpoint(self, where, scene_file, saved: dict, arrays: dict, confinement=None) -> None:
+        """:meth:`restore` from a checkpoint (``saved``: :meth:`checkpoint_state`, ``arrays``: the bonds'
+        ``broken``, ``break_mode``, ``break_step``), refusing another scene's in one line; ``confinement``:
+        side-wall forces set again."""
+
     def export_state(self, platens: PlatenDrive | None = None) -> SceneState:
         """The scene's state in the engine-neutral form (with ``platens``' state if given)."""
 

@@ -41,145 +41,23 @@ corrosion, clock, history, loop counters) comes from ``state.json`` and ``arrays
 """
 from __future__ import annotations
 
-import datetime as _dt
-import json
-import os
-import shutil
 import time
-from pathlib import Path
 
 import numpy as np
 
 from ..clocks import EventClock, PaperClock
-from ..errors import GrainfracError
-from ..grains import grain_model
-from ..protocols.columns import HISTORY_RENAMED, history_as_today
-from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
+from ..protocols.checkpoints import (ARRAYS_FILE, FORMAT, PHASES, SCENE_FILE, START_TABLE, Checkpointer,  # noqa: F401
+                                     LoadingCheckpoints, base_state, history_arrays, inexact_note, platen_state, read,
+                                     restore_platens, restore_scene, resume_record, scene_arrays)
+from ..protocols.columns import history_as_today
 from ..wave import HoldBudget
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import StressServo
 
-#: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
-SCENE_FILE = "scene.yade.gz"
-#: Per-bond arrays of the driver.
-ARRAYS_FILE = "arrays.npz"
-#: Layout of state.json and arrays.npz; a checkpoint of another layout is refused.
-FORMAT = 1
-#: Safe points of each test's driver at which a checkpoint can be taken (the phase it resumes in);
-#: a checkpoint without a ``test`` key is a creep run's (written before the other tests had any).
-PHASES = {"creep": ("loading", "ramp", "event", "relaxation", "paper"), "ucs": ("loading",), "brazilian": ("loading",)}
-#: Prefix of the initial bond-stress table's columns in arrays.npz.
-START_TABLE = "start_"
 
-
-def _json_value(value):
-    """numpy scalars and arrays as JSON numbers and lists (floats keep every bit: JSON writes repr)."""
-    if isinstance(value, (np.generic, np.ndarray)):
-        return value.tolist()
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
-
-
-def _fsync(path):
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-class LoadingCheckpoints:
-    """Checkpoints of a strain-controlled test (UCS, Brazilian): one is due before a history row's DEM
-    steps (its :meth:`safe_point`), when the state is complete.  The test's runner calls
-    :meth:`init_checkpoints` in its constructor; ``capture`` is the test's (state, arrays) writer."""
-
-    def init_checkpoints(self, checkpoint_folder, params, run_values, progress, capture):
-        self.checkpointer = None if checkpoint_folder is None else Checkpointer(
-            checkpoint_folder, params.numerics.checkpoint_interval, run_values or {}, progress, capture=capture)
-        #: the checkpoints this run went on from (DEM step, phase, when written)
-        self.resumes = []
-        #: a :class:`.vtk_output.StrainSeries` told of each row and of the end (it only reads the scene); None: no VTK
-        self.snapshot = None
-
-    def safe_point(self):
-        """Before a history row's DEM steps: the state is complete; a checkpoint if one is due."""
-        ck = self.checkpointer
-        if ck is not None and self.scene.O.iter > 0 and ck.due():
-            ck.write(self, "loading", {})
-
-
-class Checkpointer:
-    """Writes the checkpoints of one run into ``run_folder/checkpoint/``.
-
-    ``interval``: wall time between checkpoints [s] (``numerics.checkpoint_interval``); 0: none but
-    those the driver forces (a creep run's at the end of its ramp).  ``run_values``: what besides the
-    parameters makes the run (seed, load), stored so that a batch rerun can tell whether the
-    checkpoint continues its row.  ``capture(run, phase, loop, run_values, code_version)`` gives
-    (state, arrays) of the run (default: a creep run's, :func:`capture`).
-    """
-
-    def __init__(self, run_folder, interval: float, run_values: dict, progress=None, capture=None):
-        self.capture = capture or globals()["capture"]
-        self.folder = Path(run_folder)
-        self.interval = float(interval)
-        self.run_values = dict(run_values)
-        self.progress = progress or (lambda msg: None)
-        self.code_version = code_version()
-        self.last = time.monotonic()
-        #: wall time [s] and size [bytes] of each checkpoint written
-        self.write_s, self.sizes = [], []
-
-    def due(self) -> bool:
-        return self.interval > 0 and time.monotonic() - self.last >= self.interval
-
-    def write(self, run, phase: str, loop: dict):
-        """Checkpoint ``run`` at a safe point of ``phase`` with the loop's counters ``loop``."""
-        t0 = time.monotonic()
-        tmp, final, old = (self.folder / n for n in (CHECKPOINT_TMP, CHECKPOINT, CHECKPOINT_OLD))
-        try:
-            shutil.rmtree(tmp, ignore_errors=True)
-            tmp.mkdir(parents=True)
-            state, arrays = self.capture(run, phase, loop, self.run_values, self.code_version)
-            run.scene.O.save(str(tmp / SCENE_FILE))
-            with open(tmp / ARRAYS_FILE, "wb") as fh:
-                np.savez(fh, **arrays)
-            text = json.dumps(state, indent=1, default=_json_value) + "\n"
-            for name in (SCENE_FILE, ARRAYS_FILE):
-                _fsync(tmp / name)
-            (tmp / CHECKPOINT_STATE).write_text(text)   # last, once the rest is on disk: marks it complete
-            _fsync(tmp / CHECKPOINT_STATE)
-            _fsync(tmp)
-            shutil.rmtree(old, ignore_errors=True)
-            if final.exists():
-                os.replace(final, old)
-            os.replace(tmp, final)
-            _fsync(self.folder)
-            shutil.rmtree(old, ignore_errors=True)
-        except (OSError, RuntimeError, TypeError, ValueError) as exc:   # an aid: the run goes on without it
-            self.progress(f"checkpoint not written ({type(exc).__name__}: {exc}); the run goes on")
-            return
-        finally:
-            self.last = time.monotonic()
-        self.write_s.append(time.monotonic() - t0)
-        self.sizes.append(sum(p.stat().st_size for p in final.iterdir()))
-
-
-def base_state(test: str, run, phase: str, loop: dict, run_values: dict, version: str) -> dict:
-    """The keys of state.json every test writes (``run``: has ``scene``, ``t0`` and ``c0``)."""
-    sc = run.scene
-    return {"format": FORMAT, "test": test, "phase": phase, "loop": dict(loop), "run_values": run_values,
-            "code_version": version, "written": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-            "dem_steps": int(sc.O.iter), "wall_s": time.time() - run.t0, "cpu_s": time.process_time() - run.c0,
-            "scene": {"n_bodies": len(sc.O.bodies), "n_bonds": sc.n_bonds, "cracks_seen": sc._cracks_seen,
-                      "tens_seen": sc._tens_seen, "erased_by_sliding": sc.erased_by_sliding}}
-
-
-def scene_arrays(scene) -> dict:
-    """The scene's bond bookkeeping for arrays.npz."""
-    return {"broken": scene.broken, "break_mode": scene.break_mode, "break_step": scene.break_step}
-
-
-def platen_state(platens) -> dict:
-    return platens.state_dict()
+def rebind_scene(scene):
+    """After ``O.load``: fetch the scene's bond and link interactions and its law and integrator anew."""
+    scene.rebind()
 
 
 def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") -> tuple:
@@ -215,90 +93,6 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
         state["start_table_columns"] = list(run.initial_bond_stresses)
         arrays.update({START_TABLE + k: np.asarray(v) for k, v in run.initial_bond_stresses.items()})
     return state, arrays
-
-
-def read(run_folder, test: str = "creep") -> tuple:
-    """(checkpoint folder, state, arrays) of the ``test`` run in ``run_folder``; GrainfracError if it has
-    none or it is bad."""
-    where = checkpoint_folder(run_folder)
-    if where is None:
-        raise GrainfracError(f"{run_folder}: no checkpoint to resume from ({CHECKPOINT}/ missing: the run stopped "
-                             "before its first checkpoint, or was started by code without checkpoints); fix: start "
-                             "it again with --overwrite")
-    try:
-        state = json.loads((where / CHECKPOINT_STATE).read_text())
-        with np.load(where / ARRAYS_FILE) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise GrainfracError(f"{where}: checkpoint unreadable ({type(exc).__name__}: {exc}); fix: start the run "
-                             "again with --overwrite") from None
-    if state.get("format") != FORMAT or state.get("phase") not in PHASES.get(state.get("test", "creep"), ()):
-        raise GrainfracError(f"{where}: checkpoint of another layout (format {state.get('format')!r}, this code "
-                             f"reads {FORMAT}); fix: resume it with the code that wrote it, or start the run again "
-                             "with --overwrite")
-    if state.get("test", "creep") != test:
-        raise GrainfracError(f"{where}: checkpoint of a {state.get('test', 'creep')} run, not of a {test} run; fix: "
-                             f"resume it with the {state.get('test', 'creep')} command")
-    return where, state, arrays
-
-
-def rebind_scene(scene):
-    """After ``O.load``: fetch the scene's bond and link interactions and its law and integrator anew."""
-    scene.rebind()
-
-
-def history_arrays(arrays: dict, prefix: str, columns) -> dict:
-    """The history columns a checkpoint's arrays.npz holds under ``prefix``, by today's names (older checkpoints
-    hold some under their old names, :data:`grainfrac_yade.protocols.columns.HISTORY_RENAMED`)."""
-    old = {new: name for name, new in HISTORY_RENAMED.items() if prefix + name in arrays}
-    return {k: arrays[prefix + (k if prefix + k in arrays else old[k])].tolist() for k in columns}
-
-
-def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):
-    """Replace scene ``sc`` (freshly built from the same specimen and parameters) by the checkpoint's
-    (``O.load``), fetch its handles anew and restore its bond bookkeeping; ``confinement``: the
-    :class:`.confinement.Confinement` whose permanent forces are set again (None: unconfined)."""
-    O = sc.O
-    n_bodies = len(O.bodies)
-    if state["scene"]["n_bodies"] != n_bodies or state["scene"]["n_bonds"] != sc.n_bonds:
-        raise GrainfracError(f"{where}: checkpoint of another scene ({state['scene']['n_bodies']} bodies, "
-                             f"{state['scene']['n_bonds']} bonds; rebuilt: {n_bodies}, {sc.n_bonds}); fix: start the "
-                             "run again with --overwrite")
-    try:
-        O.load(str(where / SCENE_FILE))
-    except (RuntimeError, OSError, EOFError, ValueError) as exc:   # truncated or garbage: YADE's gzip/boost errors
-        raise GrainfracError(f"{where / SCENE_FILE}: the checkpoint's scene is unreadable ({type(exc).__name__}: "
-                             f"{exc}; truncated or not a YADE scene); fix: start the run again with --overwrite") from None
-    rebind_scene(sc)
-    if confinement is not None:
-        confinement.apply()   # permanent forces are not saved with the scene
-    sc.broken, sc.break_mode, sc.break_step = (np.array(arrays[k]) for k in ("broken", "break_mode", "break_step"))
-    sc._cracks_seen, sc._tens_seen = state["scene"]["cracks_seen"], state["scene"]["tens_seen"]
-    # checkpoints written before the count was kept: none was counted then
-    sc.erased_by_sliding = state["scene"].get("erased_by_sliding", 0)
-    if sc.law.nbTensCracks + sc.law.nbShearCracks != sc._cracks_seen:
-        raise GrainfracError(f"{where}: the loaded scene's crack count ({sc.law.nbTensCracks + sc.law.nbShearCracks}) "
-                             f"is not the checkpoint's ({sc._cracks_seen}); fix: start the run again with --overwrite")
-
-
-def restore_platens(pl, p: dict):
-    """After :func:`restore_scene`: the platens' body handles anew, their reference positions and speed."""
-    pl.rebind(p["reaction_pa"])
-    pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]
-
-
-
-def inexact_note(params) -> str:
-    """"" if a resume of a run with ``params`` is bit-identical to the uninterrupted run (one thread), else why not."""
-    return grain_model(params.resolution.grain_model).resume_note
-
-
-def resume_record(state: dict) -> dict:
-    """What a summary's ``resumed_from`` lists for the checkpoint ``state``."""
-    out = {"dem_steps": state["dem_steps"], "phase": state["phase"], "checkpoint_written": state["written"]}
-    if "creep_time_s" in state:
-        out["creep_time_s"] = state["creep_time_s"]
-    return out
 
 
 def restore(run, where, state: dict, arrays: dict):

@@ -16,12 +16,9 @@ import numpy as np
 
 from ..tessellation import SIDES
 from ..wave import hold_budget, scene_density
+from ..protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
 from .platens import StressServo, free_bodies, held_at_equilibrium
 
-#: Share of the bonds broken in the isotropic stage at which the specimen counts as broken apart before
-#: the test proper: with half its bonds gone there is no specimen left whose strength the axial stage
-#: could measure (a confinement 1e6 times too large broke all 239 bonds of a small specimen).
-BROKEN_APART_FRACTION = 0.5
 
 #: Walls that carry the confining stress and the inward direction (x) of their force.
 CONFINED_WALLS = (("left", 1.0), ("right", -1.0))
@@ -99,13 +96,3 @@ def consolidate(scene, platens, stress: float, params) -> dict:
         scene.drivers.remove(servo)
         platens.set_axial_velocity(0.0)
     return {"consolidation_steps": done, "consolidated": balanced, "consolidation_axial_stress_pa": servo.stress}
-
-
-def broken_apart_reason(scene, stress: float, lost: str = "no strength measured") -> str:
-    """"" if the specimen is intact after the isotropic stage at ``stress`` [Pa], else why it is not
-    (:data:`BROKEN_APART_FRACTION` of its bonds or more broken; ``lost``: what the test cannot give then)."""
-    broken, total = int(np.count_nonzero(scene.broken)), scene.n_bonds
-    if total and broken >= BROKEN_APART_FRACTION * total:
-        return (f"the specimen broke apart in the isotropic stage at sigma_3 = {stress / 1e6:.4g} MPa ({broken} of "
-                f"{total} bonds broken before axial loading): {lost}; fix: a smaller confinement")
-    return ""

@@ -46,7 +46,7 @@ from ..protocols.creep_loops import CollapseWatch, collapsing, event_clock_loop,
 from ..law import shear_strength
 from ..params import unbalanced_threshold
 from ..wave import hold_budget, scene_density
-from .checkpoint import Checkpointer, inexact_note, read, restore
+from .checkpoint import Checkpointer, capture, inexact_note, read, restore
 from .confinement import Confinement, broken_apart_reason, consolidate
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
@@ -133,7 +133,7 @@ class CreepRun:
         self.checkpointer = None
         if checkpoint_folder is not None:
             self.checkpointer = Checkpointer(checkpoint_folder, params.numerics.checkpoint_interval, run_values or {},
-                                             self.progress)
+                                             self.progress, capture=capture)
         #: (phase, loop counters) to go on from after :func:`resume_creep`; None: a run from the start
         self.resumed = None
         #: the checkpoints this run was resumed from (DEM step, creep time, phase, when written)

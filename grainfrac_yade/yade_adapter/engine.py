@@ -5,7 +5,9 @@ Explicit DEM (YADE's JCFpm bonds, Cundall's non-viscous damping) with dynamic re
 steps, and equilibrium is reached by relaxing until the project's criterion holds.  Importing this
 module does not import YADE: :func:`.load_yade` does, when the first scene is built.
 
-The test runners (UCS, Brazilian, creep), their VTK series, the Brazilian levers, yade-batch rows and
+The isotropic stage of a confined test (``consolidate``: a stress servo and dynamic relaxation), the test
+runners written for YADE so far (Brazilian, creep; the UCS test is :mod:`grainfrac_yade.protocols.ucs`), the
+VTK series, the Brazilian levers, yade-batch rows and
 the timings of ``bench`` are this engine's, listed here so that the commands reach them through the
 engine registry and never import this package.
 """
@@ -15,10 +17,10 @@ from . import load_yade, use_default_threads  # noqa: F401
 from .batch import read_table, row_errors, row_plan, run_folder_name  # noqa: F401
 from .bench_timing import TimedCreepRun, loading_step_cost, time_bond_io, time_stepping  # noqa: F401
 from .brazilian_protocol import resume_brazilian, run_brazilian  # noqa: F401
+from .confinement import consolidate  # noqa: F401
 from .creep_protocol import resume_creep, run_creep  # noqa: F401
 from .levers import Levers, new_breaks  # noqa: F401
 from .scene import GrainScene, build_scene, scene_from_state  # noqa: F401
-from .ucs_protocol import resume_ucs, run_ucs  # noqa: F401
 from .vtk_output import AXIAL_STRAIN, DIAMETRAL_STRAIN, StrainSeries, write_life_series  # noqa: F401
 
 #: The value of ``numerics.engine`` that selects this engine.

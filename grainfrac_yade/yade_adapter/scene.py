@@ -321,6 +321,40 @@ class GrainScene:
         bodies = self.O.bodies
         return np.array([tuple(bodies[int(b)].state.pos) for b in self.node_bodies()])
 
+    def checkpoint_state(self) -> dict:
+        """What a checkpoint's state.json keeps of the scene beside :meth:`save`'s file: its size (a checkpoint
+        of another scene is refused) and the bookkeeping of the breaks the law has counted."""
+        return {"n_bodies": len(self.O.bodies), "n_bonds": self.n_bonds, "cracks_seen": self._cracks_seen,
+                "tens_seen": self._tens_seen, "erased_by_sliding": self.erased_by_sliding}
+
+    def restore_checkpoint(self, where, scene_file, saved: dict, arrays: dict, confinement=None):
+        """Replace this scene (freshly built from the same specimen and parameters) by the checkpoint ``where``'s:
+        ``O.load`` of ``scene_file``, the handles fetched anew, the permanent forces of ``confinement`` set
+        again (YADE does not save them; None: unconfined), and the bond bookkeeping from ``saved``
+        (:meth:`checkpoint_state`) and ``arrays``.  GrainfracError (one line) for another scene's checkpoint,
+        an unreadable scene file or a crack count that is not the checkpoint's."""
+        O = self.O
+        n_bodies = len(O.bodies)
+        if saved["n_bodies"] != n_bodies or saved["n_bonds"] != self.n_bonds:
+            raise GrainfracError(f"{where}: checkpoint of another scene ({saved['n_bodies']} bodies, "
+                                 f"{saved['n_bonds']} bonds; rebuilt: {n_bodies}, {self.n_bonds}); fix: start the "
+                                 "run again with --overwrite")
+        try:
+            O.load(str(scene_file))
+        except (RuntimeError, OSError, EOFError, ValueError) as exc:   # truncated or garbage: YADE's gzip/boost errors
+            raise GrainfracError(f"{scene_file}: the checkpoint's scene is unreadable ({type(exc).__name__}: "
+                                 f"{exc}; truncated or not a YADE scene); fix: start the run again with --overwrite") from None
+        self.rebind()
+        if confinement is not None:
+            confinement.apply()   # permanent forces are not saved with the scene
+        self.broken, self.break_mode, self.break_step = (np.array(arrays[k]) for k in ("broken", "break_mode", "break_step"))
+        self._cracks_seen, self._tens_seen = saved["cracks_seen"], saved["tens_seen"]
+        # checkpoints written before the count was kept: none was counted then
+        self.erased_by_sliding = saved.get("erased_by_sliding", 0)
+        if self.law.nbTensCracks + self.law.nbShearCracks != self._cracks_seen:
+            raise GrainfracError(f"{where}: the loaded scene's crack count ({self.law.nbTensCracks + self.law.nbShearCracks}) "
+                                 f"is not the checkpoint's ({self._cracks_seen}); fix: start the run again with --overwrite")
+
     def save(self, path):
         """``O.save``: YADE's whole scene (bodies, interactions, engines, counters; no forces), exact doubles."""
         self.O.save(str(path))

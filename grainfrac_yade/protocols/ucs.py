@@ -1,7 +1,8 @@
 """Strain-controlled uniaxial compression between rigid platens (the UCS of paper section 3.1), or
 confined (biaxial) compression with ``confinement.stress`` sigma_3 > 0 on the side walls
-(:mod:`.confinement`: isotropic stage to sigma_1 = sigma_3 first, then the same axial loading; the
-post-peak stop rule then applies to the deviator sigma_1 - sigma_3).
+(the engine's ``consolidate``: isotropic stage to sigma_1 = sigma_3 first, then the same axial loading; the
+post-peak stop rule then applies to the deviator sigma_1 - sigma_3).  Written against the scene interface
+(:class:`grainfrac_yade.engines.Scene`): any engine runs it.
 
 The test ends once the axial stress falls below ``ucs.stop_stress_ratio`` of its peak (past
 ``ucs.stop_min_strain`` of axial strain) with bonds
@@ -10,8 +11,8 @@ column set in motion from rest: measured 3.4 MPa then below 2.4 MPa, no bond bro
 on a numerical failure (NaN or infinite measures, a DEM step above the critical one): no result.
 The result dict says which in ``end_reason`` (and ``peak_reached``, ``numerical_failure``).
 
-Checkpoints (given a run folder, :mod:`.checkpoint`): every ``numerics.checkpoint_interval`` s of
-wall time, before a history row's DEM steps; :func:`resume_ucs` goes on from the last one and
+Checkpoints (given a run folder, :mod:`.checkpoints`): every ``numerics.checkpoint_interval`` s of
+wall time, before a history row's steps; :func:`resume_ucs` goes on from the last one and
 computes what the uninterrupted test would have, bit for bit (one thread).
 """
 
@@ -21,15 +22,14 @@ import time
 
 import numpy as np
 
+from ..engines import engine_for
 from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
-from .checkpoint import (LoadingCheckpoints, base_state, history_arrays, inexact_note, platen_state, read, restore_platens,
-                         restore_scene, resume_record, scene_arrays)
-from .confinement import Confinement, broken_apart_reason, consolidate
-from .platens import Platens
-from ..protocols.cracks import broken_counts
-from ..protocols.loading import LoadingTest
-from .scene import build_scene
+from .checkpoints import (LoadingCheckpoints, base_state, history_arrays, inexact_note, platen_state, read,
+                          restore_platens, restore_scene, resume_record, scene_arrays)
+from .confinement import broken_apart_reason
+from .cracks import broken_counts
+from .loading import LoadingTest
 
 #: Columns of a UCS history.
 HISTORY_COLUMNS = ("step", "time_s", "axial_strain", "lateral_strain", "axial_stress_pa", "broken_total",
@@ -46,13 +46,14 @@ class UcsRun(LoadingCheckpoints, LoadingTest):
     def __init__(self, specimen, params, progress=None, scene=None, checkpoint_folder=None, run_values=None):
         self.t0, self.c0 = time.time(), time.process_time()
         self.params, self.progress = params, progress
-        self.scene = scene = scene or build_scene(specimen, params)
+        #: the engine of ``params`` (``numerics.engine``): builds the scene, brings a confined specimen to sigma_3
+        self.engine = engine_for(params)
+        self.scene = scene = scene or self.engine.build_scene(specimen, params)
         ucs = params.ucs
-        self.platens = platens = Platens(scene, ucs.platen_lateral)
-        scene.extras.append(platens)
+        self.platens = platens = scene.attach_platens(ucs.platen_lateral)
         self.closing_speed = ucs.strain_rate * platens.height
         platens.set_axial_velocity(self.closing_speed)
-        self.steps_per_row = max(1, int(round(ucs.record_strain_increment / (ucs.strain_rate * scene.O.dt))))
+        self.steps_per_row = max(1, int(round(ucs.record_strain_increment / (ucs.strain_rate * scene.dt))))
         self.cols = {k: [] for k in HISTORY_COLUMNS}
         self.peak, self.broken_at_peak = 0.0, 0
         self.peak_snapshot = (scene.broken.copy(), scene.break_mode.copy())
@@ -72,9 +73,8 @@ class UcsRun(LoadingCheckpoints, LoadingTest):
         broken_apart = ""   # why the specimen broke apart before the axial stage (confined tests), "" if not
         try:
             if confining > 0 and not self.resumed:
-                self.confinement = Confinement(scene, confining)
-                scene.extras.append(self.confinement)
-                self.consolidation = consolidate(scene, platens, confining, self.params)
+                self.confinement = scene.confine(confining)
+                self.consolidation = self.engine.consolidate(scene, platens, confining, self.params)
                 platens.set_axial_velocity(self.closing_speed)
                 broken_apart = end = broken_apart_reason(scene, confining)
                 if broken_apart and self.progress:
@@ -127,8 +127,7 @@ def restore(run, where, state, arrays):
     and parameters)."""
     r = state["run"]
     if r["confined"]:
-        run.confinement = Confinement(run.scene, run.confining)   # its forces, set again after O.load
-        run.scene.extras.append(run.confinement)
+        run.confinement = run.scene.confine(run.confining)   # its forces, set again after the scene is restored
     restore_scene(run.scene, where, state, arrays, run.confinement)
     restore_platens(run.platens, state["platens"])
     run.peak, run.broken_at_peak, run.consolidation = r["peak"], r["broken_at_peak"], r["consolidation"]
