@@ -211,7 +211,7 @@ def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack():
     ends at 0.44 (0.73 at the peak) after post-peak cracking, and a 6 mm disc (36 cells) ends at 0.46-0.60.
     """
     from grainfrac_yade.brazilian_analysis import brazilian_summary
-    from grainfrac_yade.yade_adapter.brazilian_protocol import run_brazilian
+    from grainfrac_yade.protocols.brazilian import run_brazilian
     p = load_parameters(overrides=TINY)
     for seed in (1, 2, 3):
         sp = build_disc_specimen(p, seed)
@@ -234,7 +234,7 @@ def test_tensile_scale_lowers_the_strength():
     measured 37.7 -> 31.0 MPa, -18 %: the split's zigzag faces fail in shear as well as in tension)."""
     from grainfrac_yade.brazilian_analysis import brazilian_summary
     from grainfrac_yade.commands.brazilian import check_tensile_scale, tensile_scale_overrides
-    from grainfrac_yade.yade_adapter.brazilian_protocol import run_brazilian
+    from grainfrac_yade.protocols.brazilian import run_brazilian
     base = load_parameters(overrides=TINY)
     half = load_parameters(overrides=TINY + tensile_scale_overrides(base, 0.5))
     check_tensile_scale(base, half, 0.5)
@@ -297,7 +297,7 @@ def test_params_json_written_before_the_brazilian_section_still_loads(tmp_path):
 def test_levers_off_change_nothing_and_slits_are_not_cracks():
     """Levers() leaves a run bit-identical; slits start broken (mode PRE_EXISTING), are left out of the crack
     counts, and lower the strength; blocked rotation blocks every cell's Z rotation (8 mm disc, seed 1)."""
-    from grainfrac_yade.yade_adapter.brazilian_protocol import run_brazilian
+    from grainfrac_yade.protocols.brazilian import run_brazilian
     from grainfrac_yade.yade_adapter.levers import PRE_EXISTING, Levers, apply_levers
     from grainfrac_yade.yade_adapter.scene import build_scene
     p = load_parameters(overrides=TINY)

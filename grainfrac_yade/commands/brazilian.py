@@ -5,7 +5,7 @@ Tensile strength sigma_t = 2 P / (pi D t) (ISRM 1978 suggested method) at the pe
 disc of diameter D (``brazilian.diameter``) and thickness t (``specimen.thickness``), the disc a
 Voronoi tessellation clipped to the circle with the grain size and composition of the UCS
 specimen (:mod:`grainfrac_yade.disc`), loaded by two rigid jaws
-(:mod:`grainfrac_yade.yade_adapter.brazilian_protocol`).
+(:mod:`grainfrac_yade.protocols.brazilian`).
 """
 from __future__ import annotations
 
@@ -150,19 +150,20 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     from ..specimen import build_disc_specimen
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..engines import engine_for
+    from ..protocols import brazilian as brazilian_test
     from ..protocols.levers import Levers, new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
     if resume:
         out = Path(out)
-        history, result, scene, (broken_peak, mode_peak) = engine_for(params).resume_brazilian(specimen, params, out,
+        history, result, scene, (broken_peak, mode_peak) = brazilian_test.resume_brazilian(specimen, params, out,
                                                                                                progress=progress)
     else:
         out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
         levers = levers or Levers()
         engine = engine_for(params)
         snapshot = engine.StrainSeries(out / "vtk", vtk_every, engine.DIAMETRAL_STRAIN) if vtk_every else None
-        history, result, scene, (broken_peak, mode_peak) = engine.run_brazilian(
+        history, result, scene, (broken_peak, mode_peak) = brazilian_test.run_brazilian(
             specimen, params, progress=progress, levers=levers, checkpoint_folder=out,
             run_values={"seed": seed, "levers": levers.to_dict()}, snapshot=snapshot)
     t = specimen.tessellation

@@ -177,6 +177,11 @@ class Scene(Protocol):
         """Rigid platens on the end cells (``lateral``: "free" smooth or "fixed" rough), listed among the
         scene's engines; their speed and forces are driven by the protocol."""
 
+    def attach_jaws(self, loading_arc: float, lateral: str) -> object:
+        """The two jaws of a Brazilian disc (the cells whose rim arcs overlap ``loading_arc`` [rad] about the ends
+        of the vertical diameter): ``set_closing_speed``, ``load``, ``diametral_strain``, ``horizontal_strain``,
+        ``diameter``, ``top``/``bottom`` cells, ``loaded_arc_deg``, ``state_dict``/``rebind``."""
+
     def confine(self, stress: float) -> object:
         """Force control on the side walls: a lateral confining stress sigma_3 [Pa] held on the side cells."""
 

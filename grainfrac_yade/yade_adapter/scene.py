@@ -38,6 +38,7 @@ from ..protocols.cracks import bond_is_inter
 from ..specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
 from .confinement import Confinement
+from .jaws import DiscJaws
 from .joints import IntactJointGuard
 from .platens import Platens
 from .measures import BOND_FORCE_SAMPLE, check_value, mean_bond_force, resultant_forces  # noqa: F401
@@ -306,6 +307,13 @@ class GrainScene:
         confinement = Confinement(self, stress)
         self.extras.append(confinement)
         return confinement
+
+    def attach_jaws(self, loading_arc: float, lateral: str = "fixed") -> DiscJaws:
+        """The two jaws of a disc (:class:`.jaws.DiscJaws`: the cells whose rim arcs overlap ``loading_arc``
+        [rad] about the ends of the vertical diameter), listed among the scene's engines."""
+        jaws = DiscJaws(self, loading_arc, lateral)
+        self.extras.append(jaws)
+        return jaws
 
     # ------------------------------------------------------------------ state
     def node_bodies(self) -> np.ndarray:

@@ -4,7 +4,8 @@ ISRM (1978) suggested method: a disc of diameter D and thickness t is loaded alo
 until it splits; its tensile strength is sigma_t = 2 P / (pi D t) at the peak load P
 (:mod:`grainfrac_yade.brazilian_analysis`).
 
-The jaws are cells of the disc, as the UCS test's platens are (:mod:`.platens`): the cells whose
+The jaws are cells of the disc, as the UCS test's platens are (the scene's ``attach_jaws``; YADE's:
+:mod:`grainfrac_yade.yade_adapter.jaws`): the cells whose
 rim arc overlaps an arc of ``brazilian.loading_arc_deg`` about the top (bottom) end of the
 vertical diameter move together at a constant speed along it, their rotation blocked, and across
 it fixed (``platen_lateral = "fixed"``, the default: rough steel jaws, and no rigid rotation of
@@ -26,8 +27,10 @@ The test ends once the load falls below ``brazilian.stop_load_ratio`` of its pea
 broken since the peak (the split), or at ``brazilian.max_strain`` (the peak is then a lower
 bound), or on a numerical failure (no result); ``end_reason`` says which.
 
-Checkpoints (given a run folder, :mod:`.checkpoint`): every ``numerics.checkpoint_interval`` s of
-wall time, before a history row's DEM steps; :func:`resume_brazilian` goes on from the last one and
+Written against the scene interface (:class:`grainfrac_yade.engines.Scene`): any engine runs it.
+
+Checkpoints (given a run folder, :mod:`.checkpoints`): every ``numerics.checkpoint_interval`` s of
+wall time, before a history row's steps; :func:`resume_brazilian` goes on from the last one and
 computes what the uninterrupted test would have, bit for bit (one thread).
 """
 from __future__ import annotations
@@ -38,106 +41,17 @@ import time
 import numpy as np
 
 from ..brazilian_analysis import splits, tensile_stress
-from ..disc import DiscTessellation
-from ..errors import GrainfracError, NumericalFailure
+from ..engines import engine_for
+from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
-from .checkpoint import (LoadingCheckpoints, base_state, history_arrays, read, restore_scene, resume_record,
-                         scene_arrays)
-from .levers import Levers, apply_levers, new_breaks
-from ..protocols.cracks import broken_counts
-from ..protocols.loading import LoadingTest
-from .scene import build_scene
-
-#: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
-JAW_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
-
-
-class DiscJaws:
-    """The two jaws of a disc scene: cells at the ends of the vertical diameter; velocity and measures."""
-
-    name = "DiscJaws"
-
-    def __init__(self, scene, loading_arc: float, lateral: str = "fixed"):
-        t = scene.specimen.tessellation
-        if not isinstance(t, DiscTessellation):
-            raise GrainfracError("Brazilian test: the specimen is not a disc; fix: build it with "
-                                 "grainfrac_yade.specimen.build_disc_specimen")
-        self.scene = scene
-        self.diameter, self.centre = t.diameter, t.centre
-        half = 0.5 * loading_arc
-        self.top = t.cells_in_arc(0.5 * math.pi, half)
-        self.bottom = np.setdiff1d(t.cells_in_arc(-0.5 * math.pi, half), self.top)
-        self.left = np.setdiff1d(t.cells_in_arc(math.pi, 0.0), np.concatenate([self.top, self.bottom]))
-        self.right = np.setdiff1d(t.cells_in_arc(0.0, 0.0), np.concatenate([self.top, self.bottom, self.left]))
-        if not (len(self.bottom) and len(self.left) and len(self.right)):
-            raise GrainfracError(f"Brazilian test: a disc of {t.n_cells} cells has no separate cells at the two jaws "
-                                 "and the ends of the horizontal diameter; fix: use a larger disc or smaller grains")
-        self.loaded_arc_deg = [self._arc_deg(self.top, 0.5 * math.pi), self._arc_deg(self.bottom, -0.5 * math.pi)]
-        O = scene.O
-        self._top, self._bottom, self._left, self._right = (
-            [O.bodies[int(b)] for b in scene.bodies_of(cells)] for cells in (self.top, self.bottom, self.left, self.right))
-        for b in self._top + self._bottom:
-            b.state.blockedDOFs = JAW_BLOCKED[lateral]
-            b.state.vel = (0, 0, 0)
-            b.state.angVel = (0, 0, 0)
-        self.y0 = self._y(self._top) - self._y(self._bottom)
-        self.x0 = self._x(self._right) - self._x(self._left)
-        self.velocity = 0.0
-
-    def rebind(self, state: dict):
-        """After ``O.load`` of a checkpoint: the jaw and rim bodies anew (handles of the replaced scene are
-        stale), the reference distances and the speed from ``state`` (:meth:`state_dict`).  No force is
-        read before the next DEM step (the load is measured after the row's steps)."""
-        O = self.scene.O
-        self._top, self._bottom, self._left, self._right = (
-            [O.bodies[b.id] for b in bodies] for bodies in (self._top, self._bottom, self._left, self._right))
-        self.y0, self.x0, self.velocity = state["y0"], state["x0"], state["velocity"]
-
-    def state_dict(self) -> dict:
-        return {"y0": float(self.y0), "x0": float(self.x0), "velocity": self.velocity}
-
-    def _arc_deg(self, cells, pole: float) -> float:
-        """Angle [deg] the union of ``cells``' rim arcs spans (measured from the pole both ways)."""
-        t = self.scene.specimen.tessellation
-        arcs = t.boundary_arc[np.isin(t.boundary_cell, cells)]
-        mid = (arcs.mean(axis=1) - pole + math.pi) % (2 * math.pi) - math.pi   # arc midpoints from the pole
-        arcs = arcs[np.abs(mid) < 0.5 * math.pi] - (arcs.mean(axis=1) - mid)[np.abs(mid) < 0.5 * math.pi, None]
-        return float(math.degrees(arcs[:, 1].max() - arcs[:, 0].min()))
-
-    @staticmethod
-    def _y(bodies) -> float:
-        return float(np.mean([b.state.pos[1] for b in bodies]))
-
-    @staticmethod
-    def _x(bodies) -> float:
-        return float(np.mean([b.state.pos[0] for b in bodies]))
-
-    def set_closing_speed(self, speed: float):
-        """Jaws approach each other at ``speed`` [m/s] (half each), along the vertical diameter."""
-        self.velocity = speed
-        for b in self._top:
-            b.state.vel = (b.state.vel[0], -0.5 * speed, 0)
-        for b in self._bottom:
-            b.state.vel = (b.state.vel[0], 0.5 * speed, 0)
-
-    def diametral_strain(self) -> float:
-        """Jaw closure over the diameter (shortening positive) [1]."""
-        return (self.y0 - (self._y(self._top) - self._y(self._bottom))) / self.diameter
-
-    def horizontal_strain(self) -> float:
-        """Change of the horizontal diameter's end-cell distance over D (compression positive) [1]."""
-        return -((self._x(self._right) - self._x(self._left)) - self.x0) / self.diameter
-
-    def load(self) -> float:
-        """Mean reaction of the two jaws along the diameter (compression positive) [N]."""
-        f = self.scene.O.forces.f
-        top = sum(f(b.id)[1] for b in self._top)
-        bottom = sum(f(b.id)[1] for b in self._bottom)
-        return 0.5 * (top - bottom)
-
+from .checkpoints import (LoadingCheckpoints, base_state, history_arrays, read, restore_scene, resume_record,
+                          scene_arrays)
+from .cracks import broken_counts
+from .levers import Levers, new_breaks
+from .loading import LoadingTest
 
 def crack_counts(scene) -> dict:
-    """Bonds broken during the test by mode and kind (:func:`.scene.broken_counts` without the slits of
+    """Bonds broken during the test by mode and kind (:func:`.cracks.broken_counts` without the slits of
     :mod:`.levers`, which are broken before loading)."""
     return broken_counts(scene, new_breaks(scene))
 
@@ -158,15 +72,16 @@ class BrazilianRun(LoadingCheckpoints, LoadingTest):
                  run_values=None, apply=True):
         self.t0, self.c0 = time.time(), time.process_time()
         self.params, self.progress = params, progress
-        self.scene = scene = scene or build_scene(specimen, params)
-        #: what the levers did (:func:`.levers.apply_levers`); ``apply`` False: a resumed test, whose
+        #: the engine of ``params`` (``numerics.engine``): builds the scene, applies the levers
+        self.engine = engine = engine_for(params)
+        self.scene = scene = scene or engine.build_scene(specimen, params)
+        #: what the levers did (the engine's ``apply_levers``); ``apply`` False: a resumed test, whose
         #: checkpoint holds the levers' bonds and counts
-        self.applied = apply_levers(scene, levers or Levers(), specimen.seed) if apply else {}
+        self.applied = engine.apply_levers(scene, levers or Levers(), specimen.seed) if apply else {}
         bz = params.brazilian
-        self.jaws = jaws = DiscJaws(scene, math.radians(bz.loading_arc_deg), bz.platen_lateral)
-        scene.extras.append(jaws)
+        self.jaws = jaws = scene.attach_jaws(math.radians(bz.loading_arc_deg), bz.platen_lateral)
         jaws.set_closing_speed(bz.strain_rate * jaws.diameter)
-        self.steps_per_row = max(1, int(round(bz.record_strain_increment / (bz.strain_rate * scene.O.dt))))
+        self.steps_per_row = max(1, int(round(bz.record_strain_increment / (bz.strain_rate * scene.dt))))
         self.thickness = specimen.thickness
         self.cols = {k: [] for k in HISTORY_COLUMNS}
         self.peak, self.broken_at_peak = 0.0, 0
