@@ -72,8 +72,11 @@ def check_row(test: str, columns, cells: dict, where: str):
     if controls["on_change"] not in ON_CHANGE:
         raise GrainfracError(f"batch table {where}: on_change = {controls['on_change']!r}; fix: use one of "
                              f"{', '.join(repr(v) for v in ON_CHANGE)}")
-    if not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool) or controls["seed"] < 0:
-        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number >= 0")
+    from ..specimen import MAX_SEED
+    if (not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool)
+            or not 0 <= controls["seed"] <= MAX_SEED):
+        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number from 0 to "
+                             f"{MAX_SEED} (the range of a 32-bit seed)")
     try:
         params = load_parameters(overrides=overrides)
     except GrainfracError as exc:
