@@ -182,7 +182,7 @@ def test_a_batch_table_is_checked_row_by_row_before_anything_runs(tmp_path, caps
     err = capsys.readouterr().err.strip().splitlines()
     assert "5 bad row(s), nothing run" in err[0]
     expected = {3: "both ratio and stress", 4: "must lie in (0, 1)", 5: "5 cells for 6 columns",
-                6: "must be quoted", 7: "specimen.width: must be > 0"}
+                6: "column study takes quoted text", 7: "specimen.width: must be > 0"}
     assert len(err) == 1 + len(expected)
     for (line, words), text in zip(expected.items(), err[1:]):
         assert f"bad.table:{line}:" in text and words in text, text
@@ -282,7 +282,7 @@ def test_a_failed_overwrite_leaves_the_old_run_as_it_was(tmp_path, capsys):
 
 # ------------------------------------------------------------------ one line, no traceback
 @pytest.mark.parametrize("argv, words", [
-    (["specimen", "--seed", "-1"], ("--seed", ">= 0")),
+    (["specimen", "--seed", "-1"], ("--seed", "from 0 to 4294967295")),
     (["specimen", "--width", "-10e-3"], ("--width: specimen.width", "must be > 0")),
     (["specimen", "--width", "3e-3", "--height", "6e-3", "--out", "/proc/x"], ("/proc/x", "cannot write")),
     (["creep", "--stress", "abc"], ("--stress", "invalid float value")),

@@ -77,3 +77,87 @@ def test_a_seed_is_limited_to_the_32_bit_range(capsys, seed, ok):
     assert _one_line(capsys) == (f"error: python3 -m grainfrac_yade specimen: argument --seed: {int(seed)}: a seed is a "
                                  "whole number from 0 to 4294967295 (the range of a 32-bit seed; e.g. 1); fix: see "
                                  "python3 -m grainfrac_yade specimen --help")
+
+
+# ------------------------------------------------------------------ batch tables
+def test_a_file_that_is_no_table_is_one_line_saying_what_a_table_looks_like(capsys):
+    assert main(["batch", str(ROOT / "README.md")]) == 2
+    assert _one_line(capsys) == (
+        f"error: {ROOT / 'README.md'}:3: not a batch table: its first line is not column names ('**time-dependent', "
+        "'rock**'); fix: a batch table is a first line of column names (parameter paths such as specimen.width, "
+        "ratio or stress, seed, study, out), then one line of values per run, e.g. `ratio seed` then `0.7 1`")
+
+
+def test_a_table_with_many_bad_rows_lists_ten_and_counts_the_rest(tmp_path, capsys):
+    table = tmp_path / "many.table"
+    table.write_text("seed specimen.width\n" + "".join(f"{i} abc\n" for i in range(1, 31)))
+    assert main(["batch", str(table)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0] == f"error: {table}: 30 bad row(s), nothing run; fix each:"
+    assert len(err) == 12 and err[-1] == "... and 20 more bad rows (fix the ones above first)"
+
+
+@pytest.mark.parametrize("columns, cell, fix", [
+    ("specimen.width seed", "ten 1", "column specimen.width takes a number [m], e.g. 0.0317"),
+    ("seed", "ten", "column seed takes a whole number, e.g. 1"),
+    ("resolution.grain_model seed", "fem 1", "column resolution.grain_model takes quoted text, one of 'rigid', 'fem'"),
+    ("numerics.keep_intact_joints seed", "yes 1", "column numerics.keep_intact_joints takes True or False"),
+    ("resolution.spheres_per_cell seed", "one 1", "column resolution.spheres_per_cell takes a whole number, e.g. 1"),
+    ("study seed", "mine 1", "column study takes quoted text, e.g. 'default'"),
+    ("ratio seed", "high 1", "column ratio takes a number, e.g. 0.0"),
+])
+def test_a_cell_of_the_wrong_type_names_the_type_its_column_takes(tmp_path, capsys, columns, cell, fix):
+    table = tmp_path / "t.table"
+    table.write_text(f"{columns}\n{cell}\n")
+    assert main(["batch", str(table)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    bad = [c for c in cell.split() if not c[0].isdigit()][0]
+    col = columns.split()[cell.split().index(bad)]
+    assert err[1] == f"batch table {table}:2: column {col}: {bad!r} is not a number or a quoted text; fix: {fix}"
+
+
+def test_a_row_whose_out_cannot_be_made_is_refused_with_the_rows(tmp_path, capsys):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("")
+    table = tmp_path / "t.table"
+    table.write_text(f"seed out\n1 '{tmp_path / 'fine'}'\n2 '{a_file / 'run'}'\n")
+    assert main(["batch", str(table), "--log-dir", str(tmp_path / "logs")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: {table}: 1 bad row(s), nothing run; fix each:",
+                   f"batch table {table}:3: out = '{a_file / 'run'}': {a_file} is a file, not a folder; fix: give "
+                   "the row an out below a folder"]
+    assert not (tmp_path / "logs").exists() and not (tmp_path / "fine").exists()
+
+
+def test_a_row_finished_before_the_batch_says_skipped_not_ok(tmp_path):
+    from grainfrac_yade.runs.batchrun import ROW_RECORDS, ROW_SKIPPED, row_outcomes
+    from grainfrac_yade.runs.runio import write_json
+    logs = tmp_path / "logs"
+    (logs / ROW_RECORDS).mkdir(parents=True)
+    for line in (2, 3):
+        folder = tmp_path / f"run{line}"
+        folder.mkdir()
+        write_json(folder / "summary.json", {"ucs_pa": 2e8})
+        write_json(logs / ROW_RECORDS / f"{line}.json", {"folder": str(folder)})
+    (logs / "2.log").write_text(f"Using python version: 3\nUCS {ROW_SKIPPED}: {tmp_path / 'run2'}\n")
+    (logs / "3.log").write_text("Using python version: 3\n")
+    got = {o.line: str(o) for o in row_outcomes(tmp_path / "t.table", logs, [2, 3])}
+    assert got[2] == f"line 2: skipped (finished): finished -> {tmp_path / 'run2'}"
+    assert got[3] == f"line 3: ok: finished -> {tmp_path / 'run3'}"
+
+
+@pytest.mark.parametrize("module", ["creep", "ucs", "brazilian"])
+def test_each_row_script_prints_the_skip_line_the_batch_looks_for(module):
+    """The batch tells a skipped row by this phrase in its log: every row script must print it."""
+    source = (ROOT / "grainfrac_yade" / "commands" / f"{module}.py").read_text()
+    assert "{ROW_SKIPPED}: {out}" in source
+
+
+# ------------------------------------------------------------------ the console holds the project's own lines
+@needs_yade
+@pytest.mark.yade
+def test_yades_banner_stays_off_the_console(tmp_path):
+    res = _cli("ucs", "--set", "specimen.width=3e-3", "--set", "specimen.height=6e-3", "--out", tmp_path / "u")
+    assert res.returncode == 0, res.stderr
+    assert "Using python version" not in res.stdout + res.stderr
+    assert "UCS" in res.stdout

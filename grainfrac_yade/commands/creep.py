@@ -533,7 +533,8 @@ def run_creep_in_yade():
         out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
                                      {"seed": int(controls["seed"]), "stress_pa": stress})
     if action == "skip":
-        print(f"creep row already finished, skipped: {out}")
+        from ..runs.batchrun import ROW_SKIPPED
+        print(f"creep {ROW_SKIPPED}: {out}")
         return
     if note:
         print(note)
