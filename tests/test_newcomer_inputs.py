@@ -161,3 +161,44 @@ def test_yades_banner_stays_off_the_console(tmp_path):
     assert res.returncode == 0, res.stderr
     assert "Using python version" not in res.stdout + res.stderr
     assert "UCS" in res.stdout
+
+
+# ------------------------------------------------------------------ broken checkpoints (refused before YADE loads)
+def _fake_unfinished_run(folder, command):
+    """A run folder as a killed run leaves it: run.json and a complete checkpoint (files of the right formats;
+    no YADE needed, the refusals come before any scene is loaded)."""
+    import gzip
+    import json
+    import numpy as np
+    (folder / "checkpoint").mkdir(parents=True)
+    (folder / "run.json").write_text(json.dumps({"command": command}))
+    (folder / "checkpoint" / "state.json").write_text(json.dumps({"format": 1, "run_values": {"seed": 1}}))
+    np.savez(folder / "checkpoint" / "arrays.npz", broken=np.zeros(100, bool), break_step=np.arange(100))
+    with gzip.open(folder / "checkpoint" / "scene.yade.gz", "wb") as fh:
+        fh.write(bytes(range(256)) * 400)
+
+
+def _truncate(path):
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+
+
+@pytest.mark.parametrize("command", ["ucs", "brazilian", "creep"])
+@pytest.mark.parametrize("damage, message", [
+    (lambda c: _truncate(c / "arrays.npz"),
+     "error: {c}/arrays.npz: the checkpoint's arrays are unreadable (truncated or not numpy's npz; BadZipFile: "),
+    (lambda c: (c / "state.json").write_bytes(b"garbage\x00\x01"),
+     "error: {c}: the checkpoint's state file (checkpoint/state.json) is unreadable (not the JSON this code "
+     "writes: garbage or truncated; "),
+    (lambda c: _truncate(c / "scene.yade.gz"),
+     "error: {c}/scene.yade.gz: the checkpoint's scene is unreadable (truncated gzip or not a YADE scene; EOFError: "),
+])
+def test_a_broken_checkpoint_file_is_named_in_one_line(tmp_path, capsys, command, damage, message):
+    run = tmp_path / "run"
+    _fake_unfinished_run(run, command)
+    damage(run / "checkpoint")
+    before = sorted(p.name for p in run.rglob("*"))
+    assert main([command, "--resume", str(run)]) == 2
+    line = _one_line(capsys)
+    assert line.startswith(message.format(c=run / "checkpoint")), line
+    assert line.endswith("fix: start the run again with the same command (run.json) and --overwrite")
+    assert sorted(p.name for p in run.rglob("*")) == before

@@ -315,6 +315,9 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
         raise GrainfracError(f"{folder}: holds a {command!r} run, not a creep run; fix: give the folder of a creep run")
     if (folder / SUMMARY).exists():
         return None
+    if checkpoint_folder(folder) is not None:
+        from ..yade_adapter.checkpoint import check_files
+        check_files(checkpoint_folder(folder))
     state = read_checkpoint_state(folder)
     if state is None and checkpoint_folder(folder) is not None:
         where = checkpoint_folder(folder)
