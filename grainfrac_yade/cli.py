@@ -1,8 +1,9 @@
 """Command line: ``python3 -m grainfrac_yade <command> ...``.
 
-Every command accepts ``--params FILE`` (merged over the shipped files in
-``params/``) and repeated ``--set section.key=value`` overrides, validated like
-the files.  User errors print one line and exit with status 2.
+The commands that build or run a model accept ``--params FILE`` (merged over the
+shipped files in ``params/``) and repeated ``--set section.key=value`` overrides,
+validated like the files (README.md lists them; tests/test_newcomer_inputs.py holds
+the list equal to the parser's).  User errors print one line and exit with status 2.
 
 Commands that run a model declare ``with_params=True`` (and optionally
 ``param_overrides``, a function of their arguments giving further overrides) in

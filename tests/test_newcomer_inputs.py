@@ -202,3 +202,33 @@ def test_a_broken_checkpoint_file_is_named_in_one_line(tmp_path, capsys, command
     assert line.startswith(message.format(c=run / "checkpoint")), line
     assert line.endswith("fix: start the run again with the same command (run.json) and --overwrite")
     assert sorted(p.name for p in run.rglob("*")) == before
+
+
+# ------------------------------------------------------------------ README and reference
+def _subcommands():
+    from grainfrac_yade.cli import build_parser
+    parser = build_parser()
+    return next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction").choices
+
+
+def test_the_readme_names_exactly_the_commands_that_take_params_and_set():
+    import re
+    readme = (ROOT / "README.md").read_text()
+    sentence = readme[readme.index("The commands that build or run a model"):]
+    sentence = sentence[: sentence.index(") take `--params FILE`")]
+    listed = set(re.findall(r"`([a-z0-9-]+)`", sentence))
+    taking = {name for name, p in _subcommands().items()
+              if {"--params", "--set"} <= {o for a in p._actions for o in a.option_strings}}
+    assert listed == taking
+
+
+def test_the_commands_reference_gives_vtk_fractions_as_off_unless_given():
+    from grainfrac_yade.analysis.figures import MAP_FRACTIONS
+    from grainfrac_yade.commands.creep import LIFE_FRACTIONS
+    assert LIFE_FRACTIONS == MAP_FRACTIONS
+    page = (ROOT / "docs" / "reference" / "commands.md").read_text()
+    row = next(l for l in page.splitlines() if l.startswith("| `--vtk-fractions`"))
+    assert row.split(" | ")[1] == "off; the flag alone: 0.1,0.5,0.9,1"
+    args = _subcommands()["creep"].parse_args(["--vtk-fractions"])
+    assert args.vtk_fractions == [0.1, 0.5, 0.9, 1.0]
+    assert _subcommands()["creep"].parse_args([]).vtk_fractions is False

@@ -9,6 +9,11 @@ import numpy as np
 from ..errors import GrainfracError
 
 
+#: Fractions of the lifetime that ``--vtk-fractions`` alone writes: the crack maps' (``analysis.figures.MAP_FRACTIONS``,
+#: held equal by tests/test_newcomer_inputs.py; not imported here, which would load matplotlib to build the parser).
+LIFE_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
+
+
 def register(sub, common):
     p = sub.add_parser("creep", help="constant-load creep test to failure with stress corrosion")
     common(p)
@@ -28,7 +33,8 @@ def register(sub, common):
     p.add_argument("--vtk-every", type=_positive_int, default=None, metavar="K",
                    help="also write VTK files at every K-th history row (one row per event of the event clock, "
                         "per creep step of the paper clock) and at the end, into DIR/vtk/")
-    p.add_argument("--vtk-fractions", type=_fractions, nargs="?", const=None, default=False, metavar="F1,F2,...",
+    p.add_argument("--vtk-fractions", type=_fractions, nargs="?", const=list(LIFE_FRACTIONS), default=False,
+                   metavar="F1,F2,...",
                    help="after the run, write the bond states at these fractions of the lifetime (of the run if "
                         "it did not fail; default the crack maps' 0.1,0.5,0.9,1) on the undeformed specimen, into "
                         "DIR/vtk/life_cells.pvd and life_bonds.pvd")
