@@ -232,3 +232,88 @@ def test_the_commands_reference_gives_vtk_fractions_as_off_unless_given():
     args = _subcommands()["creep"].parse_args(["--vtk-fractions"])
     assert args.vtk_fractions == [0.1, 0.5, 0.9, 1.0]
     assert _subcommands()["creep"].parse_args([]).vtk_fractions is False
+
+
+# ------------------------------------------------------------------ what the demo's report shows
+def _capture(monkeypatch, module, name):
+    """Keep the figure that ``module.name`` (a save or close function taking the figure first) receives."""
+    kept = []
+    original = getattr(module, name)
+
+    def keep(fig, *args, **kw):
+        kept.append(fig)
+        return original(fig, *args, **kw)
+    monkeypatch.setattr(module, name, keep)
+    return kept
+
+
+def test_a_run_with_one_creep_time_is_drawn_in_the_strain_time_figure(tmp_path, monkeypatch):
+    """The event clock can jump from the load straight to failure: one positive creep time, no curve on a log
+    axis; the run must still be drawn (a dashed line at its time), not only listed in the legend."""
+    import pandas as pd
+    from grainfrac_yade.analysis import figures
+    kept = _capture(monkeypatch, figures, "_save")
+    one = figures.Curve("ratio 0.9, seed 1", pd.DataFrame({"creep_time_s": [0.0, 9999.0],
+                                                          "axial_strain": [2e-3, 9e-3]}), True, 9999.0)
+    many = figures.Curve("ratio 0.7, seed 1", pd.DataFrame({"creep_time_s": [0.0, 10.0, 1e3, 1e5],
+                                                           "axial_strain": [2e-3, 2.1e-3, 2.2e-3, 9e-3]}), True, 1e5)
+    figures.strain_time_figure(tmp_path / "st.png", [many, one])
+    ax = kept[0].axes[0]
+    drawn = {l.get_label(): l for l in ax.get_lines()}
+    line = drawn["ratio 0.9, seed 1: one creep time, t = 9999 s (no curve on a log axis)"]
+    assert list(line.get_xdata()) == [9999.0, 9999.0]
+    assert len(drawn["ratio 0.7, seed 1"].get_xdata()) == 3
+
+
+def test_the_lifetime_figure_says_which_ucs_each_ratio_divides_by(tmp_path, monkeypatch):
+    import numpy as np
+    from grainfrac_yade.analysis import figures
+    from grainfrac_yade.analysis.labdata import paper_reference
+    kept = _capture(monkeypatch, figures, "_save")
+    s = figures.LifetimeSet("default", np.array([0.7, 0.8]), np.array([1e4, 1e3]), ucs_pa=np.array([265e6, 265e6]))
+    figures.lifetime_figure(tmp_path / "l.png", [s], reference=paper_reference())
+    labels = [t.get_text() for t in kept[0].axes[0].get_legend().get_texts()]
+    assert "default: failed runs (2); r = sigma / 265.0 MPa (its runs' UCS)" in labels
+    assert any(l.startswith("paper (UDEC): 160 MPa, r = 160 / 234.5 MPa (UDEC's UCS) = 0.682") for l in labels)
+    assert figures.ratio_reference([258e6, 282e6, np.nan]) == "r = sigma / 258.0-282.0 MPa"
+
+
+def test_crack_maps_count_cracks_and_the_macrocracks_among_them(tmp_path, monkeypatch):
+    import numpy as np
+    import pandas as pd
+    from grainfrac_yade.analysis import crackmaps
+    kept = _capture(monkeypatch, crackmaps.plt, "close")
+    cracks = pd.DataFrame({"creep_time_s": [-1.0, 5.0, 20.0], "x_m": [1e-3, 2e-3, 3e-3], "y_m": [1e-3] * 3,
+                           "face_normal_angle_deg": [0.0, 90.0, 45.0], "macro_time_s": [np.nan, 6.0, -1.0],
+                           "mode": ["tensile", "shear", "tensile"], "kind": ["inter", "intra", "inter"]})
+    crackmaps.crack_maps_figure(tmp_path / "m.png", cracks, [5.5, 30.0], ["(a)", "(b)"], 4e-3, 4e-3, 1e-3)
+    titles = [ax.get_title() for ax in kept[0].axes]
+    assert titles == ["(a)\n2 cracks, 0 of them macro", "(b)\n3 cracks, 2 of them macro"]
+    page = (ROOT / "docs" / "reference" / "output_files.md").read_text()
+    assert "### Crack counts: one definition each" in page and "macrocracks <= cracks" in page
+    from grainfrac_yade.analysis.report import CRACK_COUNTS, RUN_COLUMNS
+    assert list(RUN_COLUMNS).index("broken_total") < list(RUN_COLUMNS).index("macrocracks")
+    assert "a subset of the cracks" in CRACK_COUNTS
+    assert not (ROOT / "docs" / "output_files.md").exists()
+
+
+def test_the_animation_draws_strain_in_percent_and_no_legend_line_it_never_draws(monkeypatch):
+    import numpy as np
+    import pandas as pd
+    from grainfrac_yade import animation
+    cracks = pd.DataFrame({"creep_time_s": [1.0, 2.0], "mode": ["tensile", "shear"],
+                           "macro_time_s": [np.nan, np.nan]})
+    seg = np.array([[[0, 0], [1e-3, 0]], [[0, 1e-3], [1e-3, 1e-3]]], float)
+    hist = pd.DataFrame({"creep_time_s": [0.0, 1.0, 2.0], "axial_strain": [1e-3, 2e-3, 3e-3]})
+    r = animation._Renderer(None, (3e-3, 6e-3), cracks, seg, hist, 2.0, False, "t")
+    try:
+        inset = r.fig.axes[1]
+        assert inset.get_ylabel() == "axial strain [%]"
+        assert list(inset.get_lines()[0].get_ydata()) == pytest.approx([0.1, 0.2, 0.3])
+        r.frame(2.0, 2.0)
+        assert list(r.marker.get_ydata()) == pytest.approx([0.3])
+        legend = [t.get_text() for t in r.fig.legends[0].get_texts()]
+        assert "macrocrack: none in this run (or times not recorded)" in legend
+    finally:
+        r.close()
+    assert animation.macro_legend([np.nan, 3.0]) == "macrocrack (face fully separated): thick, in its mode's colour"

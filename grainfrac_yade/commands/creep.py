@@ -490,7 +490,7 @@ def history_columns(rows) -> dict:
 def write_crack_list(path, run):
     """cracks.csv: bond, creep time (empty for a crack of the ramp), phase (``ramp`` or ``creep``), mode, kind,
     position, orientation, segment end points and the creep time its cells separated (macrocrack; empty if
-    never); docs/output_files.md."""
+    never); docs/reference/output_files.md."""
     from ..runs.runio import write_csv
     from ..yade_adapter.scene import SHEAR, bond_segments
     sc = run.scene
