@@ -317,3 +317,33 @@ def test_the_animation_draws_strain_in_percent_and_no_legend_line_it_never_draws
     finally:
         r.close()
     assert animation.macro_legend([np.nan, 3.0]) == "macrocrack (face fully separated): thick, in its mode's colour"
+
+
+# ------------------------------------------------------------------ --vtk-times that fall into one frame
+def test_requested_times_due_at_one_row_are_one_frame():
+    from grainfrac_yade.vtkio import due_times, merged_frame_note
+    assert due_times([0.0, 1e6, 2e6, 3e6], 0.0) == ([0.0], [1e6, 2e6, 3e6])
+    assert due_times([1e6, 2e6, 3e6], 2.5e6) == ([1e6, 2e6], [3e6])
+    assert due_times([3e6], 2.5e6) == ([], [3e6])
+    assert merged_frame_note([1e6, 2e6], 2.5e6) == ("VTK: requested creep times 1e+06, 2e+06 s fell into one frame "
+                                                     "at 2.5e+06 s (the clock stepped over them: there is no state "
+                                                     "in between to write)")
+
+
+@needs_yade
+@pytest.mark.yade
+def test_a_creep_run_says_which_requested_vtk_times_fell_into_one_frame(tmp_path):
+    """A tiny creep run (seconds): 1e-9 and 2e-9 s both lie before its first event, so the event clock steps over
+    both to one frame; 1e30 s lies after its end."""
+    import json
+    out = tmp_path / "creep"
+    res = _cli("creep", "--width", "3e-3", "--height", "6e-3", "--seed", "1", "--ratio", "0.9", "--ucs", "250",
+               "--clock", "event", "--vtk-times", "0,1e-9,2e-9,1e30", "--out", out)
+    assert res.returncode == 0, res.stderr
+    s = json.loads((out / "summary.json").read_text())
+    [merged] = s["vtk_merged_times"]
+    assert merged["requested_s"] == [1e-9, 2e-9] and merged["frame_s"] > 2e-9
+    assert merged["frame_s"] in s["vtk_creep_times_s"]
+    assert s["vtk_times_not_reached_s"] == [1e30]
+    assert "VTK: requested creep times 1e-09, 2e-09 s fell into one frame at" in res.stdout
+    assert "Using python version" not in res.stdout + res.stderr

@@ -431,6 +431,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
         "vtk_creep_times_s": run.vtk_written,
+        "vtk_merged_times": getattr(run, "vtk_merged", []),
+        "vtk_times_not_reached_s": list(run.vtk_times) if run.vtk_folder is not None else [],
         **summary_header(params, seed),
     }
     if getattr(run, "resumes", None):
