@@ -79,7 +79,7 @@ def test_cli_stresses_are_mpa_and_batch_stresses_pa():
 @needs_yade
 @pytest.mark.yade
 def test_a_specimen_broken_apart_in_the_isotropic_stage_is_a_failure_not_a_ucs_of_zero(tmp_path):
-    """1e6 times the intended 20 MPa (the unit slip of the issue; the CLI refuses it, the adapter is called
+    """1e6 times the intended 20 MPa (a unit slip, Pa given for MPa; the CLI refuses it, the adapter is called
     directly): every bond breaks in the isotropic stage; the run must say so and measure nothing."""
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
     params = load_parameters(overrides=TINY + [("confinement.stress", 20e12)])
@@ -206,7 +206,8 @@ def test_the_demo_refuses_a_ratio_at_or_above_one_before_it_simulates(tmp_path, 
 @pytest.mark.yade
 def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_path):
     """Three 3 x 6 mm UCS rows (about 5 s each with YADE's start): line 3 runs; line 4's folder holds a finished
-    run of other parameters, line 5's a specimen run (the issue's take-over), so both stop with their one line;
+    run of other parameters, line 5's a specimen run (a take-over of another run's folder), so both stop with their one
+    line;
     the batch names lines 4 and 5 and exits 1; the specimen folder is left as it was."""
     from grainfrac_yade.runs.runio import prepare_run_dir, write_json
     taken = tmp_path / "taken"
@@ -261,7 +262,7 @@ def test_an_unfinished_run_with_a_checkpoint_is_refused_naming_resume(tmp_path):
 
 
 def test_a_failed_overwrite_leaves_the_old_run_as_it_was(tmp_path, capsys):
-    """The issue's case: ``--overwrite --grain-size 1e-9`` must leave the old run whole. The cell count is
+    """``--overwrite --grain-size 1e-9`` must leave the old run whole. The cell count is
     refused before any folder is made; a failure later in a replacing run (here: the specimen build refusing
     after the folder was prepared) leaves the old folder byte for byte."""
     from grainfrac_yade.commands.specimen import run_specimen

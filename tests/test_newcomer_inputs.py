@@ -74,9 +74,9 @@ def test_a_seed_is_limited_to_the_32_bit_range(capsys, seed, ok):
     with pytest.raises(SystemExit) as exc:
         build_parser().parse_args(argv)
     assert exc.value.code == 2
-    assert _one_line(capsys) == (f"error: python3 -m grainfrac_yade specimen: argument --seed: {int(seed)}: a seed is a "
-                                 "whole number from 0 to 4294967295 (the range of a 32-bit seed; e.g. 1); fix: see "
-                                 "python3 -m grainfrac_yade specimen --help")
+    assert _one_line(capsys) == (f"error: python3 -m grainfrac_yade specimen: argument --seed: {int(seed)}: "
+                                 "a seed is a whole number from 0 to 4294967295 (the range of a 32-bit seed; "
+                                 "e.g. 1); fix: see python3 -m grainfrac_yade specimen --help")
 
 
 # ------------------------------------------------------------------ batch tables
@@ -347,3 +347,16 @@ def test_a_creep_run_says_which_requested_vtk_times_fell_into_one_frame(tmp_path
     assert s["vtk_times_not_reached_s"] == [1e30]
     assert "VTK: requested creep times 1e-09, 2e-09 s fell into one frame at" in res.stdout
     assert "Using python version" not in res.stdout + res.stderr
+
+
+def test_parameters_docs_and_tests_speak_of_the_model_not_of_issue_numbers():
+    import re
+    pattern = re.compile(r"[Ii]ssue ?#?[0-9]+")
+    found = []
+    for top in ("params", "docs", "tests", "grainfrac_yade", "studies", "yade_scripts"):
+        for path in (ROOT / top).rglob("*"):
+            if path.suffix in (".md", ".py", ".toml", ".table", ".sh", ".csv") and path.is_file():
+                text = path.read_text(errors="replace")
+                found += [f"{path.relative_to(ROOT)}:{m.group(0)}" for m in pattern.finditer(text)]
+    found += [f"README.md:{m.group(0)}" for m in pattern.finditer((ROOT / "README.md").read_text())]
+    assert found == []

@@ -145,7 +145,8 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
         ax.scatter([reference.ratio], [reference.lifetime_s], marker="*", s=140, color="gold", edgecolors="k",
                    zorder=4, label=f"paper (UDEC): {reference.stress_pa / 1e6:.0f} MPa, "
                                    f"r = {reference.stress_pa / 1e6:.0f} / {reference.ucs_simulated_pa / 1e6:.1f} MPa "
-                                   f"(UDEC's UCS) = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s{as_published}")
+                                   f"(UDEC's UCS) = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s"
+                                   f"{as_published}")
         all_ratios += [reference.ratio, reference.long_term_strength_ratio]
     lo = min(all_ratios) - 0.05 if all_ratios else 0.5
     hi = max(all_ratios) + 0.05 if all_ratios else 1.0

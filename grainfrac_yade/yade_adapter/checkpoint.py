@@ -234,7 +234,8 @@ def check_files(where) -> None:
             raise ValueError("not a JSON object")
     except (OSError, ValueError) as exc:
         raise GrainfracError(f"{where}: the checkpoint's state file ({where.name}/{CHECKPOINT_STATE}) is unreadable "
-                             f"(not the JSON this code writes: garbage or truncated; {type(exc).__name__}); {fix}") from None
+                             f"(not the JSON this code writes: garbage or truncated; {type(exc).__name__}); "
+                             f"{fix}") from None
     try:
         with np.load(where / ARRAYS_FILE) as data:
             for k in data.files:
