@@ -360,3 +360,18 @@ def test_parameters_docs_and_tests_speak_of_the_model_not_of_issue_numbers():
                 found += [f"{path.relative_to(ROOT)}:{m.group(0)}" for m in pattern.finditer(text)]
     found += [f"README.md:{m.group(0)}" for m in pattern.finditer((ROOT / "README.md").read_text())]
     assert found == []
+
+
+def test_the_readme_gives_one_calibrated_ucs_the_one_ratios_divide_by():
+    """README and the calibration study name the parameter every --ratio divides by, and the tour's own ratio of
+    it to the tour specimen's UCS (step 2's 280.6 MPa, measured 2026-12-03) is what it says."""
+    import re
+    from grainfrac_yade.params import load_parameters
+    ref_mpa = round(load_parameters().calibration.reference_ucs / 1e6, 1)
+    readme = (ROOT / "README.md").read_text()
+    assert f"**calibrated UCS {ref_mpa} MPa** (`calibration.reference_ucs`" in readme
+    assert f"`--ratio` alone divides by the calibrated {ref_mpa} MPa" in readme
+    own = float(re.search(r"--ucs ([0-9.]+) --out results/tour/creep_own", readme).group(1))
+    assert f"{0.7 * ref_mpa / own:.2f} of this smaller specimen's" in readme
+    study = (ROOT / "docs" / "studies" / "ucs_calibration.md").read_text()
+    assert f"## The calibrated UCS: one number\n\n**{ref_mpa} MPa**, `calibration.reference_ucs`" in study
