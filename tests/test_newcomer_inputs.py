@@ -79,6 +79,18 @@ def test_a_seed_is_limited_to_the_32_bit_range(capsys, seed, ok):
                                  "e.g. 1); fix: see python3 -m grainfrac_yade specimen --help")
 
 
+@pytest.mark.parametrize("argv", [["demo", "--seeds", "1,4294967296"], ["calibrate-lifetimes", "s", "--lab", "x.csv",
+                                                                       "--seeds", "1,4294967296"]])
+def test_seed_lists_keep_the_same_32_bit_range(capsys, argv):
+    from grainfrac_yade.cli import build_parser
+    with pytest.raises(SystemExit) as exc:
+        build_parser().parse_args(argv)
+    assert exc.value.code == 2
+    assert _one_line(capsys) == (f"error: python3 -m grainfrac_yade {argv[0]}: argument --seeds: 4294967296: a seed is "
+                                 "a whole number from 0 to 4294967295 (the range of a 32-bit seed; e.g. 1,2); fix: "
+                                 f"see python3 -m grainfrac_yade {argv[0]} --help")
+
+
 # ------------------------------------------------------------------ batch tables
 def test_a_file_that_is_no_table_is_one_line_saying_what_a_table_looks_like(capsys):
     assert main(["batch", str(ROOT / "README.md")]) == 2
