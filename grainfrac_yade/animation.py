@@ -185,7 +185,7 @@ class _Renderer:
         self.cursor.set_xdata([time, time])
         frac = time / t_end if t_end > 0 else 1.0
         self.text.set_text(f"creep time {time:.4g} s ({frac:.1%} of the run)\n"
-                           f"{int(present.sum())} cracks ({int(macro.sum())} on macrocracks)")
+                           f"{int(present.sum())} cracks, {int(macro.sum())} of them macro")
         self.fig.canvas.draw()
         return np.asarray(self.fig.canvas.buffer_rgba())[:, :, :3].copy()
 

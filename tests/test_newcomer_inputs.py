@@ -324,6 +324,7 @@ def test_the_animation_draws_strain_in_percent_and_no_legend_line_it_never_draws
         assert list(inset.get_lines()[0].get_ydata()) == pytest.approx([0.1, 0.2, 0.3])
         r.frame(2.0, 2.0)
         assert list(r.marker.get_ydata()) == pytest.approx([0.3])
+        assert r.text.get_text().endswith("\n2 cracks, 0 of them macro")
         legend = [t.get_text() for t in r.fig.legends[0].get_texts()]
         assert "macrocrack: none in this run (or times not recorded)" in legend
     finally:
