@@ -32,6 +32,8 @@ FIGSIZE, DPI = (8.4, 6.4), 100
 GIF_COLOURS = 128
 MICRO_WIDTH, MACRO_WIDTH = 0.8, 2.2   # crack line widths [pt]
 MM = 1e3
+#: Strain in percent, as the report's figures draw it.
+PERCENT = 100.0
 #: Output names in the run folder.
 GIF_NAME, MP4_NAME, FRAME_NAME = "animation.gif", "animation.mp4", "animation_frame.png"
 
@@ -101,6 +103,15 @@ def _segments(cracks: pd.DataFrame, grain_size: float) -> np.ndarray:
     return crack_segments(cracks, grain_size)
 
 
+def macro_legend(macro_time_s) -> str:
+    """Legend of the thick crack lines: what they are, or that the run has none (a legend line the map never
+    draws would mislead); ``macro_time_s``: each crack's separation time (NaN: never)."""
+    t = np.asarray(macro_time_s, float)
+    if not np.isfinite(t).any():
+        return "macrocrack: none in this run (or times not recorded)"
+    return "macrocrack (face fully separated): thick, in its mode's colour"
+
+
 class _Renderer:
     """One matplotlib figure redrawn per frame: grains once, cracks and the marker per time."""
 
@@ -133,7 +144,7 @@ class _Renderer:
         ax.add_collection(self.lines)
         handles = [Line2D([], [], color=CRACK_COLOURS[1], lw=1.5, label="tensile crack"),
                    Line2D([], [], color=CRACK_COLOURS[2], lw=1.5, label="shear crack"),
-                   Line2D([], [], color="k", lw=MACRO_WIDTH, label="macrocrack")] + handles
+                   Line2D([], [], color=CRACK_COLOURS[1], lw=MACRO_WIDTH, label=macro_legend(macro))] + handles
         self.fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.57, 0.36), ncol=2, fontsize=8,
                         frameon=False)
         inset = self.fig.add_axes((0.59, 0.47, 0.37, 0.38))
@@ -143,13 +154,13 @@ class _Renderer:
         if log_time:
             left = t_end * 10.0 ** -LOG_TIME_DECADES
             inset.set_xscale("log")   # rows before the axis starts (creep time 0) drawn at its left end
-            inset.plot(np.maximum(t, left), strain * 1e3, color="#444444", lw=1.2, drawstyle="steps-post")
+            inset.plot(np.maximum(t, left), strain * PERCENT, color="#444444", lw=1.2, drawstyle="steps-post")
             inset.set_xlim(left, t_end)
         else:
-            inset.plot(t, strain * 1e3, color="#444444", lw=1.2, drawstyle="steps-post")
+            inset.plot(t, strain * PERCENT, color="#444444", lw=1.2, drawstyle="steps-post")
             inset.set_xlim(0, t_end if t_end > 0 else 1.0)
         inset.set_xlabel("creep time [s]")
-        inset.set_ylabel("axial strain [1e-3]")
+        inset.set_ylabel("axial strain [%]")
         inset.set_title("strain - time", fontsize=9)
         inset.grid(alpha=0.3)
         (self.marker,) = inset.plot([], [], "o", color="#d62728", ms=7, zorder=5)
@@ -170,11 +181,11 @@ class _Renderer:
         self.lines.set_color(list(self.colours[present]))
         self.lines.set_linewidth(np.where(macro[present], MACRO_WIDTH, MICRO_WIDTH))
         strain = self.strain_at(time)
-        self.marker.set_data([time], [strain * 1e3])
+        self.marker.set_data([time], [strain * PERCENT])
         self.cursor.set_xdata([time, time])
         frac = time / t_end if t_end > 0 else 1.0
         self.text.set_text(f"creep time {time:.4g} s ({frac:.1%} of the run)\n"
-                           f"{int(present.sum())} cracks ({int(macro.sum())} on macrocracks)")
+                           f"{int(present.sum())} cracks, {int(macro.sum())} of them macro")
         self.fig.canvas.draw()
         return np.asarray(self.fig.canvas.buffer_rgba())[:, :, :3].copy()
 

@@ -1,8 +1,9 @@
 """Command line: ``python3 -m grainfrac_yade <command> ...``.
 
-Every command accepts ``--params FILE`` (merged over the shipped files in
-``params/``) and repeated ``--set section.key=value`` overrides, validated like
-the files.  User errors print one line and exit with status 2.
+The commands that build or run a model accept ``--params FILE`` (merged over the
+shipped files in ``params/``) and repeated ``--set section.key=value`` overrides,
+validated like the files (README.md lists them; tests/test_newcomer_inputs.py holds
+the list equal to the parser's).  User errors print one line and exit with status 2.
 
 Commands that run a model declare ``with_params=True`` (and optionally
 ``param_overrides``, a function of their arguments giving further overrides) in
@@ -32,14 +33,25 @@ NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
 def seed_type(text: str) -> int:
-    """argparse type of a specimen seed: a whole number >= 0 (numpy's generators take no negative seed)."""
+    """argparse type of a specimen seed: a whole number in [0, MAX_SEED] (numpy's generators take no negative
+    seed; :data:`~grainfrac_yade.specimen.MAX_SEED` is the range of a 32-bit seed)."""
+    from .specimen import MAX_SEED
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. 1)") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number >= 0 (e.g. 1)")
+    if value < 0 or value > MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number from 0 to {MAX_SEED} (the range of a "
+                                         "32-bit seed; e.g. 1)")
     return value
+
+
+def check_out_flag(args):
+    """``--out ''`` (or blanks) is refused: an empty folder name would silently mean the default folder."""
+    out = getattr(args, "out", None)
+    if out is not None and not str(out).strip():
+        raise GrainfracError(f"--out {out!r}: an empty folder name; fix: give a folder (e.g. --out results/run1), "
+                             "or leave --out out for the command's default folder")
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -169,6 +181,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        check_out_flag(args)
         if getattr(args, "with_params", False):
             return args.func(args, load_params_from_args(args))
         return args.func(args)

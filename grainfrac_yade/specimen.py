@@ -86,6 +86,11 @@ def specimen_from_tessellation(tess: Tessellation, mineral, names, thickness: fl
                     clump_label=mineral_clumps(tess.face_cells, mineral), thickness=thickness, seed=seed)
 
 
+#: Largest specimen seed: 2**32 - 1, the range of a 32-bit seed (numpy's ``RandomState`` and ``np.random.seed``
+#: accept no more; ``default_rng`` would take any size, but a seed beyond 64 bits no longer reads back as an
+#: integer from the run tables, and no study needs more than a few billion specimens).
+MAX_SEED = 2**32 - 1
+
 #: Memory one cell takes while its specimen is built [bytes]: measured 11.4-11.9 kB per cell (peak resident
 #: size of build_specimen, 2,559 and 25,465 cells, 2026-12-01); the YADE scene adds to it, so this is a
 #: lower bound of a run's need.

@@ -86,11 +86,11 @@ def crack_maps_figure(path, cracks: pd.DataFrame, times, labels, width: float, h
         ax.set_ylim(-0.02 * height * MM, 1.02 * height * MM)
         ax.set_aspect("equal")
         ax.set_xlabel("x [mm]")
-        ax.set_title(f"{lab}\n{int(micro.sum())} micro, {int(macro.sum())} macro", fontsize=7)
+        ax.set_title(f"{lab}\n{int(micro.sum())} cracks, {int(macro.sum())} of them macro", fontsize=7)
     axes[0][0].set_ylabel("y [mm]")
     handles = [Line2D([], [], color=c, lw=1.2, label=k) for k, c in palette.items()]
-    handles.append(Line2D([], [], color="k", lw=MICRO_WIDTH, label="microcrack (broken bond)"))
-    macro_label = "macrocrack (face fully separated)" if "macro_time_s" in cracks else \
+    handles.append(Line2D([], [], color="k", lw=MICRO_WIDTH, label="crack (broken bond)"))
+    macro_label = "macrocrack (crack on a fully separated face)" if "macro_time_s" in cracks else \
         "macrocrack times not recorded in cracks.csv"
     handles.append(Line2D([], [], color="k", lw=MACRO_WIDTH, label=macro_label))
     if not has_segments(cracks):

@@ -215,7 +215,9 @@ def lifetime_sets(runs: pd.DataFrame) -> list:
         sets.append(LifetimeSet(label=variant, ratio=ratio, lifetime_s=life, fit=fit,
                                 lower_ratio=lower["driving_stress_ratio"].to_numpy(float)[pos],
                                 lower_time_s=end[pos],
-                                at_load_ratio=at_load["driving_stress_ratio"].to_numpy(float)))
+                                at_load_ratio=at_load["driving_stress_ratio"].to_numpy(float),
+                                ucs_pa=pd.to_numeric(g["ucs_pa"], errors="coerce").to_numpy(float)
+                                if "ucs_pa" in g else np.zeros(0)))
     return sets
 
 

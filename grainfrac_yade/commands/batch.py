@@ -16,6 +16,8 @@ from ..errors import GrainfracError
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}
+#: Bad rows listed by a refusal; the rest are counted (a file that is no table would list every line).
+MAX_LISTED_PROBLEMS = 10
 #: Exit status of a batch in which some row did not finish (rows checked and run; not a user error).
 EXIT_ROWS_FAILED = 1
 
@@ -50,6 +52,50 @@ def row_columns(test: str) -> dict:
     return dict(RUN_COLUMNS)
 
 
+def expected_cell(col: str, defaults: dict, controls: dict) -> str:
+    """What a cell of column ``col`` must be, as a fix: its type from the schema (unit, choices), else from the
+    type of its default (run columns: seed, out, study, ratio, ...)."""
+    from ..params.schema import field_spec
+    try:
+        spec = field_spec(col)
+    except GrainfracError:
+        spec = None
+    if spec is not None:
+        unit = f" [{spec['unit']}]" if spec["unit"] not in ("", "1") else ""
+        if spec["check"] == "bool":
+            return f"column {col} takes True or False"
+        if spec["check"] == "choice":
+            return f"column {col} takes quoted text, one of {', '.join(repr(c) for c in spec['choices'])}"
+        if spec["check"].endswith("_int"):
+            return f"column {col} takes a whole number, e.g. {defaults.get(col, 1)!r}"
+        return f"column {col} takes a number{unit}, e.g. {defaults.get(col, 1.0)!r}"
+    default = defaults.get(col, controls.get(col))
+    if isinstance(default, str):
+        return f"column {col} takes quoted text, e.g. {default or 'name'!r}"
+    if isinstance(default, bool):
+        return f"column {col} takes True or False"
+    if isinstance(default, int):
+        return f"column {col} takes a whole number, e.g. {default!r}"
+    if isinstance(default, float):
+        return f"column {col} takes a number, e.g. {default!r}"
+    return "text cells must be quoted, e.g. 'fem'; numbers as they are, e.g. 1.5e6"
+
+
+def check_out_writable(out: str, where: str):
+    """GrainfracError (one line naming ``where``) if the row's ``out`` folder cannot be made or written: its
+    nearest existing folder must be a writable folder (checked with the rows, before any row runs)."""
+    path = Path(out).expanduser().absolute()
+    probe = path
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir():
+        raise GrainfracError(f"batch table {where}: out = {out!r}: {probe} is a file, not a folder; fix: give the "
+                             "row an out below a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise GrainfracError(f"batch table {where}: out = {out!r}: {probe} is not writable; fix: give the row an out "
+                             "in a folder you can write, or make that folder writable")
+
+
 def check_row(test: str, columns, cells: dict, where: str):
     """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
     (one line, naming ``where``) if the row would be refused."""
@@ -65,15 +111,19 @@ def check_row(test: str, columns, cells: dict, where: str):
         try:
             values[col] = cell_value(text)
         except ValueError as exc:
-            raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: text cells must be quoted, e.g. "
-                                 "'fem'") from None
+            raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: "
+                                 f"{expected_cell(col, defaults, controls)}") from None
     overrides = [(k, v) for k, v in values.items() if k in defaults and v != defaults[k]]
     controls.update({k: v for k, v in values.items() if k in controls})
     if controls["on_change"] not in ON_CHANGE:
         raise GrainfracError(f"batch table {where}: on_change = {controls['on_change']!r}; fix: use one of "
                              f"{', '.join(repr(v) for v in ON_CHANGE)}")
-    if not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool) or controls["seed"] < 0:
-        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number >= 0")
+    from ..specimen import MAX_SEED
+    if (not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool)
+            or not 0 <= controls["seed"] <= MAX_SEED):
+        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number from 0 to "
+                             f"{MAX_SEED} (the range of a 32-bit seed)")
+    check_out_writable(str(controls["out"]) or str(Path("results", str(controls["study"]))), where)
     try:
         params = load_parameters(overrides=overrides)
     except GrainfracError as exc:
@@ -120,7 +170,10 @@ def check_table(table, test=None) -> tuple:
             problems.append(str(exc))
     if problems:
         problems.sort(key=_line_of)
-        raise GrainfracError(f"{table}: {len(problems)} bad row(s), nothing run; fix each:\n" + "\n".join(problems))
+        listed = problems[:MAX_LISTED_PROBLEMS]
+        if len(problems) > len(listed):
+            listed.append(f"... and {len(problems) - len(listed)} more bad rows (fix the ones above first)")
+        raise GrainfracError(f"{table}: {len(problems)} bad row(s), nothing run; fix each:\n" + "\n".join(listed))
     return test, checked
 
 
@@ -174,5 +227,6 @@ def cmd_batch(args) -> int:
     if failed:
         print(f"{len(failed)} of {len(rows)} rows failed: lines {', '.join(str(o.line) for o in failed)} of {table}")
         return EXIT_ROWS_FAILED
-    print(f"all {len(rows)} rows finished")
+    skipped = sum(o.skipped for o in done.values())
+    print(f"all {len(rows)} rows finished" + (f" ({skipped} skipped: finished before)" if skipped else ""))
     return 0

@@ -266,7 +266,8 @@ def run_brazilian_in_yade():
             Levers().to_dict():   # a CLI test with levers in this folder: not this row's (rows have none)
         action, note = "run", f"{out}: its checkpoint is of a test with levers (brazilian --slit-fraction ...): started again"
     if action == "skip":
-        print(f"Brazilian row already finished, skipped: {out}")
+        from ..runs.batchrun import ROW_SKIPPED
+        print(f"Brazilian {ROW_SKIPPED}: {out}")
         return
     if note:
         print(note)

@@ -33,7 +33,18 @@ def _floats(text):
 
 
 def _ints(text):
-    return [int(x) for x in text.split(",") if x.strip()]
+    """argparse type of a list of specimen seeds, e.g. 1,2: whole numbers in [0, MAX_SEED] (32-bit)."""
+    import argparse
+    from ..specimen import MAX_SEED
+    try:
+        seeds = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: seeds are whole numbers separated by commas (e.g. 1,2)") from None
+    for seed in seeds:
+        if not 0 <= seed <= MAX_SEED:
+            raise argparse.ArgumentTypeError(f"{seed}: a seed is a whole number from 0 to {MAX_SEED} (the range of a "
+                                             "32-bit seed; e.g. 1,2)")
+    return seeds
 
 
 def register(sub, common):

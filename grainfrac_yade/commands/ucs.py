@@ -150,7 +150,8 @@ def run_ucs_in_yade():
                                      f"{run_folder_name(controls, overrides)}",
                                      params, controls, {"seed": int(controls["seed"])})
     if action == "skip":
-        print(f"UCS row already finished, skipped: {out}")
+        from ..runs.batchrun import ROW_SKIPPED
+        print(f"UCS {ROW_SKIPPED}: {out}")
         return
     if note:
         print(note)

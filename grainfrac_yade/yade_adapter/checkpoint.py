@@ -46,6 +46,7 @@ import json
 import os
 import shutil
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -191,6 +192,7 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
         "run": {"rows": run.rows, "ramp_broken": run.ramp_broken, "failed": run.failed,
                 "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
                 "n_events": run.n_events, "vtk_times": run.vtk_times, "vtk_written": run.vtk_written,
+                "vtk_merged": run.vtk_merged,
                 "vtk_rows": run._vtk_rows, "vtk": run.vtk_folder is not None, "vtk_every": run.vtk_every,
                 "last_relaxation_steps": run.last_relaxation_steps, "resumes": run.resumes,
                 "consolidation": run.consolidation},
@@ -217,6 +219,39 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
     return state, arrays
 
 
+def check_files(where) -> None:
+    """GrainfracError (one line naming the file) if checkpoint folder ``where`` has a state file that is not JSON,
+    an arrays file that numpy cannot read whole, or a scene that is not a complete gzip stream (truncated): checked
+    before YADE is loaded and before anything is written.  Reads every file once (the scene's gzip stream to its
+    end: about a second per 100 MB)."""
+    import gzip
+    import zlib
+    where = Path(where)
+    fix = "fix: start the run again with the same command (run.json) and --overwrite"
+    try:
+        state = json.loads((where / CHECKPOINT_STATE).read_text())
+        if not isinstance(state, dict):
+            raise ValueError("not a JSON object")
+    except (OSError, ValueError) as exc:
+        raise GrainfracError(f"{where}: the checkpoint's state file ({where.name}/{CHECKPOINT_STATE}) is unreadable "
+                             f"(not the JSON this code writes: garbage or truncated; {type(exc).__name__}); "
+                             f"{fix}") from None
+    try:
+        with np.load(where / ARRAYS_FILE) as data:
+            for k in data.files:
+                data[k]
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise GrainfracError(f"{where / ARRAYS_FILE}: the checkpoint's arrays are unreadable "
+                             f"(truncated or not numpy's npz; {type(exc).__name__}: {exc}); {fix}") from None
+    try:
+        with gzip.open(where / SCENE_FILE, "rb") as fh:
+            while fh.read(1 << 24):
+                pass
+    except (OSError, EOFError, zlib.error) as exc:
+        raise GrainfracError(f"{where / SCENE_FILE}: the checkpoint's scene is unreadable (truncated "
+                             f"gzip or not a YADE scene; {type(exc).__name__}: {exc}); {fix}") from None
+
+
 def read(run_folder, test: str = "creep") -> tuple:
     """(checkpoint folder, state, arrays) of the ``test`` run in ``run_folder``; GrainfracError if it has
     none or it is bad."""
@@ -229,7 +264,7 @@ def read(run_folder, test: str = "creep") -> tuple:
         state = json.loads((where / CHECKPOINT_STATE).read_text())
         with np.load(where / ARRAYS_FILE) as data:
             arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise GrainfracError(f"{where}: checkpoint unreadable ({type(exc).__name__}: {exc}); fix: start the run "
                              "again with --overwrite") from None
     if state.get("format") != FORMAT or state.get("phase") not in PHASES.get(state.get("test", "creep"), ()):
@@ -327,6 +362,7 @@ def restore(run, where, state: dict, arrays: dict):
     run.failed_on_loading, run.n_events = r["failed_on_loading"], r["n_events"]
     run.vtk_times, run.vtk_written, run._vtk_rows = r["vtk_times"], r["vtk_written"], r["vtk_rows"]
     run.vtk_every = int(r.get("vtk_every", 0))   # older checkpoints: times only
+    run.vtk_merged = r.get("vtk_merged", [])   # older checkpoints: none recorded
     run.last_relaxation_steps = r["last_relaxation_steps"]
     run.consolidation = r.get("consolidation", {})
     run.resumes = r["resumes"] + [{"dem_steps": state["dem_steps"], "creep_time_s": state["creep_time_s"],
