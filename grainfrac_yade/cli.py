@@ -16,6 +16,7 @@ import argparse
 import re
 import sys
 
+from .commands._args import load_params_from_args, overrides_from_args, seed_type  # noqa: F401  (re-exported)
 from .errors import GrainfracError
 
 #: Exit status for user errors (bad input), as argparse uses.
@@ -29,17 +30,6 @@ DEBUG_FLAG = "--debug"
 ERROR_LOG_DIR = "results/logs"
 #: A negative number with an exponent (-10e-3): argparse takes it for an option ("expected one argument").
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
-
-
-def seed_type(text: str) -> int:
-    """argparse type of a specimen seed: a whole number >= 0 (numpy's generators take no negative seed)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. 1)") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number >= 0 (e.g. 1)")
-    return value
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -62,38 +52,6 @@ def _common(parser: argparse.ArgumentParser, geometry: bool = True):
         parser.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     parser.add_argument("--out", help="output folder")
     parser.add_argument("--overwrite", action="store_true", help="replace a run already in --out")
-
-
-def overrides_from_args(args) -> list:
-    """``--set`` strings plus the geometry shortcuts (--width etc.) and the command's own (``param_overrides``);
-    a shortcut's override is a :class:`~grainfrac_yade.params.FlagOverride` (its errors name the flag)."""
-    from .params import FlagOverride
-    out = list(args.overrides)
-    extra = getattr(args, "param_overrides", None)
-    if extra is not None:
-        out += list(extra(args))
-    for opt, key in (("width", "specimen.width"), ("height", "specimen.height"),
-                     ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell")):
-        value = getattr(args, opt, None)
-        if value is not None:
-            out.append(FlagOverride(key, value, "--" + opt.replace("_", "-")))
-    return out
-
-
-def load_params_from_args(args):
-    """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
-    from .params import load_parameters, override_origin
-    from .specimen import check_cell_count
-    from .tessellation import n_cells_for
-    args.resolved_overrides = overrides_from_args(args)
-    params = load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
-    sp = params.specimen   # refused before any folder is made or anything allocated
-    box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
-    flags = ", ".join(override_origin(o) for o in args.resolved_overrides
-                      if override_origin(o) != "--set" and o[0].startswith("specimen."))
-    check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
-                     sp.grain_size, flags)
-    return params
 
 
 def cmd_specimen(args, params) -> int:

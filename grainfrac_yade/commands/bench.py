@@ -93,7 +93,7 @@ def register(sub, common):
                         f"{QUICK.events} events per scene, no runs to failure")
     p.add_argument("--out", help=f"JSON file to write (default {DEFAULT_OUT.relative_to(DEFAULT_OUT.parents[1])}; "
                                  "with --quick, results/bench_quick.json)")
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seed", type=seed_type, default=1, help="specimen seed (default 1)")
     p.add_argument("--ratio", type=float, default=DEFAULT_RATIO,
                    help="creep load as a ratio of each scene's calibration.reference_ucs (default 0.7)")

@@ -22,7 +22,7 @@ def register(sub, common):
     p.add_argument("--diameter", type=float, help="disc diameter [m] (brazilian.diameter)")
     p.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
     p.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     p.add_argument("--tensile-scale", type=float, metavar="F",
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
@@ -43,7 +43,7 @@ def register(sub, common):
 
 
 def cmd_brazilian(args) -> int:
-    from ..cli import load_params_from_args
+    from ._args import load_params_from_args
     if args.resume:
         from .resume import refuse_resume_conflicts, resumable_run
         refuse_resume_conflicts(args)
@@ -73,7 +73,7 @@ def cmd_brazilian(args) -> int:
 
 
 def _reload(args, extra, base, factor):
-    from ..cli import overrides_from_args
+    from ._args import overrides_from_args
     from ..params import load_parameters
     params = load_parameters(extra_files=args.params, overrides=overrides_from_args(args) + extra)
     if factor is not None:

@@ -39,7 +39,7 @@ def _gpa(text: str) -> float:
 def register(sub, common):
     p = sub.add_parser("calibrate", help="fit strength/stiffness scale factors to UCS 234.5 MPa and E 69 GPa")
     common(p, geometry=True)
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seeds", type=seed_type, nargs="+", default=[1, 2, 3, 4, 5], help="specimen seeds (>= 0)")
     p.add_argument("--rounds", type=int, default=2, help="fixed-point rounds after the 'before' round")
     from .creep import stress_flag
