@@ -309,7 +309,7 @@ def animation_note(run_folder, out) -> str | None:
     costs seconds per run); None when the run has none."""
     import os
 
-    from ..animation import GIF_NAME, MP4_NAME
+    from .animation import GIF_NAME, MP4_NAME
     run_folder = Path(run_folder)
     gif = run_folder / GIF_NAME
     if not gif.is_file():
