@@ -97,7 +97,7 @@ def test_small_specimen_creep_curve_has_three_stages():
     t_f, tertiary starts at 0.46 t_f; strain rate 4e-12 -> 8e-16 -> 5e-11 1/s). Small specimens
     creep in steps (16 events here), so this checks the stage detector on a real staircase; the
     paper-size specimen gives smooth three-stage curves (README)."""
-    from grainfrac_yade.creep_analysis import STAGE_RATE_FACTOR, STAGE_WINDOW, creep_stages, local_rates
+    from grainfrac_yade.analysis.creep_analysis import STAGE_RATE_FACTOR, STAGE_WINDOW, creep_stages, local_rates
     from grainfrac_yade.yade_adapter.creep_protocol import run_creep
     p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3",
                                    "stress_corrosion.creep_time_limit=1e30"])
