@@ -19,7 +19,7 @@ SMALL = ["specimen.width=6e-3", "specimen.height=12e-3", "stress_corrosion.creep
 @pytest.fixture(scope="module")
 def small_ucs():
     """UCS of the small specimen (seed 1), measured: creep loads are ratios of it."""
-    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=SMALL)
     hist, *_ = run_ucs(build_specimen(p, 1), p)

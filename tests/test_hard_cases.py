@@ -172,7 +172,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
 def rigid_ucs():
     """UCS of the 4 x 8 mm specimen, seed 1 (measured 251.8 MPa; 3 s)."""
     from grainfrac_yade.specimen import build_specimen
-    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=TINY)
     return ucs_summary(run_ucs(build_specimen(p, 1), p)[0])["ucs_pa"]
@@ -360,7 +360,7 @@ def test_f_a_strict_one_cell_column_ends_at_the_strain_cap_as_a_lower_bound(sphe
     sideways (largest stress 3.4 MPa, the ringing of the first steps); 8 spheres per cell: 2 bonds per face,
     elastic to the 2 % strain cap (1.8 GPa).  Neither breaks a bond.  Before, the first run 'failed'
     post-peak at 3.4 MPa after 376 DEM steps (the ringing read as softening).  1-2 s each."""
-    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=["specimen.width=2e-3", "specimen.height=8e-3", "specimen.grain_size=1.9e-3",
                                    f"resolution.spheres_per_cell={spheres_per_cell}"])

@@ -191,7 +191,7 @@ def test_a_brazilian_peak_without_a_split_is_left_out():
 def test_crack_volumetric_strain_onset_of_a_known_history():
     """Elastic to sigma_ci = 90 MPa, then a crack dilation growing as (sigma - sigma_ci)^2: the lab's
     crack-initiation reading finds where the dilation reaches 2 % of its peak value, to the stress step."""
-    from grainfrac_yade.ucs_analysis import crack_initiation_volumetric_stress, crack_volumetric_strain
+    from grainfrac_yade.analysis.ucs_analysis import crack_initiation_volumetric_stress, crack_volumetric_strain
     young, poisson, ci = 70e9, 0.25, 90e6
     stress = np.linspace(0.0, 200e6, 401)          # 0.5 MPa a row
     ea = stress / young
