@@ -144,7 +144,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     ``vtk_every``: VTK series in ``out/vtk/`` at every k-th history row and the end (None: none; not
     carried across a resume)."""
     from pathlib import Path
-    from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
+    from ..analysis.brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
     from ..specimen import build_disc_specimen
@@ -199,7 +199,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
 def write_disc_cracks(path, scene):
     """cracks.csv: one row per bond broken during the test (DEM step, mode, kind, position, orientation, and
     whether it lies in the central band); slits (:mod:`~grainfrac_yade.yade_adapter.levers`) are left out."""
-    from ..brazilian_analysis import in_central_band
+    from ..analysis.brazilian_analysis import in_central_band
     from ..runs.runio import write_csv
     from ..yade_adapter.levers import new_breaks
     from ..yade_adapter.scene import SHEAR
@@ -219,7 +219,7 @@ def write_disc_cracks(path, scene):
 
 def band_guides(tessellation) -> np.ndarray:
     """(2, 2, 2) the central band's two edges x = x_c +- D/6, clipped to the disc [m]."""
-    from ..brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
+    from ..analysis.brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
     c, r = tessellation.centre, tessellation.radius
     dx = CENTRAL_BAND_HALF_WIDTH * 2 * r
     dy = math.sqrt(r * r - dx * dx)
