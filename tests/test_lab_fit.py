@@ -1,8 +1,8 @@
-"""The lab fit's pure core (grainfrac_yade.lab_fit): mapping, design, surface and solve against closed forms."""
+"""The lab fit's pure core (grainfrac_yade.analysis.lab_fit): mapping, design, surface and solve against closed forms."""
 import numpy as np
 import pytest
 
-from grainfrac_yade import lab_fit
+from grainfrac_yade.analysis import lab_fit
 
 
 def test_variable_mapping_ends_and_log_midpoint():
