@@ -1,6 +1,6 @@
 """``accuracy-cost [--quick]``: what accuracy costs in time, in one command.
 
-Reads the study's plan (``params/accuracy_cost.toml``, :mod:`grainfrac_yade.accuracy_study`), writes its
+Reads the study's plan (``params/accuracy_cost.toml``, :mod:`grainfrac_yade.analysis.accuracy_study`), writes its
 yade-batch tables into the study folder (``ucs.table``, ``creep.table``; ``--tables-only`` stops there,
 for ``yade-batch`` or ``submit`` by hand), runs them ``--jobs`` rows at a time (finished rows with the
 same parameters are kept, unfinished creep rows go on from their checkpoints), then writes
@@ -33,7 +33,7 @@ def register(sub, common):
 
 
 def cmd_accuracy_cost(args) -> int:
-    from ..accuracy_study import creep_rows, load_study, ucs_rows
+    from ..analysis.accuracy_study import creep_rows, load_study, ucs_rows
     from ..runs.batchrun import run_batch, write_table
     study = load_study(args.study, quick=args.quick, repo=REPO)
     study = replace(study, folder=Path(args.out or study.folder).resolve())
