@@ -501,7 +501,7 @@ def test_several_studies_fitted_separately_side_by_side(tmp_path, capsys):
 
 def test_long_titles_are_wrapped_inside_the_figure():
     from grainfrac_yade.analysis.figures import _title
-    from grainfrac_yade.plotting import plt
+    from grainfrac_yade.analysis.plotting import plt
     fig, ax = plt.subplots(figsize=(4, 3))
     t = _title(ax, "Axial strain vs creep time (normalised) (paper Fig. 5); failure leaves the top of the axis")
     r = fig.canvas.get_renderer()

@@ -285,7 +285,7 @@ def test_a_numerical_failure_is_its_own_outcome_in_summary_json(tmp_path, monkey
 
 def test_a_run_killed_while_drawing_leaves_no_summary(tmp_path, monkeypatch, tiny):
     """summary.json is written last: a run stopped before it ends is 'unfinished', never 'finished'."""
-    import grainfrac_yade.plotting as plotting
+    import grainfrac_yade.analysis.plotting as plotting
 
     def killed(*args, **kwargs):
         raise KeyboardInterrupt

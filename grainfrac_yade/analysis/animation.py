@@ -109,7 +109,7 @@ class _Renderer:
         from matplotlib.lines import Line2D
         from matplotlib.patches import Rectangle
 
-        from ..plotting import CRACK_COLOURS, draw_cells, plt
+        from .plotting import CRACK_COLOURS, draw_cells, plt
         self.plt = plt
         self.fig = plt.figure(figsize=FIGSIZE, dpi=DPI)
         ax = self.fig.add_axes((0.06, 0.08, 0.42, 0.84))

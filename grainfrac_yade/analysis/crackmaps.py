@@ -19,7 +19,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 
-from ..plotting import CRACK_COLOURS, draw_cells, plt
+from .plotting import CRACK_COLOURS, draw_cells, plt
 
 MM = 1e3
 SEGMENT_COLUMNS = ("x0_m", "y0_m", "x1_m", "y1_m")

@@ -229,7 +229,7 @@ def band_guides(tessellation) -> np.ndarray:
 def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     """crack_map_peak.png (broken bonds at the failure load, the peak before the split) and crack_map_end.png
     (at the end of the test), with the central band's edges dashed."""
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..yade_adapter.scene import bond_segments
     specimen, seed = scene.specimen, summary["seed"]
     guides = band_guides(specimen.tessellation)

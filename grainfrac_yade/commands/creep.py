@@ -356,7 +356,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..analysis.figures import MAP_FRACTIONS, run_bond_stress_figure, run_strain_time_figure
     from ..analysis.creep_analysis import CreepStages, damage_index, resolve_creep_stages
     from ..params import require_plane
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..runs.runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
     from ..specimen import build_specimen
