@@ -14,7 +14,7 @@ from .errors import GrainfracError
 from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
 from .params import Parameters
 from .regularise import regularise
-from .tessellation import Tessellation, n_cells_for, voronoi_box
+from .geometry.tessellation import Tessellation, n_cells_for, voronoi_box
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from grainfrac_yade.disc import DiscTessellation, clip_polygon_to_disc, tessella
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_disc_specimen
-from grainfrac_yade.tessellation import SIDES
+from grainfrac_yade.geometry.tessellation import SIDES
 
 #: Tiny disc for the YADE runs: 8 mm, 1 mm grains (64 cells, 2-5 s a run); the CLI test runs 5 mm.
 TINY = ["brazilian.diameter=8e-3"]

@@ -7,7 +7,7 @@ import argparse
 
 from ..params import FlagOverride, load_parameters, override_origin
 from ..specimen import check_cell_count
-from ..tessellation import n_cells_for
+from ..geometry.tessellation import n_cells_for
 
 
 def seed_type(text: str) -> int:
