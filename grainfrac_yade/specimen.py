@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .disc import check_disc_size, n_cells_for_disc, voronoi_disc
+from .geometry.disc import check_disc_size, n_cells_for_disc, voronoi_disc
 from .errors import GrainfracError
 from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
 from .params import Parameters

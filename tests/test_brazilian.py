@@ -10,7 +10,7 @@ import pytest
 from conftest import ROOT, needs_yade
 from grainfrac_yade.analysis.brazilian_analysis import (central_band_area_fraction, crack_location, hondros_centre_factor,
                                                in_central_band, tensile_stress)
-from grainfrac_yade.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
+from grainfrac_yade.geometry.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_disc_specimen

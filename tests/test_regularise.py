@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from grainfrac_yade.disc import voronoi_disc
+from grainfrac_yade.geometry.disc import voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.minerals import allocate_minerals

@@ -4,7 +4,7 @@ load_strain.png, crack maps at the peak and at the end.
 Tensile strength sigma_t = 2 P / (pi D t) (ISRM 1978 suggested method) at the peak load P of a
 disc of diameter D (``brazilian.diameter``) and thickness t (``specimen.thickness``), the disc a
 Voronoi tessellation clipped to the circle with the grain size and composition of the UCS
-specimen (:mod:`grainfrac_yade.disc`), loaded by two rigid jaws
+specimen (:mod:`grainfrac_yade.geometry.disc`), loaded by two rigid jaws
 (:mod:`grainfrac_yade.yade_adapter.brazilian_protocol`).
 """
 from __future__ import annotations

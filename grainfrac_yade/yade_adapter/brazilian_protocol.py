@@ -38,7 +38,7 @@ import time
 import numpy as np
 
 from ..analysis.brazilian_analysis import splits, tensile_stress
-from ..disc import DiscTessellation
+from ..geometry.disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays

@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Voronoi
 
-from .errors import GrainfracError
-from .geometry.tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _check_one_region_per_seed
+from ..errors import GrainfracError
+from .tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _check_one_region_per_seed
 
 #: Largest angle between two samples of a rim arc in ``cell_vertices`` [deg].
 ARC_SAMPLE_DEG = 2.0
