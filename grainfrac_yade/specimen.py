@@ -13,7 +13,7 @@ from .geometry.disc import check_disc_size, n_cells_for_disc, voronoi_disc
 from .errors import GrainfracError
 from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
 from .params import Parameters
-from .regularise import regularise
+from .geometry.regularise import regularise
 from .geometry.tessellation import Tessellation, n_cells_for, voronoi_box
 
 
@@ -114,7 +114,7 @@ def check_cell_count(n_cells: int, what: str, grain_size: float, flags: str = ""
 
 def build_specimen(params: Parameters, seed: int) -> Specimen:
     """Tessellate the specimen of ``params.specimen``, collapse its short edges
-    (``specimen.min_edge_fraction``, :mod:`grainfrac_yade.regularise`) and allocate minerals (seeded)."""
+    (``specimen.min_edge_fraction``, :mod:`grainfrac_yade.geometry.regularise`) and allocate minerals (seeded)."""
     sp = params.specimen
     box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
     check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",

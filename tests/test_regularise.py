@@ -1,4 +1,4 @@
-"""Regularised tessellation (``specimen.min_edge_fraction``, grainfrac_yade/regularise.py): exact invariants.
+"""Regularised tessellation (``specimen.min_edge_fraction``, grainfrac_yade/geometry/regularise.py): exact invariants.
 
 Pure numpy, no YADE.  Tolerances: areas and wall lengths sum to the domain's to 1e-12 relative (a few
 thousand float64 additions of terms of the domain's size: rounding ~1e-15; the collapse itself is exact
@@ -16,7 +16,7 @@ from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.minerals import allocate_minerals
 from grainfrac_yade.params import PARAMS_DIR, load_parameters, migrate_tree
-from grainfrac_yade.regularise import regularise
+from grainfrac_yade.geometry.regularise import regularise
 from grainfrac_yade.specimen import build_disc_specimen, build_specimen
 from grainfrac_yade.geometry.tessellation import voronoi_box
 

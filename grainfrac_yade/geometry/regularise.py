@@ -35,9 +35,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .geometry.disc import SAME_POINT_FRACTION, _arc_points, _quadrant_side, _segment_area_moment, _shoelace
-from .errors import GrainfracError
-from .geometry.tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _polygon_area_centroid
+from .disc import SAME_POINT_FRACTION, _arc_points, _quadrant_side, _segment_area_moment, _shoelace
+from ..errors import GrainfracError
+from .tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _polygon_area_centroid
 
 #: A corner of a regularised cell must turn by more than this fraction of the product of its two
 #: edges' lengths (cross product / (l1 l2) = sine of the turning angle): strictly convex, no corner
