@@ -11,7 +11,7 @@ import numpy as np
 
 from .geometry.disc import check_disc_size, n_cells_for_disc, voronoi_disc
 from .errors import GrainfracError
-from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
+from .geometry.minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
 from .params import Parameters
 from .geometry.regularise import regularise
 from .geometry.tessellation import Tessellation, n_cells_for, voronoi_box

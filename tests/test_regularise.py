@@ -14,7 +14,7 @@ import pytest
 from grainfrac_yade.geometry.disc import voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
-from grainfrac_yade.minerals import allocate_minerals
+from grainfrac_yade.geometry.minerals import allocate_minerals
 from grainfrac_yade.params import PARAMS_DIR, load_parameters, migrate_tree
 from grainfrac_yade.geometry.regularise import regularise
 from grainfrac_yade.specimen import build_disc_specimen, build_specimen

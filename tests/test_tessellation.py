@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from grainfrac_yade.minerals import allocate_minerals, area_fractions, mineral_clumps
+from grainfrac_yade.geometry.minerals import allocate_minerals, area_fractions, mineral_clumps
 from grainfrac_yade.specimen import build_specimen
 from grainfrac_yade.geometry.tessellation import SIDES, n_cells_for, tessellate_seeds, voronoi_box
 
