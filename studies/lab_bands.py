@@ -27,7 +27,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 GRAIN_SIZE_CSV = ROOT / "docs" / "studies" / "lab_bands_grain_size.csv"
 LEVERS_CSV = ROOT / "docs" / "studies" / "lab_bands_levers.csv"

@@ -401,7 +401,7 @@ def real_run():
     """A real parameter set (small specimen), its specimen and layout as the run would build them."""
     from grainfrac_yade.grains.rigid import build_layout
     from grainfrac_yade.params import load_parameters
-    from grainfrac_yade.specimen import build_specimen
+    from grainfrac_yade.geometry.specimen import build_specimen
     params = load_parameters(overrides=SMALL)
     seed = 5
     specimen = build_specimen(params, seed)

@@ -13,7 +13,7 @@ from grainfrac_yade.analysis.brazilian_analysis import (central_band_area_fracti
 from grainfrac_yade.geometry.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_disc_specimen
+from grainfrac_yade.geometry.specimen import build_disc_specimen
 from grainfrac_yade.geometry.tessellation import SIDES
 
 #: Tiny disc for the YADE runs: 8 mm, 1 mm grains (64 cells, 2-5 s a run); the CLI test runs 5 mm.

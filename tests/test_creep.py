@@ -9,7 +9,7 @@ import pytest
 
 from conftest import ROOT, needs_yade
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 pytestmark = [needs_yade, pytest.mark.yade]
 

@@ -15,7 +15,7 @@ from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 SMALL = ["specimen.width=3e-3", "specimen.height=6e-3"]
 FEM = ["resolution.grain_model=fem"]

@@ -171,7 +171,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
 @pytest.fixture(scope="module")
 def rigid_ucs():
     """UCS of the 4 x 8 mm specimen, seed 1 (measured 251.8 MPa; 3 s)."""
-    from grainfrac_yade.specimen import build_specimen
+    from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.yade_adapter.ucs_protocol import run_ucs
     p = load_parameters(overrides=TINY)
@@ -268,7 +268,7 @@ def sliver_seeds(width, grain=1e-3, jitter_seed=3):
 
 
 def sliver_specimen(params, width):
-    from grainfrac_yade.specimen import specimen_from_tessellation
+    from grainfrac_yade.geometry.specimen import specimen_from_tessellation
     from grainfrac_yade.geometry.tessellation import tessellate_seeds
     t = tessellate_seeds(sliver_seeds(width), [4e-3, 8e-3], 1e-3)
     assert t.cell_measure.sum() == pytest.approx(32e-6, rel=1e-12)   # no cell overlaps another
@@ -341,7 +341,7 @@ def test_f_grains_just_below_the_width_run_a_ucs_to_a_finite_peak(tmp_path, capt
 def column_specimen(params, n=5, grain=1.9e-3):
     """n cells stacked in a 2 x 8 mm box, every one spanning the width (seeds jittered about the axis,
     so faces are inclined by 18 to 31 degrees)."""
-    from grainfrac_yade.specimen import specimen_from_tessellation
+    from grainfrac_yade.geometry.specimen import specimen_from_tessellation
     from grainfrac_yade.geometry.tessellation import tessellate_seeds
     rng = np.random.default_rng(1)
     seeds = np.column_stack([1e-3 + rng.uniform(-0.3, 0.3, n) * 2e-3, (np.arange(n) + 0.5) * 8e-3 / n])

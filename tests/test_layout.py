@@ -4,7 +4,7 @@ import pytest
 
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.layout import bond_properties, cell_mass_inertia
-from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
+from grainfrac_yade.geometry.specimen import build_specimen, specimen_from_tessellation
 from grainfrac_yade.geometry.tessellation import tessellate_seeds
 
 

@@ -17,7 +17,7 @@ from grainfrac_yade.grains import layout_for
 from grainfrac_yade.geometry.minerals import allocate_minerals
 from grainfrac_yade.params import PARAMS_DIR, load_parameters, migrate_tree
 from grainfrac_yade.geometry.regularise import regularise
-from grainfrac_yade.specimen import build_disc_specimen, build_specimen
+from grainfrac_yade.geometry.specimen import build_disc_specimen, build_specimen
 from grainfrac_yade.geometry.tessellation import voronoi_box
 
 GRAIN = 1e-3

@@ -218,7 +218,7 @@ def test_event_loop_on_nan_stresses_raises_instead_of_ending_not_failed():
 @pytest.fixture(scope="module")
 def tiny():
     from grainfrac_yade.grains import layout_for
-    from grainfrac_yade.specimen import build_specimen
+    from grainfrac_yade.geometry.specimen import build_specimen
     params = load_parameters(overrides=TINY)
     specimen = build_specimen(params, 1)
     return params, specimen, layout_for(specimen, params)

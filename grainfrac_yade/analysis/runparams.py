@@ -105,7 +105,7 @@ def parameters_from_json(path):
 
 @dataclass(frozen=True)
 class RebuiltSpecimen:
-    specimen: object         # grainfrac_yade.specimen.Specimen
+    specimen: object         # grainfrac_yade.geometry.specimen.Specimen
     run_params: RunParameters
     checks: tuple            # what was verified against the run's records (text)
 
@@ -143,7 +143,7 @@ def rebuild_specimen(folder, seed, n_bonds=None, cracks=None) -> RebuiltSpecimen
         raise GrainfracError(f"{folder}: 3D specimen (specimen.dimension = {params.specimen.dimension}); "
                              "fix: grain maps are drawn for 2D specimens only")
     from ..grains import layout_for
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     specimen = build_specimen(params, seed)
     checks = []
     need_layout = n_bonds is not None or (cracks is not None and len(cracks) and

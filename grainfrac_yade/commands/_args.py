@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from ..params import FlagOverride, load_parameters, override_origin
-from ..specimen import check_cell_count
+from ..geometry.specimen import check_cell_count
 from ..geometry.tessellation import n_cells_for
 
 

@@ -79,7 +79,7 @@ def check_row(test: str, columns, cells: dict, where: str):
     except GrainfracError as exc:
         raise GrainfracError(f"batch table {where}: {exc}") from None
     try:
-        from ..specimen import check_cell_count
+        from ..geometry.specimen import check_cell_count
         from ..geometry.tessellation import n_cells_for
         sp = params.specimen
         check_cell_count(n_cells_for([sp.width, sp.height], sp.grain_size), "the row's specimen", sp.grain_size)

@@ -147,7 +147,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     from ..analysis.brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
-    from ..specimen import build_disc_specimen
+    from ..geometry.specimen import build_disc_specimen
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..yade_adapter.brazilian_protocol import resume_brazilian, run_brazilian
     from ..yade_adapter.levers import Levers, new_breaks

@@ -359,7 +359,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..analysis.plotting import crack_map
     from ..runs.runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..wave import budget_fields
     from ..yade_adapter.creep_protocol import resume_creep, run_creep
     from ..yade_adapter.scene import bond_segments, broken_counts

@@ -75,7 +75,7 @@ def run_elastic_to_folder(params, seed, out, grains="mesh", nodes_per_face=2, co
     from ..elastic import contact_ratios, elastic_summary
     from ..grains import grain_model
     from ..runs.runio import code_version, commit_run_dir, prepare_run_dir, write_json
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     models, ratios = {}, {}

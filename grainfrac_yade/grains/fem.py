@@ -41,7 +41,7 @@ from ..errors import GrainfracError
 from ..grainmesh import grain_mesh
 from ..layout import BondProperties, ClumpLayout, cell_mass_inertia
 from ..params import Parameters
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 from ._interface import GrainModel
 
 NAME = "fem"

@@ -9,12 +9,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry.disc import check_disc_size, n_cells_for_disc, voronoi_disc
-from .errors import GrainfracError
-from .geometry.minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
-from .params import Parameters
-from .geometry.regularise import regularise
-from .geometry.tessellation import Tessellation, n_cells_for, voronoi_box
+from .disc import check_disc_size, n_cells_for_disc, voronoi_disc
+from ..errors import GrainfracError
+from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
+from ..params import Parameters
+from .regularise import regularise
+from .tessellation import Tessellation, n_cells_for, voronoi_box
 
 
 @dataclass(frozen=True)
