@@ -41,7 +41,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .errors import GrainfracError
-from .grainmesh import grain_mesh
+from .geometry.grainmesh import grain_mesh
 from .layout import ClumpLayout, bond_properties, mineral_pair_table
 from .params import Parameters
 from .geometry.specimen import Specimen

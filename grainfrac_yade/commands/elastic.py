@@ -11,7 +11,7 @@ RETIRED_GRAINS = {"deformable": "the triangle-mesh reference is called mesh now;
 
 def register(sub, common):
     from ..elastic import GRAIN_MODELS
-    from ..grainmesh import CONTACT_PLACEMENTS
+    from ..geometry.grainmesh import CONTACT_PLACEMENTS
     p = sub.add_parser("elastic", help="static elastic reference: E, nu and the contact stress tail "
                                        "of rigid, mesh and fem cells (seconds, no YADE)")
     common(p)

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import GrainfracError
-from .geometry.specimen import Specimen
+from ..errors import GrainfracError
+from .specimen import Specimen
 
 #: Polygon edges shorter than this fraction of the grain size are not subdivided (no face, no contact).
 MIN_EDGE_FRACTION = 1e-3
