@@ -16,7 +16,6 @@ import argparse
 import re
 import sys
 
-from .commands._args import load_params_from_args, overrides_from_args, seed_type  # noqa: F401  (re-exported)
 from .errors import GrainfracError
 
 #: Exit status for user errors (bad input), as argparse uses.
@@ -40,6 +39,7 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def _common(parser: argparse.ArgumentParser, geometry: bool = True):
+    from .commands._args import seed_type   # not at module level: see main()
     parser.add_argument("--params", action="append", default=[], metavar="FILE",
                         help="TOML file merged over the shipped parameters (repeatable)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
@@ -121,6 +121,8 @@ def _log_traceback(command: str) -> str:
 def main(argv=None) -> int:
     from .yade_adapter import use_default_threads
     use_default_threads()   # before any command module loads the OpenMP runtime
+    # this module's own imports load no numpy (nor OpenBLAS, which reads OMP_NUM_THREADS once) before this line
+    from .commands._args import load_params_from_args
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = DEBUG_FLAG in argv
     argv = join_negative_values([a for a in argv if a != DEBUG_FLAG])
