@@ -16,6 +16,7 @@ import argparse
 import re
 import sys
 
+from .commands import animate, register_all
 from .errors import GrainfracError
 
 #: Exit status for user errors (bad input), as argparse uses.
@@ -80,9 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     _common(p)
     p.add_argument("--bonds", action="store_true", help="draw the bond network on the picture")
     p.set_defaults(func=cmd_specimen, with_params=True)
-    from .commands import register_all
     register_all(sub, _common)
-    from .commands import animate
     animate.register(sub, _common)
     return parser
 

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
+from .runparams import rebuild_specimen
 
 #: Frames of an animation by default: 4 s at the default rate.
 DEFAULT_FRAMES = 60
@@ -88,7 +89,6 @@ def _read_run(folder: Path):
 
 def _specimen(folder, run, summary, cracks):
     """(specimen or None, note): the run's grains rebuilt and verified, else the reason."""
-    from .runparams import rebuild_specimen
     try:
         rebuilt = rebuild_specimen(folder, run.get("seed"), n_bonds=summary.get("n_bonds"), cracks=cracks)
     except GrainfracError as exc:

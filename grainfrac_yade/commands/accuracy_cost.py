@@ -15,6 +15,11 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from ..analysis.accuracy_study import creep_rows, load_study, ucs_rows
+from ..errors import GrainfracError
+from ..runs.batchrun import run_batch, write_table
+from ..runs.runio import write_csv
+
 REPO = Path(__file__).resolve().parents[2]
 STUDY_FILE = REPO / "params" / "accuracy_cost.toml"
 
@@ -33,8 +38,6 @@ def register(sub, common):
 
 
 def cmd_accuracy_cost(args) -> int:
-    from ..analysis.accuracy_study import creep_rows, load_study, ucs_rows
-    from ..runs.batchrun import run_batch, write_table
     study = load_study(args.study, quick=args.quick, repo=REPO)
     study = replace(study, folder=Path(args.out or study.folder).resolve())
     folder = study.folder
@@ -63,8 +66,6 @@ def summarise(study) -> int:
     from ..analysis.accuracy import history_measures, label_runs, markdown_table, pareto_figure, setting_rows
     from ..analysis.collect import code_version_note, collect_runs
     from ..analysis.study import read_history
-    from ..errors import GrainfracError
-    from ..runs.runio import write_csv
     folder = study.folder
     runs = collect_runs(folder)
     labelled = label_runs(study, runs) if not runs.empty else runs

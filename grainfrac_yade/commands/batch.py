@@ -13,6 +13,12 @@ import os
 from pathlib import Path
 
 from ..errors import GrainfracError
+from ..geometry.specimen import check_cell_count
+from ..geometry.tessellation import n_cells_for
+from ..params import load_parameters, require_plane, shipped_values
+from ..runs.batchrun import cell_value, read_table_rows, row_outcomes, run_batch
+from .brazilian import require_disc_model
+from .creep import CREEP_ROW_COLUMNS, check_stress_range, outcome, resolve_stress
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}
@@ -45,7 +51,6 @@ def row_columns(test: str) -> dict:
     """The run-control columns of a kind of row, with defaults (parameters aside)."""
     from ..yade_adapter.batch import RUN_COLUMNS
     if test == "creep":
-        from .creep import CREEP_ROW_COLUMNS
         return dict(RUN_COLUMNS, **CREEP_ROW_COLUMNS)
     return dict(RUN_COLUMNS)
 
@@ -53,8 +58,6 @@ def row_columns(test: str) -> dict:
 def check_row(test: str, columns, cells: dict, where: str):
     """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
     (one line, naming ``where``) if the row would be refused."""
-    from ..runs.batchrun import cell_value
-    from ..params import load_parameters, shipped_values
     from ..yade_adapter.batch import ON_CHANGE, check_columns
     defaults, controls = shipped_values(), row_columns(test)
     check_columns(columns, {**defaults, **controls}, where)
@@ -79,8 +82,6 @@ def check_row(test: str, columns, cells: dict, where: str):
     except GrainfracError as exc:
         raise GrainfracError(f"batch table {where}: {exc}") from None
     try:
-        from ..geometry.specimen import check_cell_count
-        from ..geometry.tessellation import n_cells_for
         sp = params.specimen
         check_cell_count(n_cells_for([sp.width, sp.height], sp.grain_size), "the row's specimen", sp.grain_size)
         _check_kind(test, params, controls)
@@ -90,10 +91,7 @@ def check_row(test: str, columns, cells: dict, where: str):
 
 
 def _check_kind(test, params, controls):
-    from ..params import require_plane
-    from .creep import check_stress_range, resolve_stress
     if test == "brazilian":
-        from .brazilian import require_disc_model
         require_disc_model(params)
         return
     require_plane(params, test)
@@ -109,7 +107,6 @@ def _check_kind(test, params, controls):
 def check_table(table, test=None) -> tuple:
     """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row`;
     else GrainfracError with one line per bad row."""
-    from ..runs.batchrun import read_table_rows
     columns, rows, problems = read_table_rows(table)
     test = test or guess_test(columns, Path(table).name)
     checked = {}
@@ -133,7 +130,6 @@ def _line_of(problem: str) -> int:
 def describe(summary: dict) -> str:
     """The result phrase of a finished row."""
     if "lifetime_s" in summary:
-        from .creep import outcome
         return f"creep {summary['stress_pa'] / 1e6:.1f} MPa: {outcome(summary)}"
     if "tensile_strength_pa" in summary:
         t = summary["tensile_strength_pa"]
@@ -143,7 +139,6 @@ def describe(summary: dict) -> str:
 
 
 def cmd_batch(args) -> int:
-    from ..runs.batchrun import row_outcomes, run_batch
     table = Path(args.table)
     if args.jobs < 1:
         raise GrainfracError(f"--jobs {args.jobs}: fix: at least 1")

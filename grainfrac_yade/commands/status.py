@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 
-from ..runs.slurm import STATES
+from ..runs.slurm import STATES, study_states
 
 
 def register(sub, common):
@@ -22,7 +22,6 @@ def register(sub, common):
 
 def status_report(folder) -> dict:
     """The states of a submitted study as one JSON-ready dict."""
-    from ..runs.slurm import study_states
     record, states, queue, acct = study_states(folder)
     counts = {s: sum(1 for x in states if x.state == s) for s in STATES}
     return {"study": record["study"], "folder": str(folder), "table": record["source_table"],

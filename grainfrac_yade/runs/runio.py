@@ -25,6 +25,7 @@ from pathlib import Path
 from .. import __version__
 from ..atomic import write_atomically, write_text_atomically
 from ..errors import GrainfracError
+from ..params import flatten, load_parameters, migrate_tree
 
 #: Files whose presence marks a folder as holding a finished or running run.
 RUN_MARKERS = ("run.json",)
@@ -262,7 +263,6 @@ MISSING = "(missing)"
 def _parameter_pairs(stored_tree: dict, params) -> dict:
     """{dotted key: (stored value, value of ``params``)} over both parameter trees; a key missing
     from an older stored tree counts as the shipped default, as the analysis reads it."""
-    from ..params import load_parameters
     stored = comparable_parameters(stored_tree)
     now = comparable_parameters(params.to_dict())
     defaults = comparable_parameters(load_parameters().to_dict())
@@ -277,7 +277,6 @@ def _differences(pairs: dict) -> list:
 
 def flatten_values(values: dict) -> dict:
     """``run_values`` as JSON stores them, flattened to dotted keys."""
-    from ..params import flatten
     return flatten(json.loads(json.dumps(_clean(values))))
 
 
@@ -285,7 +284,6 @@ def comparable_parameters(tree: dict) -> dict:
     """A parameter tree (``Parameters.to_dict()`` or a params.json) as {dotted key: value} as JSON
     stores it, without the provenance entries (:data:`PROVENANCE_KEYS`) and the parameters that do
     not change results (:data:`RESULT_NEUTRAL_KEYS`)."""
-    from ..params import flatten, migrate_tree
     tree = json.loads(json.dumps(_clean({k: v for k, v in tree.items() if k not in PROVENANCE_KEYS})))
     migrate_tree(tree)   # renamed keys of older params.json (stress_corrosion.mode -> law)
     return {k: v for k, v in flatten(tree).items() if k not in RESULT_NEUTRAL_KEYS}
