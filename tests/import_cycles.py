@@ -21,6 +21,10 @@ from pathlib import Path
 PACKAGE = "grainfrac_yade"
 ROOT = Path(__file__).resolve().parent.parent / PACKAGE
 
+#: Libraries heavy or optional enough that a module may import them, or a module of the package that loads
+#: them, inside the function that needs them (docs/maintainers.md): a command's start-up stays short.
+HEAVY = ("matplotlib", "pandas", "vtk", "vtkmodules", "PIL", "scipy.stats")
+
 #: How an import is written (``Import.kind``).
 TOP, FUNCTION, IMPORTLIB = "top", "function", "importlib"
 
@@ -207,6 +211,28 @@ def in_function_imports(own_only: bool = True) -> list:
                 out.append(imp)
             elif not own_only:
                 out.append(imp)
+    return out
+
+
+def heavy_libraries(name: str, known: dict | None = None, _memo: dict | None = None) -> set:
+    """The :data:`HEAVY` libraries that importing module ``name`` loads: its module-level imports, and
+    theirs in turn (with the package ``__init__`` each runs)."""
+    known = modules() if known is None else known
+    memo = {} if _memo is None else _memo
+    if name in memo:
+        return memo[name]
+    memo[name] = set()   # a module being visited adds nothing twice
+    out = set()
+    for imp in import_list(name, known[name], known):
+        if imp.in_function:
+            continue
+        hit = _resolve(imp.target, known)
+        if hit is None:
+            out.update(h for h in HEAVY if imp.target == h or imp.target.startswith(h + "."))
+        elif hit != name:
+            for m in [hit] + _parents(hit, name, known):
+                out |= heavy_libraries(m, known, memo)
+    memo[name] = out
     return out
 
 

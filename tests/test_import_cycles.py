@@ -2,9 +2,63 @@
 is written (``tests/import_cycles.py`` finds them from the source with ``ast``): inside functions, in a
 lazy ``__getattr__``, by ``importlib.import_module`` (a registry's loop over literal names), and the
 package ``__init__`` that importing ``pkg.sub`` runs."""
+import subprocess
+import sys
 import textwrap
+from pathlib import Path
 
-from import_cycles import cycles, graph, import_list, imports
+from import_cycles import PACKAGE, cycles, graph, heavy_libraries, imports, in_function_imports, modules
+
+
+def _group(reason, *pairs):
+    return {pair: reason for pair in pairs}
+
+
+_ADAPTER = ("the YADE adapter, loaded only by the command that runs YADE; the commands are to reach "
+            "the engine through an engine registry instead")
+_RESTRUCTURED = ("a command or adapter module being restructured behind the scene interface: its imports "
+                 "move to the top with that change")
+
+#: The package's own modules imported inside functions, as (importer, imported) without the package
+#: prefix, each with the reason it stays there.  An import of a module that loads a heavy library when
+#: imported (``import_cycles.HEAVY``: matplotlib, pandas, VTK, Pillow, scipy.stats) needs no entry;
+#: nor does an ``importlib`` registry.  Every other in-function import of the package's own modules
+#: fails the test below: move it to the top of its module (where it makes no cycle), or add it here
+#: with its reason.
+ALLOWED = {
+    **_group("cli.py's module level loads no numpy: main() sets the one-thread default (OMP_NUM_THREADS, "
+             "read once by OpenBLAS and the OpenMP runtime) before anything loads it",
+             ("cli", "commands._args"), ("cli", "yade_adapter")),
+    **_group("guarded by ImportError: a cluster's batch code may predate checkpoints",
+             ("runs.slurm", "runs.runio")),
+    **_group(_ADAPTER,
+             ("commands.batch", "yade_adapter.batch"), ("commands.submit", "yade_adapter.batch"),
+             ("commands.bench", "yade_adapter"), ("commands.bench", "yade_adapter.bench_timing"),
+             ("commands.brazilian", "yade_adapter.batch"), ("commands.brazilian", "yade_adapter.brazilian_protocol"),
+             ("commands.brazilian", "yade_adapter.levers"), ("commands.brazilian", "yade_adapter.scene"),
+             ("commands.brazilian", "yade_adapter.vtk_output"),
+             ("commands.creep", "yade_adapter.batch"), ("commands.creep", "yade_adapter.creep_protocol"),
+             ("commands.creep", "yade_adapter.scene"), ("commands.creep", "yade_adapter.vtk_output"),
+             ("commands.specimen", "yade_adapter.batch"), ("commands.specimen", "yade_adapter.scene"),
+             ("commands.ucs", "yade_adapter.batch"), ("commands.ucs", "yade_adapter.scene"),
+             ("commands.ucs", "yade_adapter.ucs_protocol"), ("commands.ucs", "yade_adapter.vtk_output")),
+    **_group(_RESTRUCTURED,
+             ("commands.bench", "commands._args"), ("commands.bench", "errors"),
+             ("commands.bench", "geometry.specimen"), ("commands.bench", "grains"), ("commands.bench", "params"),
+             ("commands.bench", "runs.runio"),
+             ("commands.brazilian", "analysis.brazilian_analysis"), ("commands.brazilian", "commands._args"),
+             ("commands.brazilian", "commands.resume"), ("commands.brazilian", "commands.ucs"),
+             ("commands.brazilian", "geometry.specimen"), ("commands.brazilian", "params"),
+             ("commands.brazilian", "runs.runio"),
+             ("commands.creep", "analysis.creep_analysis"), ("commands.creep", "analysis.runparams"),
+             ("commands.creep", "geometry.specimen"), ("commands.creep", "params"), ("commands.creep", "runs.runio"),
+             ("commands.creep", "wave"),
+             ("commands.specimen", "params"),
+             ("commands.ucs", "analysis.ucs_analysis"), ("commands.ucs", "commands.creep"),
+             ("commands.ucs", "geometry.specimen"), ("commands.ucs", "params"), ("commands.ucs", "runs.runio"),
+             ("yade_adapter.batch", "runs.runio"),
+             ("yade_adapter.bench_timing", "yade_adapter.platens"), ("yade_adapter.bench_timing", "yade_adapter.scene")),
+}
 
 
 def test_the_finder_sees_a_cycle():
@@ -77,3 +131,32 @@ def test_the_package_has_no_import_cycle():
     assert "grainfrac_yade.law.area" in g["grainfrac_yade.law"]
     assert "grainfrac_yade.analysis.study" in g["grainfrac_yade.analysis"]
     assert cycles(g) == []
+
+
+def _short(name):
+    return name[len(PACKAGE) + 1:]
+
+
+def test_in_function_imports_of_the_package_are_only_the_allowed_ones():
+    """docs/maintainers.md: imports inside functions only for YADE and heavy or optional libraries."""
+    known, memo = modules(), {}
+    found = {(_short(i.module), _short(i.target)): i for i in in_function_imports()
+             if not heavy_libraries(i.target, known, memo)}
+    stray = sorted(f"{i} (no reason in ALLOWED)" for pair, i in found.items() if pair not in ALLOWED)
+    assert not stray, "\n".join(stray)
+    stale = sorted(pair for pair in ALLOWED if pair not in found)
+    assert not stale, f"ALLOWED entries no longer needed (remove them): {stale}"
+
+
+def test_the_heavy_libraries_are_seen():
+    known = modules()
+    assert heavy_libraries(f"{PACKAGE}.analysis.study", known) >= {"matplotlib", "pandas"}
+    assert heavy_libraries(f"{PACKAGE}.analysis", known) == set()   # its names load on first use
+
+
+def test_the_cli_module_loads_no_numpy():
+    """main() sets the one-thread default before numpy (OpenBLAS) or the OpenMP runtime is loaded."""
+    code = "import sys, grainfrac_yade.cli; print(sorted(m for m in ('numpy', 'scipy', 'matplotlib') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=Path(__file__).resolve().parent.parent).stdout
+    assert out.strip() == "[]"
