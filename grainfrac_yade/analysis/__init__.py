@@ -5,7 +5,11 @@ ratio), :mod:`.fits` (static-fatigue laws), :mod:`.labdata` (lab CSV, paper refe
 :mod:`.figures` and :mod:`.crackmaps` (PNG), :mod:`.report` (markdown), :mod:`.runparams`
 (params.json -> Parameters, the run's specimen rebuilt and verified), :mod:`.rescale` (creep times
 at another beta1, exact for event-clock runs of a strength law), :mod:`.study` (``analyze_study``:
-study folder(s) -> report.md; imports matplotlib).
+study folder(s) -> report.md; imports matplotlib).  One run's results from its history (pure numpy):
+:mod:`.creep_analysis` (creep stages, damage index), :mod:`.ucs_analysis`, :mod:`.brazilian_analysis`.
+The lab fit (:mod:`.lab_fit`), the accuracy study's plan (:mod:`.accuracy_study`; its results:
+:mod:`.accuracy`), pictures of specimens and crack maps (:mod:`.plotting`), the crack-growth animation
+(:mod:`.animation`).
 
 The names below are loaded on first use (:data:`LAZY`), so that importing one pure-numpy module of
 this package (a test's results from its history, say) does not load pandas, scipy.stats or matplotlib.
