@@ -13,8 +13,12 @@ Command modules never import this module.
 from __future__ import annotations
 
 import argparse
+import datetime as _dt
 import re
 import sys
+import tempfile
+import traceback
+from pathlib import Path
 
 from .commands import animate, register_all
 from .errors import GrainfracError
@@ -100,10 +104,6 @@ def join_negative_values(argv: list) -> list:
 
 def _log_traceback(command: str) -> str:
     """Write the current exception's traceback to a new log file; its path (or a note if none could be written)."""
-    import datetime as _dt
-    import tempfile
-    import traceback
-    from pathlib import Path
     stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     text = f"python3 -m grainfrac_yade {' '.join(sys.argv[1:])}\n\n{traceback.format_exc()}"
     for folder in (Path(ERROR_LOG_DIR), Path(tempfile.gettempdir())):

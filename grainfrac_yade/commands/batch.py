@@ -10,6 +10,7 @@ the exit status is 1 when a row did not finish a run, naming those rows.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from ..errors import GrainfracError
@@ -122,7 +123,6 @@ def check_table(table, test=None) -> tuple:
 
 
 def _line_of(problem: str) -> int:
-    import re
     m = re.search(r":(\d+)\b", problem)
     return int(m.group(1)) if m else 0
 

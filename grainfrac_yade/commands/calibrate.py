@@ -13,6 +13,9 @@ before and after, and to ``OUT/calibration.csv`` (one row per seed and round).
 """
 from __future__ import annotations
 
+import dataclasses
+import multiprocessing as mp
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -98,8 +101,6 @@ def _run_seeds(params, seeds, folders, jobs):
     work = [(params, seed, folder) for seed, folder in zip(seeds, folders)]
     if jobs <= 1:
         return [_run_one(w) for w in work]
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
     with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
         return list(pool.map(_run_one, work))
 
@@ -116,7 +117,6 @@ FITTED_KEYS = ("strength_scale", "stiffness_scale", "reference_ucs")
 
 def carried_lines(calibration) -> list:
     """``key = value  # unit, meaning`` lines of the [calibration] keys not fitted here, at ``calibration``'s values."""
-    import dataclasses
     return [f"{f.name} = {getattr(calibration, f.name)!r}    # {f.metadata['unit']}, {f.metadata['doc']}"
             for f in dataclasses.fields(calibration) if f.name not in FITTED_KEYS]
 

@@ -1,6 +1,8 @@
 """``elastic``: static linear-elastic reference of a specimen (no YADE); summary.json and histograms."""
 from __future__ import annotations
 
+import argparse
+
 from ..elastic import GRAIN_MODELS, contact_ratios, elastic_summary
 from ..geometry.grainmesh import CONTACT_PLACEMENTS
 from ..geometry.specimen import build_specimen
@@ -38,7 +40,6 @@ def register(sub, common):
 
 def _grains(text: str) -> str:
     """``--grains`` value; one line for a retired name."""
-    import argparse
     if text in RETIRED_GRAINS:
         raise argparse.ArgumentTypeError(f"{text!r}: {RETIRED_GRAINS[text]}")
     return text

@@ -9,6 +9,8 @@ answer; without them the states come from the files alone, and the output says s
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 
 from ..runs.slurm import STATES, study_states
 
@@ -34,13 +36,11 @@ def status_report(folder) -> dict:
 
 def _short(path: str) -> str:
     """``path`` relative to the current folder when inside it."""
-    import os
     rel = os.path.relpath(path)
     return path if rel.startswith("..") else rel
 
 
 def cmd_status(args) -> int:
-    from pathlib import Path
     rep = status_report(Path(args.folder))
     if args.json:
         print(json.dumps(rep, indent=2))

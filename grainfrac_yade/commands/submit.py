@@ -13,6 +13,7 @@ one starts again, or resumes where the batch code resumes it).
 """
 from __future__ import annotations
 
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -139,7 +140,6 @@ def cmd_submit(args) -> int:
         print(f"# dry run: {len(todo)} row(s) {rows_text} of {args.table} would run into {study_dir}/; "
               "nothing written or submitted")
         return 0
-    import shutil
     sbatch = shutil.which("sbatch")
     if sbatch is None:
         raise GrainfracError("sbatch not found on PATH; fix: submit from a SLURM login node (Debian: apt-get install "

@@ -5,6 +5,7 @@ parameters and seed give the same specimen, bit for bit.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,7 +95,6 @@ BYTES_PER_CELL = 12e3
 
 def memory_bytes() -> float:
     """Physical memory of this machine [bytes] (inf where the system does not say)."""
-    import os
     try:
         return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
     except (ValueError, OSError, AttributeError):

@@ -204,7 +204,6 @@ def commit_run_dir(where) -> Path:
 
 def remove_checkpoints(folder) -> None:
     """Delete a run folder's checkpoint folders (a finished or replaced run has nothing to resume)."""
-    import shutil
     for name in (CHECKPOINT, CHECKPOINT_TMP, CHECKPOINT_OLD):
         shutil.rmtree(Path(folder) / name, ignore_errors=True)
 
