@@ -4,8 +4,8 @@ import pytest
 
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.layout import bond_properties, cell_mass_inertia
-from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
-from grainfrac_yade.tessellation import tessellate_seeds
+from grainfrac_yade.geometry.specimen import build_specimen, specimen_from_tessellation
+from grainfrac_yade.geometry.tessellation import tessellate_seeds
 
 
 @pytest.fixture(scope="module")

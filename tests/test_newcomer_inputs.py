@@ -312,7 +312,7 @@ def test_crack_maps_count_cracks_and_the_macrocracks_among_them(tmp_path, monkey
 def test_the_animation_draws_strain_in_percent_and_no_legend_line_it_never_draws(monkeypatch):
     import numpy as np
     import pandas as pd
-    from grainfrac_yade import animation
+    from grainfrac_yade.analysis import animation
     cracks = pd.DataFrame({"creep_time_s": [1.0, 2.0], "mode": ["tensile", "shear"],
                            "macro_time_s": [np.nan, np.nan]})
     seg = np.array([[[0, 0], [1e-3, 0]], [[0, 1e-3], [1e-3, 1e-3]]], float)

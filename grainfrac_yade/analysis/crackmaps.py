@@ -19,7 +19,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 
-from ..plotting import CRACK_COLOURS, draw_cells, plt
+from .plotting import CRACK_COLOURS, draw_cells, plt
 
 MM = 1e3
 SEGMENT_COLUMNS = ("x0_m", "y0_m", "x1_m", "y1_m")
@@ -64,7 +64,7 @@ def crack_maps_figure(path, cracks: pd.DataFrame, times, labels, width: float, h
                       grain_alpha: float = GRAIN_ALPHA):
     """One panel per time: specimen outline, microcracks thin, macrocracks thick, coloured by
     ``colour_by`` ("mode": tensile/shear, "kind": inter/intra-granular). ``specimen`` (2D
-    :class:`~grainfrac_yade.specimen.Specimen`): its cells are drawn under the cracks, coloured by
+    :class:`~grainfrac_yade.geometry.specimen.Specimen`): its cells are drawn under the cracks, coloured by
     mineral with opacity ``grain_alpha``; None: outline only."""
     seg = crack_segments(cracks, grain_size) * MM
     palette = COLOURS[colour_by]

@@ -2,7 +2,7 @@
 
 Inputs are plain arrays and DataFrames (history.csv tables, lifetime sets); nothing here reads
 run folders. Strain is compression positive and drawn in %.  Pictures of specimens and the crack
-map itself are :mod:`grainfrac_yade.plotting`; everything built from results is here.
+map itself are :mod:`grainfrac_yade.analysis.plotting`; everything built from results is here.
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..plotting import plt
+from .plotting import plt
 from .fits import CONFIDENCE, LifetimeFit
 
 DPI = 130

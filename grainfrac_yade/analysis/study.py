@@ -8,6 +8,7 @@ time is rescaled exactly to another stress-corrosion rate (see :mod:`.rescale`).
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -309,9 +310,7 @@ def _rescale_text(runs: pd.DataFrame, beta1: float, source: str, reference) -> l
 def animation_note(run_folder, out) -> str | None:
     """Report line linking the focus run's crack-growth animation (``animate``; not made here, rendering
     costs seconds per run); None when the run has none."""
-    import os
-
-    from ..animation import GIF_NAME, MP4_NAME
+    from .animation import GIF_NAME, MP4_NAME
     run_folder = Path(run_folder)
     gif = run_folder / GIF_NAME
     if not gif.is_file():

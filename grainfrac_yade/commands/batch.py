@@ -10,9 +10,17 @@ the exit status is 1 when a row did not finish a run, naming those rows.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from ..errors import GrainfracError
+from ..geometry.specimen import MAX_SEED, check_cell_count
+from ..geometry.tessellation import n_cells_for
+from ..params import load_parameters, require_plane, shipped_values
+from ..params.schema import field_spec
+from ..runs.batchrun import cell_value, read_table_rows, row_outcomes, run_batch
+from .brazilian import require_disc_model
+from .creep import CREEP_ROW_COLUMNS, check_stress_range, outcome, resolve_stress
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}
@@ -47,7 +55,6 @@ def row_columns(test: str) -> dict:
     """The run-control columns of a kind of row, with defaults (parameters aside)."""
     from ..yade_adapter.batch import RUN_COLUMNS
     if test == "creep":
-        from .creep import CREEP_ROW_COLUMNS
         return dict(RUN_COLUMNS, **CREEP_ROW_COLUMNS)
     return dict(RUN_COLUMNS)
 
@@ -55,7 +62,6 @@ def row_columns(test: str) -> dict:
 def expected_cell(col: str, defaults: dict, controls: dict) -> str:
     """What a cell of column ``col`` must be, as a fix: its type from the schema (unit, choices), else from the
     type of its default (run columns: seed, out, study, ratio, ...)."""
-    from ..params.schema import field_spec
     try:
         spec = field_spec(col)
     except GrainfracError:
@@ -99,8 +105,6 @@ def check_out_writable(out: str, where: str):
 def check_row(test: str, columns, cells: dict, where: str):
     """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
     (one line, naming ``where``) if the row would be refused."""
-    from ..runs.batchrun import cell_value
-    from ..params import load_parameters, shipped_values
     from ..yade_adapter.batch import ON_CHANGE, check_columns
     defaults, controls = shipped_values(), row_columns(test)
     check_columns(columns, {**defaults, **controls}, where)
@@ -118,7 +122,6 @@ def check_row(test: str, columns, cells: dict, where: str):
     if controls["on_change"] not in ON_CHANGE:
         raise GrainfracError(f"batch table {where}: on_change = {controls['on_change']!r}; fix: use one of "
                              f"{', '.join(repr(v) for v in ON_CHANGE)}")
-    from ..specimen import MAX_SEED
     if (not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool)
             or not 0 <= controls["seed"] <= MAX_SEED):
         raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number from 0 to "
@@ -129,8 +132,6 @@ def check_row(test: str, columns, cells: dict, where: str):
     except GrainfracError as exc:
         raise GrainfracError(f"batch table {where}: {exc}") from None
     try:
-        from ..specimen import check_cell_count
-        from ..tessellation import n_cells_for
         sp = params.specimen
         check_cell_count(n_cells_for([sp.width, sp.height], sp.grain_size), "the row's specimen", sp.grain_size)
         _check_kind(test, params, controls)
@@ -140,10 +141,7 @@ def check_row(test: str, columns, cells: dict, where: str):
 
 
 def _check_kind(test, params, controls):
-    from ..params import require_plane
-    from .creep import check_stress_range, resolve_stress
     if test == "brazilian":
-        from .brazilian import require_disc_model
         require_disc_model(params)
         return
     require_plane(params, test)
@@ -159,7 +157,6 @@ def _check_kind(test, params, controls):
 def check_table(table, test=None) -> tuple:
     """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row`;
     else GrainfracError with one line per bad row."""
-    from ..runs.batchrun import read_table_rows
     columns, rows, problems = read_table_rows(table)
     test = test or guess_test(columns, Path(table).name)
     checked = {}
@@ -178,7 +175,6 @@ def check_table(table, test=None) -> tuple:
 
 
 def _line_of(problem: str) -> int:
-    import re
     m = re.search(r":(\d+)\b", problem)
     return int(m.group(1)) if m else 0
 
@@ -186,7 +182,6 @@ def _line_of(problem: str) -> int:
 def describe(summary: dict) -> str:
     """The result phrase of a finished row."""
     if "lifetime_s" in summary:
-        from .creep import outcome
         return f"creep {summary['stress_pa'] / 1e6:.1f} MPa: {outcome(summary)}"
     if "tensile_strength_pa" in summary:
         t = summary["tensile_strength_pa"]
@@ -196,7 +191,6 @@ def describe(summary: dict) -> str:
 
 
 def cmd_batch(args) -> int:
-    from ..runs.batchrun import row_outcomes, run_batch
     table = Path(args.table)
     if args.jobs < 1:
         raise GrainfracError(f"--jobs {args.jobs}: fix: at least 1")

@@ -93,7 +93,7 @@ def register(sub, common):
                         f"{QUICK.events} events per scene, no runs to failure")
     p.add_argument("--out", help=f"JSON file to write (default {DEFAULT_OUT.relative_to(DEFAULT_OUT.parents[1])}; "
                                  "with --quick, results/bench_quick.json)")
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seed", type=seed_type, default=1, help="specimen seed (default 1)")
     p.add_argument("--ratio", type=float, default=DEFAULT_RATIO,
                    help="creep load as a ratio of each scene's calibration.reference_ucs (default 0.7)")
@@ -188,7 +188,7 @@ def scene_params(user_files, scene_files, user_overrides, scene_overrides):
 def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
     """Ramp, hold and relax one scene as a creep run does; time a few events, then its stepping and bond I/O."""
     from ..errors import GrainfracError
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..yade_adapter.bench_timing import TimedCreepRun, time_bond_io, time_stepping
     stress = ratio * params.calibration.reference_ucs
     specimen = build_specimen(params, seed)
@@ -218,7 +218,7 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
     """Creep to failure with the event and with the paper clock, one run each, same specimen and load.
 
     ``params_for_clock(clock)`` gives the parameters with ``stress_corrosion.clock`` set."""
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..yade_adapter.bench_timing import TimedCreepRun
     out = {}
     for clock in ("event", "paper"):
@@ -259,7 +259,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
     from ..errors import GrainfracError
     from ..grains import critical_dem_step
     from ..runs.runio import code_version, write_json
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..yade_adapter.bench_timing import loading_step_cost
     progress = progress or (lambda msg: None)
     if creep_stress_mpa is not None and not creep_stress_mpa > 0:
@@ -306,7 +306,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
 def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
     """One paper-size finite-element creep run to failure (seed 1, event clock): lifetime or what ended it, DEM
     steps, CPU time, and the relaxation steps per event."""
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..yade_adapter.bench_timing import TimedCreepRun
     _, width, height = FEM_SIZES[-1]
     params = scene_params(extra_files, (FEM_PRESET,), [f"specimen.width={width}", f"specimen.height={height}",

@@ -4,7 +4,7 @@ load_strain.png, crack maps at the peak and at the end.
 Tensile strength sigma_t = 2 P / (pi D t) (ISRM 1978 suggested method) at the peak load P of a
 disc of diameter D (``brazilian.diameter``) and thickness t (``specimen.thickness``), the disc a
 Voronoi tessellation clipped to the circle with the grain size and composition of the UCS
-specimen (:mod:`grainfrac_yade.disc`), loaded by two rigid jaws
+specimen (:mod:`grainfrac_yade.geometry.disc`), loaded by two rigid jaws
 (:mod:`grainfrac_yade.yade_adapter.brazilian_protocol`).
 """
 from __future__ import annotations
@@ -22,7 +22,7 @@ def register(sub, common):
     p.add_argument("--diameter", type=float, help="disc diameter [m] (brazilian.diameter)")
     p.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
     p.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     p.add_argument("--tensile-scale", type=float, metavar="F",
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
@@ -43,7 +43,7 @@ def register(sub, common):
 
 
 def cmd_brazilian(args) -> int:
-    from ..cli import load_params_from_args
+    from ._args import load_params_from_args
     if args.resume:
         from .resume import refuse_resume_conflicts, resumable_run
         refuse_resume_conflicts(args)
@@ -73,7 +73,7 @@ def cmd_brazilian(args) -> int:
 
 
 def _reload(args, extra, base, factor):
-    from ..cli import overrides_from_args
+    from ._args import overrides_from_args
     from ..params import load_parameters
     params = load_parameters(extra_files=args.params, overrides=overrides_from_args(args) + extra)
     if factor is not None:
@@ -144,10 +144,10 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     ``vtk_every``: VTK series in ``out/vtk/`` at every k-th history row and the end (None: none; not
     carried across a resume)."""
     from pathlib import Path
-    from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
+    from ..analysis.brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
-    from ..specimen import build_disc_specimen
+    from ..geometry.specimen import build_disc_specimen
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
     from ..yade_adapter.brazilian_protocol import resume_brazilian, run_brazilian
     from ..yade_adapter.levers import Levers, new_breaks
@@ -199,7 +199,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
 def write_disc_cracks(path, scene):
     """cracks.csv: one row per bond broken during the test (DEM step, mode, kind, position, orientation, and
     whether it lies in the central band); slits (:mod:`~grainfrac_yade.yade_adapter.levers`) are left out."""
-    from ..brazilian_analysis import in_central_band
+    from ..analysis.brazilian_analysis import in_central_band
     from ..runs.runio import write_csv
     from ..yade_adapter.levers import new_breaks
     from ..yade_adapter.scene import SHEAR
@@ -219,7 +219,7 @@ def write_disc_cracks(path, scene):
 
 def band_guides(tessellation) -> np.ndarray:
     """(2, 2, 2) the central band's two edges x = x_c +- D/6, clipped to the disc [m]."""
-    from ..brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
+    from ..analysis.brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
     c, r = tessellation.centre, tessellation.radius
     dx = CENTRAL_BAND_HALF_WIDTH * 2 * r
     dy = math.sqrt(r * r - dx * dx)
@@ -229,7 +229,7 @@ def band_guides(tessellation) -> np.ndarray:
 def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     """crack_map_peak.png (broken bonds at the failure load, the peak before the split) and crack_map_end.png
     (at the end of the test), with the central band's edges dashed."""
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..yade_adapter.scene import bond_segments
     specimen, seed = scene.specimen, summary["seed"]
     guides = band_guides(specimen.tessellation)

@@ -13,12 +13,20 @@ data used, and ``STUDY/calibrate/fit.csv``.
 """
 from __future__ import annotations
 
+import argparse
 import hashlib
 import json
 import math
 from pathlib import Path
 
+from ..analysis.lifetime_calibration import ModelPoint, fit
 from ..errors import GrainfracError
+from ..geometry.specimen import MAX_SEED
+from ..law import scales_with_beta1, time_scaling_laws
+from ..params import flat_values, load_parameters, require_plane, write_parameter_file
+from ..runs.batchrun import run_batch, write_table
+from ..runs.runio import code_version, comparable_parameters, write_csv
+from .creep import stress_flag
 
 #: Keys of the fitted parameters, by law.
 BETA2_KEY = {"hillig_charles": "stress_corrosion.beta2", "normalised": "stress_corrosion.beta2_normalised"}
@@ -34,8 +42,6 @@ def _floats(text):
 
 def _ints(text):
     """argparse type of a list of specimen seeds, e.g. 1,2: whole numbers in [0, MAX_SEED] (32-bit)."""
-    import argparse
-    from ..specimen import MAX_SEED
     try:
         seeds = [int(x) for x in text.split(",") if x.strip()]
     except ValueError:
@@ -48,7 +54,6 @@ def _ints(text):
 
 
 def register(sub, common):
-    from .creep import stress_flag
     p = sub.add_parser("calibrate-lifetimes", help="fit beta1, beta2 (and a threshold) to lab lifetimes (runs "
                                                    "the creep rows it needs through yade-batch)")
     common(p)
@@ -68,7 +73,6 @@ def register(sub, common):
 def _digest(tree: dict) -> str:
     """Identity of a parameter tree (params.json layout) for reuse: every key that changes results."""
     from ..analysis.study import VARIANT_IGNORE
-    from ..runs.runio import comparable_parameters
     flat = {k: v for k, v in comparable_parameters(tree).items() if k not in VARIANT_IGNORE}
     return hashlib.sha256(json.dumps(flat, sort_keys=True).encode()).hexdigest()
 
@@ -94,7 +98,6 @@ def model_point(ratio, summaries) -> "ModelPoint | None":
     """The model at one ratio from its seeds' summaries: geometric mean of the lifetimes; a lower bound if a
     seed did not fail; None if no seed gives a value (failed on loading, numerical failure, broken apart before the
     test)."""
-    from ..analysis.lifetime_calibration import ModelPoint
     logs, censored, notes = [], False, []
     for s in summaries:
         if s.get("numerical_failure"):
@@ -120,7 +123,6 @@ class BatchModel:
     yade-batch (missing rows only) or reused from the study."""
 
     def __init__(self, args, params, ratios, seeds, ucs, study: Path, progress=print):
-        from ..params import flat_values
         self.args, self.params, self.ratios, self.seeds, self.ucs = args, params, ratios, seeds, ucs
         self.study, self.progress = study, progress
         self.base = flat_values(args.params, args.resolved_overrides)
@@ -128,12 +130,10 @@ class BatchModel:
         self.runs = 0
 
     def trial_params(self, beta2, threshold):
-        from ..params import load_parameters
         extra = [(self.beta2_key, beta2), (THRESHOLD_KEY, threshold)]
         return load_parameters(extra_files=self.args.params, overrides=list(self.args.resolved_overrides) + extra)
 
     def __call__(self, beta2, threshold):
-        from ..runs.batchrun import run_batch, write_table
         params = self.trial_params(beta2, threshold)
         digest = _digest(params.to_dict())
         known = [r for r in finished_runs(self.study) if r[0] == digest]
@@ -193,10 +193,6 @@ def _fit_lines(result, trial, beta1) -> list:
 
 def cmd_calibrate_lifetimes(args, params) -> int:
     from ..analysis.labdata import read_lab_csv
-    from ..analysis.lifetime_calibration import fit
-    from ..law import scales_with_beta1, time_scaling_laws
-    from ..params import require_plane, write_parameter_file
-    from ..runs.runio import code_version, write_csv
     require_plane(params, "calibrate-lifetimes")
     sc = params.stress_corrosion
     if not scales_with_beta1(sc.law) or sc.clock != "event":

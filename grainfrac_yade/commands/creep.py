@@ -310,7 +310,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     import json
 
     from ..analysis.runparams import load_run_parameters
-    from ..runs.runio import CHECKPOINT, SUMMARY, checkpoint_folder, read_checkpoint_state
+    from ..runs.runio import CHECKPOINT, SUMMARY, check_files, checkpoint_folder, read_checkpoint_state
     folder = Path(folder)
     try:
         command = json.loads((folder / "run.json").read_text()).get("command")
@@ -322,7 +322,6 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     if (folder / SUMMARY).exists():
         return None
     if checkpoint_folder(folder) is not None:
-        from ..yade_adapter.checkpoint import check_files
         check_files(checkpoint_folder(folder))
     state = read_checkpoint_state(folder)
     if state is None and checkpoint_folder(folder) is not None:
@@ -363,12 +362,12 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     import time
 
     from ..analysis.figures import MAP_FRACTIONS, run_bond_stress_figure, run_strain_time_figure
-    from ..creep_analysis import CreepStages, damage_index, resolve_creep_stages
+    from ..analysis.creep_analysis import CreepStages, damage_index, resolve_creep_stages
     from ..params import require_plane
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..runs.runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..wave import budget_fields
     from ..yade_adapter.creep_protocol import resume_creep, run_creep
     from ..yade_adapter.scene import bond_segments, broken_counts
@@ -431,7 +430,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
         "vtk_creep_times_s": run.vtk_written,
-        "vtk_merged_times": getattr(run, "vtk_merged", []),
+        "vtk_merged_times": run.vtk_merged,
         "vtk_times_not_reached_s": list(run.vtk_times) if run.vtk_folder is not None else [],
         **summary_header(params, seed),
     }

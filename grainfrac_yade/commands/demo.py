@@ -11,10 +11,17 @@ About 3-4 min on 2 cores with the defaults (measured in the notes); every run wr
 """
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import time
 from pathlib import Path
+
+from ..errors import GrainfracError
+from ..geometry.specimen import MAX_SEED
+from ..params import flat_values, require_plane
+from ..runs.batchrun import read_table_rows, row_outcomes, run_batch, write_table
+from .creep import outcome
 
 #: Demo defaults: a 10 x 20 mm specimen (about 200 cells; a creep run takes 15-40 s on one core).
 DEMO_WIDTH_M, DEMO_HEIGHT_M = 10e-3, 20e-3
@@ -28,8 +35,6 @@ def _floats(text):
 
 def _ints(text):
     """argparse type of a list of specimen seeds, e.g. 1,2: whole numbers in [0, MAX_SEED] (32-bit)."""
-    import argparse
-    from ..specimen import MAX_SEED
     try:
         seeds = [int(x) for x in text.split(",") if x.strip()]
     except ValueError:
@@ -57,9 +62,6 @@ def _say(t0, msg):
 
 
 def cmd_demo(args, params) -> int:
-    from ..runs.batchrun import run_batch, write_table
-    from ..errors import GrainfracError
-    from ..params import flat_values, require_plane
     from .specimen import run_specimen
     t0 = time.time()
     repo = Path(__file__).resolve().parents[2]
@@ -109,7 +111,6 @@ def cmd_demo(args, params) -> int:
 def check_demo_arguments(args, params) -> None:
     """Refuse, before anything runs, what would make rows fail: ratios outside (0, 1), negative seeds, no
     seeds or ratios, fewer than one job (one line each)."""
-    from ..errors import GrainfracError
     bad = [r for r in args.ratios if not 0 < r < 1]
     if bad or not args.ratios:
         raise GrainfracError(f"--ratios {','.join(f'{r:g}' for r in args.ratios) or '(none)'}: a driving-stress "
@@ -123,7 +124,6 @@ def check_demo_arguments(args, params) -> None:
 
 def _failed_rows(table, log_dir) -> list:
     """The rows of ``table`` run into ``log_dir`` that did not finish a run (:func:`row_outcomes`)."""
-    from ..runs.batchrun import read_table_rows, row_outcomes
     _, rows, _ = read_table_rows(table)
     return [o for o in row_outcomes(table, log_dir, list(rows)) if not o.ok]
 
@@ -139,6 +139,5 @@ def _ucs_line(summary: dict) -> str:
 
 
 def _creep_line(folder: Path) -> str:
-    from .creep import outcome
     s = _read(folder)
     return f"creep {folder.name}: {s['stress_pa'] / 1e6:.0f} MPa, {outcome(s)}, {s['n_events']} events"

@@ -6,9 +6,9 @@ from pathlib import Path
 import numpy as np
 
 from ..grains import critical_dem_step, layout_for
-from ..plotting import specimen_figure
+from ..analysis.plotting import specimen_figure
 from ..runs.runio import commit_run_dir, prepare_run_dir, write_json
-from ..specimen import build_specimen
+from ..geometry.specimen import build_specimen
 
 
 def specimen_record(specimen, layout, params=None) -> dict:

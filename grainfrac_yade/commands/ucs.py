@@ -78,10 +78,10 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     from pathlib import Path
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
-    from ..specimen import build_specimen
-    from ..ucs_analysis import ucs_summary
+    from ..geometry.specimen import build_specimen
+    from ..analysis.ucs_analysis import ucs_summary
     from ..yade_adapter.scene import bond_segments
     from ..yade_adapter import ucs_protocol
     require_plane(params, "ucs")

@@ -8,6 +8,7 @@ the file>`` (yade utils.py), so a task runs
 """
 from __future__ import annotations
 
+import ast
 import json
 import os
 import re
@@ -181,7 +182,6 @@ def read_table_rows(path) -> tuple:
     YADE's ``TableParamReader`` reads it (``#`` comments, blank lines skipped, whitespace-separated cells,
     ``=`` repeats the line above, a trailing ``!`` on a column name dropped) but without its
     IndexError: a line with another number of cells than the header is one problem line naming it."""
-    import re
     path = Path(path)
     try:
         text = path.read_text()
@@ -226,7 +226,6 @@ def read_table_rows(path) -> tuple:
 
 def cell_value(text: str):
     """A table cell as YADE evaluates it (a Python literal); ValueError if it is not one (e.g. unquoted text)."""
-    import ast
     try:
         return ast.literal_eval(text)
     except (ValueError, SyntaxError):

@@ -2,7 +2,7 @@
 
 ISRM (1978) suggested method: a disc of diameter D and thickness t is loaded along a diameter
 until it splits; its tensile strength is sigma_t = 2 P / (pi D t) at the peak load P
-(:mod:`grainfrac_yade.brazilian_analysis`).
+(:mod:`grainfrac_yade.analysis.brazilian_analysis`).
 
 The jaws are cells of the disc, as the UCS test's platens are (:mod:`.platens`): the cells whose
 rim arc overlaps an arc of ``brazilian.loading_arc_deg`` about the top (bottom) end of the
@@ -37,8 +37,8 @@ import time
 
 import numpy as np
 
-from ..brazilian_analysis import splits, tensile_stress
-from ..disc import DiscTessellation
+from ..analysis.brazilian_analysis import splits, tensile_stress
+from ..geometry.disc import DiscTessellation
 from ..errors import GrainfracError, NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoint import LoadingCheckpoints, base_state, read, restore_scene, resume_record, scene_arrays
@@ -58,7 +58,7 @@ class DiscJaws:
         t = scene.specimen.tessellation
         if not isinstance(t, DiscTessellation):
             raise GrainfracError("Brazilian test: the specimen is not a disc; fix: build it with "
-                                 "grainfrac_yade.specimen.build_disc_specimen")
+                                 "grainfrac_yade.geometry.specimen.build_disc_specimen")
         self.scene = scene
         self.diameter, self.centre = t.diameter, t.centre
         half = 0.5 * loading_arc
@@ -263,7 +263,7 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None, chec
     """Run the test; return (history columns, result dict, scene, snapshot at the failure load).
 
     The snapshot (bonds broken, their modes) is taken at the failure load: the peak before the split
-    (:func:`grainfrac_yade.brazilian_analysis.split_peak_index`, the same rows), else at the largest
+    (:func:`grainfrac_yade.analysis.brazilian_analysis.split_peak_index`, the same rows), else at the largest
     load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
     Broken counts and the snapshot leave out slits.  ``checkpoint_folder``: the run folder,
     checkpoints go to its ``checkpoint/`` (None: none); ``run_values``: stored with them (seed, levers).

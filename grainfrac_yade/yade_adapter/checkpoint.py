@@ -54,15 +54,12 @@ import numpy as np
 from ..clocks import EventClock, PaperClock
 from ..errors import GrainfracError
 from ..grains import grain_model
-from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
+from ..runs.runio import (ARRAYS_FILE, CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, SCENE_FILE,
+                          check_files, checkpoint_folder, code_version)
 from ..wave import HoldBudget
 from .corrosion_engine import StressCorrosion, add_stiffness_restorer
 from .platens import StressServo
 
-#: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
-SCENE_FILE = "scene.yade.gz"
-#: Per-bond arrays of the driver.
-ARRAYS_FILE = "arrays.npz"
 #: Layout of state.json and arrays.npz; a checkpoint of another layout is refused.
 FORMAT = 1
 #: Safe points of each test's driver at which a checkpoint can be taken (the phase it resumes in);
@@ -217,39 +214,6 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
         state["start_table_columns"] = list(run.initial_bond_stresses)
         arrays.update({START_TABLE + k: np.asarray(v) for k, v in run.initial_bond_stresses.items()})
     return state, arrays
-
-
-def check_files(where) -> None:
-    """GrainfracError (one line naming the file) if checkpoint folder ``where`` has a state file that is not JSON,
-    an arrays file that numpy cannot read whole, or a scene that is not a complete gzip stream (truncated): checked
-    before YADE is loaded and before anything is written.  Reads every file once (the scene's gzip stream to its
-    end: about a second per 100 MB)."""
-    import gzip
-    import zlib
-    where = Path(where)
-    fix = "fix: start the run again with the same command (run.json) and --overwrite"
-    try:
-        state = json.loads((where / CHECKPOINT_STATE).read_text())
-        if not isinstance(state, dict):
-            raise ValueError("not a JSON object")
-    except (OSError, ValueError) as exc:
-        raise GrainfracError(f"{where}: the checkpoint's state file ({where.name}/{CHECKPOINT_STATE}) is unreadable "
-                             f"(not the JSON this code writes: garbage or truncated; {type(exc).__name__}); "
-                             f"{fix}") from None
-    try:
-        with np.load(where / ARRAYS_FILE) as data:
-            for k in data.files:
-                data[k]
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-        raise GrainfracError(f"{where / ARRAYS_FILE}: the checkpoint's arrays are unreadable "
-                             f"(truncated or not numpy's npz; {type(exc).__name__}: {exc}); {fix}") from None
-    try:
-        with gzip.open(where / SCENE_FILE, "rb") as fh:
-            while fh.read(1 << 24):
-                pass
-    except (OSError, EOFError, zlib.error) as exc:
-        raise GrainfracError(f"{where / SCENE_FILE}: the checkpoint's scene is unreadable (truncated "
-                             f"gzip or not a YADE scene; {type(exc).__name__}: {exc}); {fix}") from None
 
 
 def read(run_folder, test: str = "creep") -> tuple:

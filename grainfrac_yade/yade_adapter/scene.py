@@ -1,4 +1,4 @@
-"""Turn a :class:`~grainfrac_yade.specimen.Specimen` into a YADE scene and read bonds back.
+"""Turn a :class:`~grainfrac_yade.geometry.specimen.Specimen` into a YADE scene and read bonds back.
 
 The scene holds only what a test asks for (guide: "simulate only the effects a
 scene calls for"): a plain mechanical scene has exactly ForceResetter,
@@ -33,7 +33,7 @@ from ..grains import GrainModel, layout_for, model_of
 from ..law import check_finite
 from ..layout import BondProperties, ClumpLayout, bond_properties
 from ..params import Parameters
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
 from .joints import IntactJointGuard
 

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
+from .runparams import rebuild_specimen
 
 #: Frames of an animation by default: 4 s at the default rate.
 DEFAULT_FRAMES = 60
@@ -75,7 +76,7 @@ def _read_run(folder: Path):
     hist = pd.read_csv(folder / "history.csv")
     cracks = pd.read_csv(folder / "cracks.csv")
     if "phase" in cracks:   # the ramp's cracks have no creep time: they are there from the first frame on
-        from .analysis.crack_phases import RAMP_TIME
+        from .crack_phases import RAMP_TIME
         cracks["creep_time_s"] = cracks["creep_time_s"].where(cracks["phase"] != "ramp", RAMP_TIME)
     for name, frame, cols in (("history.csv", hist, ("creep_time_s", "axial_strain")),
                               ("cracks.csv", cracks, ("creep_time_s", "mode"))):
@@ -90,7 +91,6 @@ def _read_run(folder: Path):
 
 def _specimen(folder, run, summary, cracks):
     """(specimen or None, note): the run's grains rebuilt and verified, else the reason."""
-    from .analysis.runparams import rebuild_specimen
     try:
         rebuilt = rebuild_specimen(folder, run.get("seed"), n_bonds=summary.get("n_bonds"), cracks=cracks)
     except GrainfracError as exc:
@@ -99,7 +99,7 @@ def _specimen(folder, run, summary, cracks):
 
 
 def _segments(cracks: pd.DataFrame, grain_size: float) -> np.ndarray:
-    from .analysis.crackmaps import crack_segments
+    from .crackmaps import crack_segments
     return crack_segments(cracks, grain_size)
 
 
