@@ -10,17 +10,27 @@ from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
 
 
-def seed_type(text: str) -> int:
+def seed_type(text: str, example: str = "1") -> int:
     """argparse type of a specimen seed: a whole number in [0, MAX_SEED] (numpy's generators take no negative
     seed; :data:`~grainfrac_yade.geometry.specimen.MAX_SEED` is the range of a 32-bit seed)."""
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. 1)") from None
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. {example})") from None
     if value < 0 or value > MAX_SEED:
         raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number from 0 to {MAX_SEED} (the range of a "
-                                         "32-bit seed; e.g. 1)")
+                                         f"32-bit seed; e.g. {example})")
     return value
+
+
+def seed_list_type(text: str) -> list:
+    """argparse type of a list of specimen seeds separated by commas, e.g. 1,2: each as :func:`seed_type`."""
+    return [seed_type(x, example="1,2") for x in text.split(",") if x.strip()]
+
+
+def float_list_type(text: str) -> list:
+    """argparse type of a list of numbers separated by commas, e.g. 0.7,0.8."""
+    return [float(x) for x in text.split(",") if x.strip()]
 
 
 def overrides_from_args(args) -> list:

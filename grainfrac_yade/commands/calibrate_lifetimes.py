@@ -13,7 +13,6 @@ data used, and ``STUDY/calibrate/fit.csv``.
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import math
@@ -21,11 +20,11 @@ from pathlib import Path
 
 from ..analysis.lifetime_calibration import ModelPoint, fit
 from ..errors import GrainfracError
-from ..geometry.specimen import MAX_SEED
 from ..law import scales_with_beta1, time_scaling_laws
 from ..params import flat_values, load_parameters, require_plane, write_parameter_file
 from ..runs.batchrun import run_batch, write_table
 from ..runs.runio import code_version, comparable_parameters, write_csv
+from ._args import float_list_type, seed_list_type
 from .creep import stress_flag
 
 #: Keys of the fitted parameters, by law.
@@ -36,35 +35,18 @@ STRESS_RTOL = 1e-9
 DEFAULT_SEEDS = (1, 2, 3)
 
 
-def _floats(text):
-    return [float(x) for x in text.split(",") if x.strip()]
-
-
-def _ints(text):
-    """argparse type of a list of specimen seeds, e.g. 1,2: whole numbers in [0, MAX_SEED] (32-bit)."""
-    try:
-        seeds = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: seeds are whole numbers separated by commas (e.g. 1,2)") from None
-    for seed in seeds:
-        if not 0 <= seed <= MAX_SEED:
-            raise argparse.ArgumentTypeError(f"{seed}: a seed is a whole number from 0 to {MAX_SEED} (the range of a "
-                                             "32-bit seed; e.g. 1,2)")
-    return seeds
-
-
 def register(sub, common):
     p = sub.add_parser("calibrate-lifetimes", help="fit beta1, beta2 (and a threshold) to lab lifetimes (runs "
                                                    "the creep rows it needs through yade-batch)")
     common(p)
     p.add_argument("study", help="study folder: its finished creep runs are reused; new runs go to STUDY/calibrate/")
     p.add_argument("--lab", required=True, help="CSV driving_stress_ratio,lifetime_s[,source]")
-    p.add_argument("--seeds", type=_ints, default=None,
+    p.add_argument("--seeds", type=seed_list_type, default=None,
                    help="specimen seeds of each ratio (default: those of the study's creep runs, else 1,2,3)")
     p.add_argument("--ucs", type=stress_flag, default=None, metavar="MPA",
                    help="UCS [MPa, like every stress flag; files and batch columns in Pa] the lab ratios refer to (default: the study's runs' ucs_pa if they agree, else "
                         "calibration.reference_ucs)")
-    p.add_argument("--threshold-ratios", type=_floats, default=None, metavar="R1,R2,...",
+    p.add_argument("--threshold-ratios", type=float_list_type, default=None, metavar="R1,R2,...",
                    help="also fit stress_corrosion.threshold_ratio among these values, e.g. 0,0.3,0.4")
     p.add_argument("--jobs", type=int, default=1, help="creep runs at a time")
     p.set_defaults(func=cmd_calibrate_lifetimes, with_params=True)

@@ -11,16 +11,15 @@ About 3-4 min on 2 cores with the defaults (measured in the notes); every run wr
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import time
 from pathlib import Path
 
 from ..errors import GrainfracError
-from ..geometry.specimen import MAX_SEED
 from ..params import flat_values, require_plane
 from ..runs.batchrun import read_table_rows, row_outcomes, run_batch, write_table
+from ._args import float_list_type, seed_list_type
 from .creep import outcome
 
 #: Demo defaults: a 10 x 20 mm specimen (about 200 cells; a creep run takes 15-40 s on one core).
@@ -29,28 +28,11 @@ DEMO_SEEDS = (1, 2)
 DEMO_RATIOS = (0.7, 0.8, 0.9)
 
 
-def _floats(text):
-    return [float(x) for x in text.split(",") if x.strip()]
-
-
-def _ints(text):
-    """argparse type of a list of specimen seeds, e.g. 1,2: whole numbers in [0, MAX_SEED] (32-bit)."""
-    try:
-        seeds = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: seeds are whole numbers separated by commas (e.g. 1,2)") from None
-    for seed in seeds:
-        if not 0 <= seed <= MAX_SEED:
-            raise argparse.ArgumentTypeError(f"{seed}: a seed is a whole number from 0 to {MAX_SEED} (the range of a "
-                                             "32-bit seed; e.g. 1,2)")
-    return seeds
-
-
 def register(sub, common):
     p = sub.add_parser("demo", help="main job: small lifetime study (specimen, UCS, creep at 3 ratios, report)")
     common(p, geometry=False)
-    p.add_argument("--ratios", type=_floats, default=list(DEMO_RATIOS), help="driving-stress ratios, e.g. 0.7,0.8,0.9")
-    p.add_argument("--seeds", type=_ints, default=list(DEMO_SEEDS), help="specimen seeds, e.g. 1,2")
+    p.add_argument("--ratios", type=float_list_type, default=list(DEMO_RATIOS), help="driving-stress ratios, e.g. 0.7,0.8,0.9")
+    p.add_argument("--seeds", type=seed_list_type, default=list(DEMO_SEEDS), help="specimen seeds, e.g. 1,2")
     p.add_argument("--width", type=float, default=DEMO_WIDTH_M, help="specimen width [m]")
     p.add_argument("--height", type=float, default=DEMO_HEIGHT_M, help="specimen height [m]")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: cores)")
