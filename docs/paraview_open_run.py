@@ -24,10 +24,10 @@ from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetAnimationScene, 
                              PVDReader, Render, ResetCamera, SaveScreenshot, Show, Threshold,
                              UpdatePipeline)
 
-#: Mineral colours of grainfrac_yade/plotting.py (paper Fig. 2a); others grey.
+#: Mineral colours of grainfrac_yade/analysis/plotting.py (paper Fig. 2a); others grey.
 MINERAL_RGB = {"biotite": (0.23, 0.23, 0.23), "k_feldspar": (0.91, 0.63, 0.48), "quartz": (0.85, 0.85, 0.91),
                "plagioclase": (0.96, 0.93, 0.78)}
-#: Bond states 1 (tensile crack) and 2 (shear crack), as grainfrac_yade/plotting.py draws them.
+#: Bond states 1 (tensile crack) and 2 (shear crack), as grainfrac_yade/analysis/plotting.py draws them.
 STATE_RGB = {1: (0.12, 0.47, 0.71), 2: (0.84, 0.15, 0.16)}
 CRACK_LINE_WIDTH = 3.0
 

@@ -1,8 +1,9 @@
 """Command line: ``python3 -m grainfrac_yade <command> ...``.
 
-Every command accepts ``--params FILE`` (merged over the shipped files in
-``params/``) and repeated ``--set section.key=value`` overrides, validated like
-the files.  User errors print one line and exit with status 2.
+The commands that build or run a model accept ``--params FILE`` (merged over the
+shipped files in ``params/``) and repeated ``--set section.key=value`` overrides,
+validated like the files (README.md lists them; tests/test_newcomer_inputs.py holds
+the list equal to the parser's).  User errors print one line and exit with status 2.
 
 Commands that run a model declare ``with_params=True`` (and optionally
 ``param_overrides``, a function of their arguments giving further overrides) in
@@ -13,9 +14,14 @@ Command modules never import this module.
 from __future__ import annotations
 
 import argparse
+import datetime as _dt
 import re
 import sys
+import tempfile
+import traceback
+from pathlib import Path
 
+from .commands import animate, register_all
 from .errors import GrainfracError
 
 #: Exit status for user errors (bad input), as argparse uses.
@@ -31,15 +37,12 @@ ERROR_LOG_DIR = "results/logs"
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
-def seed_type(text: str) -> int:
-    """argparse type of a specimen seed: a whole number >= 0 (numpy's generators take no negative seed)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. 1)") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number >= 0 (e.g. 1)")
-    return value
+def check_out_flag(args):
+    """``--out ''`` (or blanks) is refused: an empty folder name would silently mean the default folder."""
+    out = getattr(args, "out", None)
+    if out is not None and not str(out).strip():
+        raise GrainfracError(f"--out {out!r}: an empty folder name; fix: give a folder (e.g. --out results/run1), "
+                             "or leave --out out for the command's default folder")
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -50,6 +53,7 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def _common(parser: argparse.ArgumentParser, geometry: bool = True):
+    from .commands._args import seed_type   # not at module level: see main()
     parser.add_argument("--params", action="append", default=[], metavar="FILE",
                         help="TOML file merged over the shipped parameters (repeatable)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
@@ -62,38 +66,6 @@ def _common(parser: argparse.ArgumentParser, geometry: bool = True):
         parser.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     parser.add_argument("--out", help="output folder")
     parser.add_argument("--overwrite", action="store_true", help="replace a run already in --out")
-
-
-def overrides_from_args(args) -> list:
-    """``--set`` strings plus the geometry shortcuts (--width etc.) and the command's own (``param_overrides``);
-    a shortcut's override is a :class:`~grainfrac_yade.params.FlagOverride` (its errors name the flag)."""
-    from .params import FlagOverride
-    out = list(args.overrides)
-    extra = getattr(args, "param_overrides", None)
-    if extra is not None:
-        out += list(extra(args))
-    for opt, key in (("width", "specimen.width"), ("height", "specimen.height"),
-                     ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell")):
-        value = getattr(args, opt, None)
-        if value is not None:
-            out.append(FlagOverride(key, value, "--" + opt.replace("_", "-")))
-    return out
-
-
-def load_params_from_args(args):
-    """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
-    from .params import load_parameters, override_origin
-    from .specimen import check_cell_count
-    from .tessellation import n_cells_for
-    args.resolved_overrides = overrides_from_args(args)
-    params = load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
-    sp = params.specimen   # refused before any folder is made or anything allocated
-    box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
-    flags = ", ".join(override_origin(o) for o in args.resolved_overrides
-                      if override_origin(o) != "--set" and o[0].startswith("specimen."))
-    check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
-                     sp.grain_size, flags)
-    return params
 
 
 def cmd_specimen(args, params) -> int:
@@ -122,9 +94,7 @@ def build_parser() -> argparse.ArgumentParser:
     _common(p)
     p.add_argument("--bonds", action="store_true", help="draw the bond network on the picture")
     p.set_defaults(func=cmd_specimen, with_params=True)
-    from .commands import register_all
     register_all(sub, _common)
-    from .commands import animate
     animate.register(sub, _common)
     return parser
 
@@ -143,10 +113,6 @@ def join_negative_values(argv: list) -> list:
 
 def _log_traceback(command: str) -> str:
     """Write the current exception's traceback to a new log file; its path (or a note if none could be written)."""
-    import datetime as _dt
-    import tempfile
-    import traceback
-    from pathlib import Path
     stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     text = f"python3 -m grainfrac_yade {' '.join(sys.argv[1:])}\n\n{traceback.format_exc()}"
     for folder in (Path(ERROR_LOG_DIR), Path(tempfile.gettempdir())):
@@ -163,12 +129,15 @@ def _log_traceback(command: str) -> str:
 def main(argv=None) -> int:
     from .yade_adapter import use_default_threads
     use_default_threads()   # before any command module loads the OpenMP runtime
+    # this module's own imports load no numpy (nor OpenBLAS, which reads OMP_NUM_THREADS once) before this line
+    from .commands._args import load_params_from_args
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = DEBUG_FLAG in argv
     argv = join_negative_values([a for a in argv if a != DEBUG_FLAG])
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        check_out_flag(args)
         if getattr(args, "with_params", False):
             return args.func(args, load_params_from_args(args))
         return args.func(args)

@@ -56,6 +56,10 @@ _ROOT = Path(__file__).resolve().parents[1]
 
 
 def _default(action: argparse.Action) -> str:
+    if action.nargs == "?" and action.default is False:   # an optional-value flag: off unless given
+        alone = action.const
+        alone = ",".join(f"{v:g}" for v in alone) if isinstance(alone, (list, tuple)) else alone
+        return _cell(f"off; the flag alone: {alone}")
     if action.nargs == 0 or action.default in (None, argparse.SUPPRESS) or action.default == []:
         return ""
     default = action.default

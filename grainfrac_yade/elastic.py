@@ -41,10 +41,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .errors import GrainfracError
-from .grainmesh import grain_mesh
+from .geometry.grainmesh import grain_mesh
 from .layout import ClumpLayout, bond_properties, mineral_pair_table
 from .params import Parameters
-from .specimen import Specimen
+from .geometry.specimen import Specimen
 
 #: Applied axial strain [1]; any value gives the same ratios and moduli (linear model).
 DEFAULT_STRAIN = 1e-4

@@ -17,7 +17,7 @@ import numpy as np
 
 from .contact_strength import face_strength_multipliers
 from .params import Parameters, calibrated_contact
-from .specimen import Specimen
+from .geometry.specimen import Specimen
 
 
 @dataclass(frozen=True)

@@ -235,3 +235,20 @@ def read_vtp(path) -> dict:
     pts = poly.GetPoints()
     return {"points": nps.vtk_to_numpy(pts.GetData()).copy() if pts is not None else np.zeros((0, 3)),
             "cells": cells, "cell_data": arrays(poly.GetCellData()), "field_data": arrays(poly.GetFieldData())}
+
+
+def due_times(pending: list, now: float) -> tuple:
+    """(due, still pending) of the requested snapshot times ``pending`` (sorted, [s]) at time ``now``: those at or
+    before ``now`` are written now, as one frame of the state at ``now`` (the first recorded state at or after each)."""
+    k = 0
+    while k < len(pending) and pending[k] <= now:
+        k += 1
+    return list(pending[:k]), list(pending[k:])
+
+
+def merged_frame_note(requested, frame_time: float, clock: str = "creep") -> str:
+    """One progress line saying that the requested times ``requested`` [s] fell into one frame at ``frame_time``
+    (the clock stepped over them: no state between two recorded rows exists to write)."""
+    times = ", ".join(f"{t:g}" for t in requested)
+    return (f"VTK: requested {clock} times {times} s fell into one frame at {frame_time:.6g} s (the clock stepped "
+            "over them: there is no state in between to write)")

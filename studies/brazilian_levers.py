@@ -12,8 +12,8 @@ from pathlib import Path
 from grainfrac_yade.commands.brazilian import run_brazilian_to_folder, tensile_scale_overrides
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json
-from grainfrac_yade.specimen import build_specimen
-from grainfrac_yade.ucs_analysis import ucs_summary
+from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.analysis.ucs_analysis import ucs_summary
 from grainfrac_yade.yade_adapter.levers import Levers, apply_levers
 
 SEEDS = (1, 2, 3)

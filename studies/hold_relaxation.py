@@ -49,7 +49,7 @@ def main(argv=None) -> int:
         return 1
     params = load_parameters(extra_files=a.params, overrides=[*a.overrides, "stress_corrosion.enabled=false"])
     from grainfrac_yade.runs.runio import code_version
-    from grainfrac_yade.specimen import build_specimen
+    from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.yade_adapter.creep_protocol import CreepRun
     from grainfrac_yade.wave import scene_density
     from grainfrac_yade.yade_adapter.scene import mean_bond_force

@@ -27,7 +27,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 GRAIN_SIZE_CSV = ROOT / "docs" / "studies" / "lab_bands_grain_size.csv"
 LEVERS_CSV = ROOT / "docs" / "studies" / "lab_bands_levers.csv"
@@ -90,8 +90,8 @@ def run_setting(name, extra_files, out: Path, seed: int = SEED) -> list:
 
 def volumetric_crack_initiation(folder: Path, summary: dict) -> float:
     """Crack initiation read from the crack volumetric strain of the UCS run in ``folder`` (as the lab
-    reads it: grainfrac_yade.ucs_analysis.crack_initiation_volumetric_stress) [Pa]."""
-    from grainfrac_yade.ucs_analysis import crack_initiation_volumetric_stress
+    reads it: grainfrac_yade.analysis.ucs_analysis.crack_initiation_volumetric_stress) [Pa]."""
+    from grainfrac_yade.analysis.ucs_analysis import crack_initiation_volumetric_stress
     rows = list(csv.DictReader((Path(folder) / "history.csv").open()))
     col = {k: np.array([float(r[k]) for r in rows]) for k in ("axial_stress_pa", "axial_strain", "lateral_strain")}
     return crack_initiation_volumetric_stress(col["axial_stress_pa"], col["axial_strain"], col["lateral_strain"],

@@ -1,4 +1,4 @@
-"""Joint calibration of the contact levers to the lab's bands (grainfrac_yade.lab_fit): docs/studies/lab_calibration.md.
+"""Joint calibration of the contact levers to the lab's bands (grainfrac_yade.analysis.lab_fit): docs/studies/lab_calibration.md.
 
 Four parts, run in this order; each reads what the one before wrote and writes plain files:
 
@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from grainfrac_yade import lab_fit
+from grainfrac_yade.analysis import lab_fit
 from studies.lab_bands import LEVER_FIELDS, measure
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -62,8 +62,10 @@ def fingerprint(record: dict) -> tuple:
 
 
 def set_name(record: dict) -> str:
-    """A folder name for a stored set: CPU model and SIMD target."""
-    return re.sub(r"[^a-z0-9]+", "_", f"{record['cpu']} {record['simd']}".lower()).strip("_")
+    """A folder name for a stored set: CPU model, its family/model/stepping (where recorded) and SIMD target
+    (two machines with the same model string and SIMD target need two folders)."""
+    cpu = f"{record['cpu']} {record.get('cpu_id', '')} {record['simd']}"
+    return re.sub(r"[^a-z0-9]+", "_", cpu.lower()).strip("_")
 
 
 def stored_sets() -> list:

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from grainfrac_yade.grains.rigid import build_layout
-from grainfrac_yade.specimen import specimen_from_tessellation
-from grainfrac_yade.tessellation import tessellate_seeds
+from grainfrac_yade.geometry.specimen import specimen_from_tessellation
+from grainfrac_yade.geometry.tessellation import tessellate_seeds
 from grainfrac_yade.yade_adapter.corrosion_engine import StressCorrosion, add_stiffness_restorer
 from grainfrac_yade.yade_adapter.scene import build_scene
 

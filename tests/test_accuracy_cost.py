@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from conftest import ROOT, needs_yade
-from grainfrac_yade.accuracy_study import (DEFAULT_SETTING, creep_rows, load_study, setting_of_folder,
+from grainfrac_yade.analysis.accuracy_study import (DEFAULT_SETTING, creep_rows, load_study, setting_of_folder,
                                            ucs_rows)
 from grainfrac_yade.analysis.accuracy import (creep_strain_before_tertiary, history_measures, label_runs,
                                               markdown_table, pareto_figure, setting_rows, slope_b)

@@ -401,7 +401,7 @@ def real_run():
     """A real parameter set (small specimen), its specimen and layout as the run would build them."""
     from grainfrac_yade.grains.rigid import build_layout
     from grainfrac_yade.params import load_parameters
-    from grainfrac_yade.specimen import build_specimen
+    from grainfrac_yade.geometry.specimen import build_specimen
     params = load_parameters(overrides=SMALL)
     seed = 5
     specimen = build_specimen(params, seed)
@@ -501,7 +501,7 @@ def test_several_studies_fitted_separately_side_by_side(tmp_path, capsys):
 
 def test_long_titles_are_wrapped_inside_the_figure():
     from grainfrac_yade.analysis.figures import _title
-    from grainfrac_yade.plotting import plt
+    from grainfrac_yade.analysis.plotting import plt
     fig, ax = plt.subplots(figsize=(4, 3))
     t = _title(ax, "Axial strain vs creep time (normalised) (paper Fig. 5); failure leaves the top of the axis")
     r = fig.canvas.get_renderer()

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from conftest import ROOT, needs_yade
-from grainfrac_yade.brazilian_analysis import (central_band_area_fraction, crack_location, hondros_centre_factor,
+from grainfrac_yade.analysis.brazilian_analysis import (central_band_area_fraction, crack_location, hondros_centre_factor,
                                                in_central_band, tensile_stress)
-from grainfrac_yade.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
+from grainfrac_yade.geometry.disc import DiscTessellation, clip_polygon_to_disc, tessellate_disc, voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_disc_specimen
-from grainfrac_yade.tessellation import SIDES
+from grainfrac_yade.geometry.specimen import build_disc_specimen
+from grainfrac_yade.geometry.tessellation import SIDES
 
 #: Tiny disc for the YADE runs: 8 mm, 1 mm grains (64 cells, 2-5 s a run); the CLI test runs 5 mm.
 TINY = ["brazilian.diameter=8e-3"]
@@ -135,7 +135,7 @@ def test_central_band_area_fraction_by_counting():
 def test_failure_load_is_the_peak_before_the_split():
     """A drop below 0.8 x the peak with new breaks is the split; a higher load after it (halves crushed
     between the jaws) is not the strength. Without breaks a drop is ringing, not a split."""
-    from grainfrac_yade.brazilian_analysis import brazilian_summary, split_peak_index
+    from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary, split_peak_index
     load = [0, 5, 10, 12, 9, 14, 17, 6]
     broken = [0, 0, 0, 1, 5, 6, 8, 20]
     assert split_peak_index(load, broken) == (3, 4)
@@ -152,7 +152,7 @@ def test_a_drop_before_the_minimum_strain_is_not_the_split():
     """The start transient: the jaws start at full speed, a weak contact breaks and the load rings down
     (6 of 30 lab-design discs: 2e-6 strain). With ``min_strain`` the drop is skipped and the real peak
     overtakes the transient one; without it (0, the default) the transient is taken as the split."""
-    from grainfrac_yade.brazilian_analysis import brazilian_summary, split_peak_index
+    from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary, split_peak_index
     load = [20, 5, 8, 30, 60, 90, 40]
     broken = [0, 1, 1, 2, 3, 10, 80]
     strain = [2e-6, 4e-6, 6e-6, 3e-4, 6e-4, 9e-4, 1e-3]
@@ -210,7 +210,7 @@ def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack():
     peak 0.87 / 0.96 / 0.88.  Eight grains across is near the smallest disc that splits cleanly: seed 4
     ends at 0.44 (0.73 at the peak) after post-peak cracking, and a 6 mm disc (36 cells) ends at 0.46-0.60.
     """
-    from grainfrac_yade.brazilian_analysis import brazilian_summary
+    from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary
     from grainfrac_yade.protocols.brazilian import run_brazilian
     p = load_parameters(overrides=TINY)
     for seed in (1, 2, 3):
@@ -232,7 +232,7 @@ def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack():
 def test_tensile_scale_lowers_the_strength():
     """J^T x 0.5 on every contact row, cohesion unchanged: a lower Brazilian strength (8 mm disc, seed 1;
     measured 37.7 -> 31.0 MPa, -18 %: the split's zigzag faces fail in shear as well as in tension)."""
-    from grainfrac_yade.brazilian_analysis import brazilian_summary
+    from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary
     from grainfrac_yade.commands.brazilian import check_tensile_scale, tensile_scale_overrides
     from grainfrac_yade.protocols.brazilian import run_brazilian
     base = load_parameters(overrides=TINY)

@@ -114,7 +114,7 @@ def test_synthetic_lab_lifetimes_give_back_the_parameters_that_made_them(tmp_pat
     15 creep runs through yade-batch; 3.7 min on the shared 2 cores)."""
     from types import SimpleNamespace
 
-    from grainfrac_yade.cli import load_params_from_args
+    from grainfrac_yade.commands._args import load_params_from_args
     from grainfrac_yade.commands.calibrate_lifetimes import BatchModel
     study = tmp_path / "synthetic"
     args = SimpleNamespace(params=[], overrides=["stress_corrosion.creep_time_limit=1e30"], width=TINY["width"],

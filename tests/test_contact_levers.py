@@ -17,7 +17,7 @@ from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.layout import bond_properties
 from grainfrac_yade.params import load_parameters, pair_key
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 #: Draws of the large-sample checks: the sample mean of a unit-mean Weibull has the standard error
 #: CV / sqrt(n) (2.3e-3 at m = 1.5, n = 1e5).

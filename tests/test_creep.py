@@ -9,7 +9,7 @@ import pytest
 
 from conftest import ROOT, needs_yade
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 pytestmark = [needs_yade, pytest.mark.yade]
 
@@ -19,7 +19,7 @@ SMALL = ["specimen.width=6e-3", "specimen.height=12e-3", "stress_corrosion.creep
 @pytest.fixture(scope="module")
 def small_ucs():
     """UCS of the small specimen (seed 1), measured: creep loads are ratios of it."""
-    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=SMALL)
     hist, *_ = run_ucs(build_specimen(p, 1), p)
@@ -97,7 +97,7 @@ def test_small_specimen_creep_curve_has_three_stages():
     t_f, tertiary starts at 0.46 t_f; strain rate 4e-12 -> 8e-16 -> 5e-11 1/s). Small specimens
     creep in steps (16 events here), so this checks the stage detector on a real staircase; the
     paper-size specimen gives smooth three-stage curves (README)."""
-    from grainfrac_yade.creep_analysis import STAGE_RATE_FACTOR, STAGE_WINDOW, creep_stages, local_rates
+    from grainfrac_yade.analysis.creep_analysis import STAGE_RATE_FACTOR, STAGE_WINDOW, creep_stages, local_rates
     from grainfrac_yade.yade_adapter.creep_protocol import run_creep
     p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3",
                                    "stress_corrosion.creep_time_limit=1e30"])

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from grainfrac_yade.creep_analysis import (STAGE_MIN_EVENTS, STAGE_WINDOW, creep_stages, damage_index, local_rates,
+from grainfrac_yade.analysis.creep_analysis import (STAGE_MIN_EVENTS, STAGE_WINDOW, creep_stages, damage_index, local_rates,
                                             resolve_creep_stages)
 
 

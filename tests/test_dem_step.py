@@ -14,7 +14,7 @@ import pytest
 from conftest import needs_yade
 from grainfrac_yade.grains import critical_dem_step
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 TINY = ["specimen.width=4e-3", "specimen.height=8e-3"]
 CLUMP_REL = 1e-12   # see module doc

@@ -8,10 +8,10 @@ from conftest import needs_yade
 from grainfrac_yade.elastic import (mesh_network, elastic_summary, plane_strain_matrix, rigid_network,
                                     solve_uniaxial)
 from grainfrac_yade.errors import GrainfracError
-from grainfrac_yade.grainmesh import face_node_positions, grain_mesh
+from grainfrac_yade.geometry.grainmesh import face_node_positions, grain_mesh
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
+from grainfrac_yade.geometry.specimen import build_specimen, specimen_from_tessellation
 
 SMALL = ["specimen.width=5e-3", "specimen.height=10e-3"]
 

@@ -3,10 +3,11 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.engines import ENGINE_NAMES, Scene, SceneState, engine, engine_for
+from grainfrac_yade.engines import Scene, SceneState
+from grainfrac_yade.engines.registry import ENGINE_NAMES, engine, engine_for
 from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
 

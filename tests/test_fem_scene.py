@@ -15,7 +15,7 @@ from grainfrac_yade.grains.fem import build_fem_layout, element_apex
 from grainfrac_yade.elastic import (cluster_network, contact_statistics, mesh_network, node_stiffness,
                                     solve_uniaxial, stiffness_matrix)
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem.toml"
 MEDIAN_VERLET = ["numerics.verlet_radius_quantile=0.5", "numerics.verlet_fraction=0.5"]

@@ -15,7 +15,7 @@ from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 SMALL = ["specimen.width=3e-3", "specimen.height=6e-3"]
 FEM = ["resolution.grain_model=fem"]
@@ -166,7 +166,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
     run = SimpleNamespace(rows=rows, ramp_broken=3, failed=False, failure_reason="", failed_on_loading=False,
                           failed_before_test=False,
                           numerical_failure=False, n_events=2, scene=scene, vtk_written=[], initial_bond_stresses=None,
-                          break_time=np.full(lay.n_bonds, np.nan), macro_time=np.full(lay.n_bonds, np.nan))
+                          break_time=np.full(lay.n_bonds, np.nan), macro_time=np.full(lay.n_bonds, np.nan), vtk_folder=None, vtk_times=[], vtk_merged=[])
     monkeypatch.setattr(engine, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     run_ucs_to_folder(params, SEED, tmp_path / "ucs")
     run_creep_to_folder(params, SEED, tmp_path / "creep", 200e6, 0.7, 285e6)

@@ -9,8 +9,8 @@ import pytest
 from conftest import needs_yade
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
-from grainfrac_yade.tessellation import tessellate_seeds
+from grainfrac_yade.geometry.specimen import build_specimen, specimen_from_tessellation
+from grainfrac_yade.geometry.tessellation import tessellate_seeds
 
 pytestmark = [needs_yade, pytest.mark.yade]
 

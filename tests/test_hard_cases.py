@@ -172,8 +172,8 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
 @pytest.fixture(scope="module")
 def rigid_ucs():
     """UCS of the 4 x 8 mm specimen, seed 1 (measured 251.8 MPa; 3 s)."""
-    from grainfrac_yade.specimen import build_specimen
-    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.geometry.specimen import build_specimen
+    from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=TINY)
     return ucs_summary(run_ucs(build_specimen(p, 1), p)[0])["ucs_pa"]
@@ -269,8 +269,8 @@ def sliver_seeds(width, grain=1e-3, jitter_seed=3):
 
 
 def sliver_specimen(params, width):
-    from grainfrac_yade.specimen import specimen_from_tessellation
-    from grainfrac_yade.tessellation import tessellate_seeds
+    from grainfrac_yade.geometry.specimen import specimen_from_tessellation
+    from grainfrac_yade.geometry.tessellation import tessellate_seeds
     t = tessellate_seeds(sliver_seeds(width), [4e-3, 8e-3], 1e-3)
     assert t.cell_measure.sum() == pytest.approx(32e-6, rel=1e-12)   # no cell overlaps another
     minerals = np.random.default_rng(1).integers(0, len(params.minerals), t.n_cells)
@@ -308,7 +308,7 @@ def test_e_a_sliver_cell_builds_a_stable_scene_and_compresses_finitely(width):
 def test_e_seeds_too_close_to_tell_apart_are_one_clear_error_not_overlapping_cells():
     """1e-9 m apart (Qhull's precision in a 4 x 8 mm box): Qhull gave two seeds one region, so two cells
     overlapped (areas summing to 1.015 x the box) and one had no face: an unbonded body inside another."""
-    from grainfrac_yade.tessellation import tessellate_seeds
+    from grainfrac_yade.geometry.tessellation import tessellate_seeds
     with pytest.raises(GrainfracError) as err:
         tessellate_seeds(sliver_seeds(1e-9), [4e-3, 8e-3], 1e-3)
     assert str(err.value) == ("tessellation: seeds 13 and 33 lie 1e-09 m apart, too close for the Voronoi "
@@ -342,8 +342,8 @@ def test_f_grains_just_below_the_width_run_a_ucs_to_a_finite_peak(tmp_path, capt
 def column_specimen(params, n=5, grain=1.9e-3):
     """n cells stacked in a 2 x 8 mm box, every one spanning the width (seeds jittered about the axis,
     so faces are inclined by 18 to 31 degrees)."""
-    from grainfrac_yade.specimen import specimen_from_tessellation
-    from grainfrac_yade.tessellation import tessellate_seeds
+    from grainfrac_yade.geometry.specimen import specimen_from_tessellation
+    from grainfrac_yade.geometry.tessellation import tessellate_seeds
     rng = np.random.default_rng(1)
     seeds = np.column_stack([1e-3 + rng.uniform(-0.3, 0.3, n) * 2e-3, (np.arange(n) + 0.5) * 8e-3 / n])
     t = tessellate_seeds(seeds, [2e-3, 8e-3], grain)
@@ -361,7 +361,7 @@ def test_f_a_strict_one_cell_column_ends_at_the_strain_cap_as_a_lower_bound(sphe
     sideways (largest stress 3.4 MPa, the ringing of the first steps); 8 spheres per cell: 2 bonds per face,
     elastic to the 2 % strain cap (1.8 GPa).  Neither breaks a bond.  Before, the first run 'failed'
     post-peak at 3.4 MPa after 376 DEM steps (the ringing read as softening).  1-2 s each."""
-    from grainfrac_yade.ucs_analysis import ucs_summary
+    from grainfrac_yade.analysis.ucs_analysis import ucs_summary
     from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=["specimen.width=2e-3", "specimen.height=8e-3", "specimen.grain_size=1.9e-3",
                                    f"resolution.spheres_per_cell={spheres_per_cell}"])

@@ -13,7 +13,7 @@ import pytest
 
 from conftest import needs_yade
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem.toml"
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]

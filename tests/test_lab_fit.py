@@ -1,8 +1,8 @@
-"""The lab fit's pure core (grainfrac_yade.lab_fit): mapping, design, surface and solve against closed forms."""
+"""The lab fit's pure core (grainfrac_yade.analysis.lab_fit): mapping, design, surface and solve against closed forms."""
 import numpy as np
 import pytest
 
-from grainfrac_yade import lab_fit
+from grainfrac_yade.analysis import lab_fit
 
 
 def test_variable_mapping_ends_and_log_midpoint():
@@ -191,7 +191,7 @@ def test_a_brazilian_peak_without_a_split_is_left_out():
 def test_crack_volumetric_strain_onset_of_a_known_history():
     """Elastic to sigma_ci = 90 MPa, then a crack dilation growing as (sigma - sigma_ci)^2: the lab's
     crack-initiation reading finds where the dilation reaches 2 % of its peak value, to the stress step."""
-    from grainfrac_yade.ucs_analysis import crack_initiation_volumetric_stress, crack_volumetric_strain
+    from grainfrac_yade.analysis.ucs_analysis import crack_initiation_volumetric_stress, crack_volumetric_strain
     young, poisson, ci = 70e9, 0.25, 90e6
     stress = np.linspace(0.0, 200e6, 401)          # 0.5 MPa a row
     ea = stress / young

@@ -4,8 +4,8 @@ import pytest
 
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.layout import bond_properties, cell_mass_inertia
-from grainfrac_yade.specimen import build_specimen, specimen_from_tessellation
-from grainfrac_yade.tessellation import tessellate_seeds
+from grainfrac_yade.geometry.specimen import build_specimen, specimen_from_tessellation
+from grainfrac_yade.geometry.tessellation import tessellate_seeds
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +59,7 @@ def test_series_stiffness_formula(small_params):
     area, l = 1e-3 * 1e-3, 0.5e-3
     kn = area / (1 / c.normal_stiffness + l / (q.young / (1 - q.poisson**2)) + l / (b.young / (1 - b.poisson**2)))
     ks = area / (1 / c.shear_stiffness + l / q.shear_modulus + l / b.shear_modulus)
-    cal = small_params.calibration   # one factor on every bond's stiffness and strengths (issue 4)
+    cal = small_params.calibration   # one factor on every bond's stiffness and strengths (the calibration of the packing)
     assert bp.normal_stiffness[0] == pytest.approx(kn * cal.stiffness_scale, rel=1e-12)
     assert bp.shear_stiffness[0] == pytest.approx(ks * cal.stiffness_scale, rel=1e-12)
     assert bp.tensile_strength[0] == pytest.approx(c.tensile_strength * cal.strength_scale, rel=1e-15)

@@ -79,7 +79,7 @@ def test_cli_stresses_are_mpa_and_batch_stresses_pa():
 @needs_yade
 @pytest.mark.yade
 def test_a_specimen_broken_apart_in_the_isotropic_stage_is_a_failure_not_a_ucs_of_zero(tmp_path):
-    """1e6 times the intended 20 MPa (the unit slip of the issue; the CLI refuses it, the adapter is called
+    """1e6 times the intended 20 MPa (a unit slip, Pa given for MPa; the CLI refuses it, the adapter is called
     directly): every bond breaks in the isotropic stage; the run must say so and measure nothing."""
     from grainfrac_yade.commands.ucs import run_ucs_to_folder
     params = load_parameters(overrides=TINY + [("confinement.stress", 20e12)])
@@ -182,7 +182,7 @@ def test_a_batch_table_is_checked_row_by_row_before_anything_runs(tmp_path, caps
     err = capsys.readouterr().err.strip().splitlines()
     assert "5 bad row(s), nothing run" in err[0]
     expected = {3: "both ratio and stress", 4: "must lie in (0, 1)", 5: "5 cells for 6 columns",
-                6: "must be quoted", 7: "specimen.width: must be > 0"}
+                6: "column study takes quoted text", 7: "specimen.width: must be > 0"}
     assert len(err) == 1 + len(expected)
     for (line, words), text in zip(expected.items(), err[1:]):
         assert f"bad.table:{line}:" in text and words in text, text
@@ -206,7 +206,8 @@ def test_the_demo_refuses_a_ratio_at_or_above_one_before_it_simulates(tmp_path, 
 @pytest.mark.yade
 def test_batch_runs_the_rows_and_exits_non_zero_naming_the_row_that_failed(tmp_path):
     """Three 3 x 6 mm UCS rows (about 5 s each with YADE's start): line 3 runs; line 4's folder holds a finished
-    run of other parameters, line 5's a specimen run (the issue's take-over), so both stop with their one line;
+    run of other parameters, line 5's a specimen run (a take-over of another run's folder), so both stop with their one
+    line;
     the batch names lines 4 and 5 and exits 1; the specimen folder is left as it was."""
     from grainfrac_yade.runs.runio import prepare_run_dir, write_json
     taken = tmp_path / "taken"
@@ -261,7 +262,7 @@ def test_an_unfinished_run_with_a_checkpoint_is_refused_naming_resume(tmp_path):
 
 
 def test_a_failed_overwrite_leaves_the_old_run_as_it_was(tmp_path, capsys):
-    """The issue's case: ``--overwrite --grain-size 1e-9`` must leave the old run whole. The cell count is
+    """``--overwrite --grain-size 1e-9`` must leave the old run whole. The cell count is
     refused before any folder is made; a failure later in a replacing run (here: the specimen build refusing
     after the folder was prepared) leaves the old folder byte for byte."""
     from grainfrac_yade.commands.specimen import run_specimen
@@ -282,7 +283,7 @@ def test_a_failed_overwrite_leaves_the_old_run_as_it_was(tmp_path, capsys):
 
 # ------------------------------------------------------------------ one line, no traceback
 @pytest.mark.parametrize("argv, words", [
-    (["specimen", "--seed", "-1"], ("--seed", ">= 0")),
+    (["specimen", "--seed", "-1"], ("--seed", "from 0 to 4294967295")),
     (["specimen", "--width", "-10e-3"], ("--width: specimen.width", "must be > 0")),
     (["specimen", "--width", "3e-3", "--height", "6e-3", "--out", "/proc/x"], ("/proc/x", "cannot write")),
     (["creep", "--stress", "abc"], ("--stress", "invalid float value")),

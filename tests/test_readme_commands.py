@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from grainfrac_yade.cli import build_parser, load_params_from_args
+from grainfrac_yade.cli import build_parser
+from grainfrac_yade.commands._args import load_params_from_args
 from grainfrac_yade.commands.batch import check_table
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -28,7 +28,7 @@ Event seed 1 is the hard case: a cascade the specimen arrests holds the servo at
 import pytest
 
 from conftest import needs_yade
-from grainfrac_yade.creep_analysis import STAGE_GRID
+from grainfrac_yade.analysis.creep_analysis import STAGE_GRID
 from platform_fingerprint import matching_set, stored_sets
 from reference_creep import RUNS, run, stored
 

@@ -1,4 +1,4 @@
-"""Regularised tessellation (``specimen.min_edge_fraction``, grainfrac_yade/regularise.py): exact invariants.
+"""Regularised tessellation (``specimen.min_edge_fraction``, grainfrac_yade/geometry/regularise.py): exact invariants.
 
 Pure numpy, no YADE.  Tolerances: areas and wall lengths sum to the domain's to 1e-12 relative (a few
 thousand float64 additions of terms of the domain's size: rounding ~1e-15; the collapse itself is exact
@@ -11,14 +11,14 @@ import math
 import numpy as np
 import pytest
 
-from grainfrac_yade.disc import voronoi_disc
+from grainfrac_yade.geometry.disc import voronoi_disc
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
-from grainfrac_yade.minerals import allocate_minerals
+from grainfrac_yade.geometry.minerals import allocate_minerals
 from grainfrac_yade.params import PARAMS_DIR, load_parameters, migrate_tree
-from grainfrac_yade.regularise import regularise
-from grainfrac_yade.specimen import build_disc_specimen, build_specimen
-from grainfrac_yade.tessellation import voronoi_box
+from grainfrac_yade.geometry.regularise import regularise
+from grainfrac_yade.geometry.specimen import build_disc_specimen, build_specimen
+from grainfrac_yade.geometry.tessellation import voronoi_box
 
 GRAIN = 1e-3
 SUM_REL = 1e-12      # see module doc
@@ -94,7 +94,7 @@ def test_box_invariants(seed, fraction):
     # wall faces: each wall's pieces sum to its length; vertices stay in the box
     side = np.bincount(t.boundary_side, weights=t.boundary_measure, minlength=4)
     assert np.allclose(side, [h, h, w, w], rtol=SUM_REL, atol=0)
-    from grainfrac_yade.tessellation import _polygon_area_centroid
+    from grainfrac_yade.geometry.tessellation import _polygon_area_centroid
     for c in range(t.n_cells):
         v = t.cell_vertices[c]
         assert np.all((v >= 0) & (v <= t.box))

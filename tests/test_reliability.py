@@ -218,7 +218,7 @@ def test_event_loop_on_nan_stresses_raises_instead_of_ending_not_failed():
 @pytest.fixture(scope="module")
 def tiny():
     from grainfrac_yade.grains import layout_for
-    from grainfrac_yade.specimen import build_specimen
+    from grainfrac_yade.geometry.specimen import build_specimen
     params = load_parameters(overrides=TINY)
     specimen = build_specimen(params, 1)
     return params, specimen, layout_for(specimen, params)
@@ -236,7 +236,7 @@ def stand_in_run(tiny, rows, failed=False, numerical=False, reason=""):
                            failed_before_test=False,
                            numerical_failure=numerical, n_events=0, scene=scene, vtk_written=[],
                            initial_bond_stresses=None, break_time=np.where(broken, -1.0, np.nan),
-                           macro_time=np.full(n, np.nan))
+                           macro_time=np.full(n, np.nan), vtk_folder=None, vtk_times=[], vtk_merged=[])
 
 
 def history_row(t, strain=2e-3):
@@ -285,7 +285,7 @@ def test_a_numerical_failure_is_its_own_outcome_in_summary_json(tmp_path, monkey
 
 def test_a_run_killed_while_drawing_leaves_no_summary(tmp_path, monkeypatch, tiny):
     """summary.json is written last: a run stopped before it ends is 'unfinished', never 'finished'."""
-    import grainfrac_yade.plotting as plotting
+    import grainfrac_yade.analysis.plotting as plotting
 
     def killed(*args, **kwargs):
         raise KeyboardInterrupt

@@ -6,7 +6,7 @@ import pytest
 from conftest import needs_yade
 from grainfrac_yade.layout import step_floor_factors
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 
 SMALL = ["specimen.width=4e-3", "specimen.height=8e-3"]
 

@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from grainfrac_yade.minerals import allocate_minerals, area_fractions, mineral_clumps
-from grainfrac_yade.specimen import build_specimen
-from grainfrac_yade.tessellation import SIDES, n_cells_for, tessellate_seeds, voronoi_box
+from grainfrac_yade.geometry.minerals import allocate_minerals, area_fractions, mineral_clumps
+from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.geometry.tessellation import SIDES, n_cells_for, tessellate_seeds, voronoi_box
 
 BOX2 = np.array([10e-3, 20e-3])
 

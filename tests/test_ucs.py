@@ -4,8 +4,8 @@ import pytest
 
 from conftest import needs_yade
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
-from grainfrac_yade.ucs_analysis import crack_damage_stress, elastic_constants, ucs_summary
+from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.analysis.ucs_analysis import crack_damage_stress, elastic_constants, ucs_summary
 
 pytestmark = [needs_yade, pytest.mark.yade]
 

@@ -98,7 +98,7 @@ def test_cluster_rigid_motion_recovers_a_rotation_and_translation():
 
 
 def test_frame_times_linear_and_logarithmic():
-    from grainfrac_yade.animation import LOG_TIME_DECADES, frame_times
+    from grainfrac_yade.analysis.animation import LOG_TIME_DECADES, frame_times
     lin = frame_times(8.0, 5)
     assert list(lin) == [0.0, 2.0, 4.0, 6.0, 8.0]
     log = frame_times(1e7, 7, log_time=True)

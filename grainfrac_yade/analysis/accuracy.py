@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..accuracy_study import DEFAULT_SETTING, Study, run_index
+from .accuracy_study import DEFAULT_SETTING, Study, run_index
 from .lifetimes import outcome
 
 #: Where a zero error (the reference itself) sits on the log axis of the Pareto figure.

@@ -9,6 +9,7 @@ import pandas as pd
 from ..params import RENAMED_KEYS, migrate_tree
 from ..params import flatten as flatten_tree
 from ..protocols.columns import summary_as_today
+from ..runs.slurm import FAILED, rows_without_runs
 
 #: Parameter paths copied from each run's params.json into the table (older params.json are read through
 #: :func:`~grainfrac_yade.params.migrate_tree`: ``stress_corrosion.mode`` becomes ``stress_corrosion.law``).
@@ -61,7 +62,6 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
     run folder's path. With ``all_params`` every parameter of params.json becomes a column
     (dotted name); otherwise only :data:`PARAM_COLUMNS`.
     """
-    from ..runs.slurm import FAILED, rows_without_runs
     root = Path(root)
     rows = []
     folders = sorted({p.parent for p in root.rglob("run.json")} | {p.parent for p in root.rglob(FAILED)})

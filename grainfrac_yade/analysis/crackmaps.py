@@ -19,7 +19,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 
-from ..plotting import CRACK_COLOURS, draw_cells, plt
+from .plotting import CRACK_COLOURS, draw_cells, plt
 
 MM = 1e3
 SEGMENT_COLUMNS = ("x0_m", "y0_m", "x1_m", "y1_m")
@@ -64,7 +64,7 @@ def crack_maps_figure(path, cracks: pd.DataFrame, times, labels, width: float, h
                       grain_alpha: float = GRAIN_ALPHA):
     """One panel per time: specimen outline, microcracks thin, macrocracks thick, coloured by
     ``colour_by`` ("mode": tensile/shear, "kind": inter/intra-granular). ``specimen`` (2D
-    :class:`~grainfrac_yade.specimen.Specimen`): its cells are drawn under the cracks, coloured by
+    :class:`~grainfrac_yade.geometry.specimen.Specimen`): its cells are drawn under the cracks, coloured by
     mineral with opacity ``grain_alpha``; None: outline only."""
     seg = crack_segments(cracks, grain_size) * MM
     palette = COLOURS[colour_by]
@@ -86,11 +86,11 @@ def crack_maps_figure(path, cracks: pd.DataFrame, times, labels, width: float, h
         ax.set_ylim(-0.02 * height * MM, 1.02 * height * MM)
         ax.set_aspect("equal")
         ax.set_xlabel("x [mm]")
-        ax.set_title(f"{lab}\n{int(micro.sum())} micro, {int(macro.sum())} macro", fontsize=7)
+        ax.set_title(f"{lab}\n{int(micro.sum())} cracks, {int(macro.sum())} of them macro", fontsize=7)
     axes[0][0].set_ylabel("y [mm]")
     handles = [Line2D([], [], color=c, lw=1.2, label=k) for k, c in palette.items()]
-    handles.append(Line2D([], [], color="k", lw=MICRO_WIDTH, label="microcrack (broken bond)"))
-    macro_label = "macrocrack (face fully separated)" if "macro_time_s" in cracks else \
+    handles.append(Line2D([], [], color="k", lw=MICRO_WIDTH, label="crack (broken bond)"))
+    macro_label = "macrocrack (crack on a fully separated face)" if "macro_time_s" in cracks else \
         "macrocrack times not recorded in cracks.csv"
     handles.append(Line2D([], [], color="k", lw=MACRO_WIDTH, label=macro_label))
     if not has_segments(cracks):

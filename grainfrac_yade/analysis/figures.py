@@ -2,7 +2,7 @@
 
 Inputs are plain arrays and DataFrames (history.csv tables, lifetime sets); nothing here reads
 run folders. Strain is compression positive and drawn in %.  Pictures of specimens and the crack
-map itself are :mod:`grainfrac_yade.plotting`; everything built from results is here.
+map itself are :mod:`grainfrac_yade.analysis.plotting`; everything built from results is here.
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..plotting import plt
+from .plotting import plt
 from .fits import CONFIDENCE, LifetimeFit
 
 DPI = 130
@@ -41,6 +41,17 @@ class LifetimeSet:
     lower_time_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
     sources: np.ndarray | None = None   # lab: one label per point
     at_load_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))   # failed at t = 0 (not fitted)
+    ucs_pa: np.ndarray = field(default_factory=lambda: np.zeros(0))   # the UCS each run's ratio refers to [Pa]
+
+
+def ratio_reference(ucs_pa) -> str:
+    """Which UCS a set's ratios divide by, for a legend: one value, or the range over its runs ("" if unknown)."""
+    u = np.asarray(ucs_pa, float)
+    u = u[np.isfinite(u) & (u > 0)]
+    if not len(u):
+        return ""
+    lo, hi = u.min() / 1e6, u.max() / 1e6
+    return f"r = sigma / {lo:.1f} MPa" if round(lo, 1) == round(hi, 1) else f"r = sigma / {lo:.1f}-{hi:.1f} MPa"
 
 
 @dataclass
@@ -101,9 +112,10 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
     all_ratios = []
     for k, s in enumerate(model_sets):
         c = colours[k % 10]
+        ref = ratio_reference(s.ucs_pa)
         if len(s.ratio):
             ax.scatter(s.ratio, s.lifetime_s, s=22, color=c, edgecolors="k", linewidths=0.4, zorder=3,
-                       label=f"{s.label}: failed runs ({len(s.ratio)})")
+                       label=f"{s.label}: failed runs ({len(s.ratio)})" + (f"; {ref} (its runs' UCS)" if ref else ""))
         if len(s.lower_ratio):
             ax.scatter(s.lower_ratio, s.lower_time_s, s=30, facecolors="none", edgecolors=c, marker="o", zorder=3,
                        label=f"{s.label}: not failed by end time (lower bound, not fitted; {len(s.lower_ratio)})")
@@ -132,7 +144,9 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
                         if time_note and np.isfinite(getattr(reference, "beta1_pa_s", np.nan)) else "")
         ax.scatter([reference.ratio], [reference.lifetime_s], marker="*", s=140, color="gold", edgecolors="k",
                    zorder=4, label=f"paper (UDEC): {reference.stress_pa / 1e6:.0f} MPa, "
-                                   f"r = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s{as_published}")
+                                   f"r = {reference.stress_pa / 1e6:.0f} / {reference.ucs_simulated_pa / 1e6:.1f} MPa "
+                                   f"(UDEC's UCS) = {reference.ratio:.3f}, t = {reference.lifetime_s:.4g} s"
+                                   f"{as_published}")
         all_ratios += [reference.ratio, reference.long_term_strength_ratio]
     lo = min(all_ratios) - 0.05 if all_ratios else 0.5
     hi = max(all_ratios) + 0.05 if all_ratios else 1.0
@@ -143,7 +157,7 @@ def lifetime_figure(path, model_sets, lab: LifetimeSet | None = None, reference=
                    label=f"Lajtai & Schmidtke 1986: long-term strength < {lts:.0%} of UCS (lies here)")
         ax.axvline(lts, color="0.4", lw=1, ls=":")
     ax.set_yscale("log")
-    ax.set_xlabel("driving-stress ratio sigma / sigma_c [-]")
+    ax.set_xlabel("driving-stress ratio sigma / sigma_c [-] (sigma_c: each set's own UCS, in the legend)")
     ax.set_ylabel("lifetime (time to failure) [s]")
     _title(ax, "Lifetime vs driving-stress ratio (paper Fig. 4)" + (f" - {time_note}" if time_note else ""))
     ax.grid(True, which="major", alpha=0.3)
@@ -194,6 +208,13 @@ def strain_time_figure(path, curves, normalised: bool = False, time_note: str | 
         x = t / c.t_ref_s if normalised else t
         sel = np.isfinite(x) & (np.ones_like(x, bool) if normalised else x > 0)
         if not sel.any():
+            continue
+        if not normalised and sel.sum() < 2:
+            # one positive creep time (e.g. the event clock jumped from the load straight to failure): no curve on a
+            # log axis; a dashed line at that time keeps the run in the figure, not only in its legend
+            ax.axvline(x[sel][0], color=colour, lw=1.1, ls="--",
+                       label=f"{c.label}{'' if c.failed else ' (not failed)'}: one creep time, t = {x[sel][0]:.4g} s "
+                             "(no curve on a log axis)")
             continue
         ax.plot(x[sel], eps[sel], color=colour, lw=1.1, drawstyle="steps-post",
                 label=c.label + ("" if c.failed else " (not failed)"))

@@ -53,11 +53,18 @@ def coefficients_markdown(coefficients: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+#: The crack counts of the run table and the figures, defined once (as in docs/reference/output_files.md).
+CRACK_COUNTS = ("Crack counts: *cracks* are broken bonds (microcracks) of the ramp and of creep; *creep cracks* those "
+                "broken at the held load (cracks = ramp cracks + creep cracks); *macrocracks* the cracks whose face is "
+                "fully separated, ramp or creep: a subset of the cracks (never more), not of the creep cracks. The "
+                "crack maps title each panel \"N cracks, M of them macro\" at its time.")
+
 RUN_COLUMNS = {
     "link": ("run", ""), "seed": ("seed", ""), "variant": ("variant", ""), "driving_stress_ratio": ("ratio", ".4f"),
     "stress_mpa": ("stress [MPa]", ".1f"), "status": ("status", ""), "outcome": ("outcome", ""),
     "lifetime_s": ("lifetime [s]", ".4g"), "creep_time_end_s": ("end of creep [s]", ".4g"),
-    "n_events": ("events", ".0f"), "broken_creep": ("creep cracks", ".0f"), "macrocracks": ("macrocracks", ".0f"),
+    "n_events": ("events", ".0f"), "broken_total": ("cracks", ".0f"), "broken_creep": ("creep cracks", ".0f"),
+    "macrocracks": ("macrocracks", ".0f"),
     "wall_s": ("wall [s]", ".0f"), "problem": ("problem", ""),
 }
 
@@ -136,7 +143,7 @@ def render_report(c: ReportContent) -> str:
              "running, stopped or crashed, or a SLURM row not started yet), *run error* (no summary.json; the batch "
              "task that ran it failed and recorded its error line in failed.json, shown as problem), "
              "*unreadable* (a JSON file that cannot be parsed, or a failed run without a "
-             "valid lifetime).", "",
+             "valid lifetime).", "", CRACK_COUNTS, "",
              markdown_table(_runs_for_table(c), RUN_COLUMNS), ""]
     lines += ["## Lifetime vs driving-stress ratio (paper Fig. 4)", "",
               "Fitted by least squares in ln t: the static-fatigue line ln t_f = a - b r and the power law "

@@ -25,6 +25,7 @@ import pandas as pd
 
 from ..errors import GrainfracError
 from ..law import scales_with_beta1, time_scaling_laws
+from ..params import read_toml
 
 #: Summary and table columns that are creep times [s] (wall_s is wall-clock time: not scaled).
 TIME_COLUMNS = ("lifetime_s", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
@@ -51,7 +52,6 @@ def check_beta1(value, source: str = "--beta1") -> float:
 
 def beta1_from_toml(path) -> float:
     """``[stress_corrosion] beta1`` of a TOML file (e.g. params/stress_corrosion_calibrated.toml)."""
-    from ..params import read_toml   # one TOML reader: missing file / bad syntax as one-line errors
     path = Path(path)
     data = read_toml(path)
     sc = data.get("stress_corrosion")

@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GrainfracError
+from ..geometry.specimen import build_specimen
+from ..grains import layout_for
+from ..params import build_parameters, load_parameters, migrate_tree
 
 #: Sections of the file layout that are tables of one schema class (missing keys can be filled).
 #: composition, grains and contacts are never filled: they define the material.
@@ -58,7 +61,6 @@ def default_tree() -> dict:
     """The shipped parameter set as a params.json tree (cached)."""
     global _DEFAULTS
     if _DEFAULTS is None:
-        from ..params import load_parameters
         _DEFAULTS = load_parameters().to_dict()
     return _DEFAULTS
 
@@ -75,7 +77,6 @@ def load_run_parameters(path, fill_missing: bool = False) -> RunParameters:
         path = path / "params.json"
     tree = _read(path)
     sources = tree.pop("sources", ())
-    from ..params import migrate_tree
     migrate_tree(tree)   # renamed keys (stress_corrosion.mode -> stress_corrosion.law) read as today's
     filled = []
     if fill_missing:
@@ -89,7 +90,6 @@ def load_run_parameters(path, fill_missing: bool = False) -> RunParameters:
                 if key not in mine:
                     mine[key] = value
                     filled.append(f"{section}.{key}")
-    from ..params import build_parameters
     origins = {}
     try:
         params = build_parameters(tree, origins, tuple(sources) if isinstance(sources, list) else ())
@@ -105,7 +105,7 @@ def parameters_from_json(path):
 
 @dataclass(frozen=True)
 class RebuiltSpecimen:
-    specimen: object         # grainfrac_yade.specimen.Specimen
+    specimen: object         # grainfrac_yade.geometry.specimen.Specimen
     run_params: RunParameters
     checks: tuple            # what was verified against the run's records (text)
 
@@ -142,8 +142,6 @@ def rebuild_specimen(folder, seed, n_bonds=None, cracks=None) -> RebuiltSpecimen
     if params.specimen.dimension != 2:
         raise GrainfracError(f"{folder}: 3D specimen (specimen.dimension = {params.specimen.dimension}); "
                              "fix: grain maps are drawn for 2D specimens only")
-    from ..grains import layout_for
-    from ..specimen import build_specimen
     specimen = build_specimen(params, seed)
     checks = []
     need_layout = n_bonds is not None or (cracks is not None and len(cracks) and

@@ -8,6 +8,7 @@ time is rescaled exactly to another stress-corrosion rate (see :mod:`.rescale`).
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -216,7 +217,9 @@ def lifetime_sets(runs: pd.DataFrame) -> list:
         sets.append(LifetimeSet(label=variant, ratio=ratio, lifetime_s=life, fit=fit,
                                 lower_ratio=lower["driving_stress_ratio"].to_numpy(float)[pos],
                                 lower_time_s=end[pos],
-                                at_load_ratio=at_load["driving_stress_ratio"].to_numpy(float)))
+                                at_load_ratio=at_load["driving_stress_ratio"].to_numpy(float),
+                                ucs_pa=pd.to_numeric(g["ucs_pa"], errors="coerce").to_numpy(float)
+                                if "ucs_pa" in g else np.zeros(0)))
     return sets
 
 
@@ -308,9 +311,7 @@ def _rescale_text(runs: pd.DataFrame, beta1: float, source: str, reference) -> l
 def animation_note(run_folder, out) -> str | None:
     """Report line linking the focus run's crack-growth animation (``animate``; not made here, rendering
     costs seconds per run); None when the run has none."""
-    import os
-
-    from ..animation import GIF_NAME, MP4_NAME
+    from .animation import GIF_NAME, MP4_NAME
     run_folder = Path(run_folder)
     gif = run_folder / GIF_NAME
     if not gif.is_file():

@@ -1,9 +1,9 @@
 """CLI commands, one module each; :func:`register_all` adds the ones beyond ``specimen``."""
+import importlib
 
 
 def register_all(subparsers, common):
     """Add later commands (ucs, creep, analyze, demo) to the CLI as they exist."""
-    import importlib
     for name in ("ucs", "calibrate", "calibrate_beta1", "calibrate_lifetimes", "analyze_ucs", "creep", "analyze", "demo",
                  "elastic", "bench", "accuracy_cost",
                  "submit", "status", "brazilian", "batch"):

@@ -1,6 +1,6 @@
 """``accuracy-cost [--quick]``: what accuracy costs in time, in one command.
 
-Reads the study's plan (``params/accuracy_cost.toml``, :mod:`grainfrac_yade.accuracy_study`), writes its
+Reads the study's plan (``params/accuracy_cost.toml``, :mod:`grainfrac_yade.analysis.accuracy_study`), writes its
 yade-batch tables into the study folder (``ucs.table``, ``creep.table``; ``--tables-only`` stops there,
 for ``yade-batch`` or ``submit`` by hand), runs them ``--jobs`` rows at a time (finished rows with the
 same parameters are kept, unfinished creep rows go on from their checkpoints), then writes
@@ -14,6 +14,11 @@ import os
 import time
 from dataclasses import replace
 from pathlib import Path
+
+from ..analysis.accuracy_study import creep_rows, load_study, ucs_rows
+from ..errors import GrainfracError
+from ..runs.batchrun import run_batch, write_table
+from ..runs.runio import write_csv
 
 REPO = Path(__file__).resolve().parents[2]
 STUDY_FILE = REPO / "params" / "accuracy_cost.toml"
@@ -33,8 +38,6 @@ def register(sub, common):
 
 
 def cmd_accuracy_cost(args) -> int:
-    from ..accuracy_study import creep_rows, load_study, ucs_rows
-    from ..runs.batchrun import run_batch, write_table
     study = load_study(args.study, quick=args.quick, repo=REPO)
     study = replace(study, folder=Path(args.out or study.folder).resolve())
     folder = study.folder
@@ -63,8 +66,6 @@ def summarise(study) -> int:
     from ..analysis.accuracy import history_measures, label_runs, markdown_table, pareto_figure, setting_rows
     from ..analysis.collect import code_version_note, collect_runs
     from ..analysis.study import read_history
-    from ..errors import GrainfracError
-    from ..runs.runio import write_csv
     folder = study.folder
     runs = collect_runs(folder)
     labelled = label_runs(study, runs) if not runs.empty else runs

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..errors import GrainfracError
+
 #: Columns that define a model variant in a UCS study.
 VARIANT = ("resolution.spheres_per_cell", "specimen.grain_size", "specimen.width", "specimen.height",
            "resolution.grain_model", "resolution.nodes_per_face", "confinement.stress")
@@ -32,9 +34,8 @@ def register(sub, common):
 def cmd_analyze_ucs(args) -> int:
     import pandas as pd
 
-    from ..analysis import collect_runs, group_stats
+    from ..analysis.collect import collect_runs, group_stats
     from ..analysis.study import fill_missing_params
-    from ..errors import GrainfracError
     folder = Path(args.folder)
     runs = collect_runs(folder)
     if runs.empty or "ucs_pa" not in runs:
@@ -80,7 +81,6 @@ def envelopes(runs, folder) -> list:
     from ..analysis.envelope import fit_hoek_brown, fit_mohr_coulomb
     from ..analysis.figures import envelope_figure
     from ..analysis.labdata import lab_property
-    from ..errors import GrainfracError
     done = runs[(runs["status"] == "finished") & runs["ucs_pa"].notna()]
     others = [v for v in VARIANT if v != CONFINEMENT] + [k for k in LOADING_VARIANT if k in runs]
     rows, lines = [], []

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 
 def register(sub, common):
-    from ..animation import DEFAULT_FPS, DEFAULT_FRAMES
+    from ..analysis.animation import DEFAULT_FPS, DEFAULT_FRAMES
     p = sub.add_parser("animate", help="crack-growth animation of a creep run (GIF; MP4 where ffmpeg exists)")
     p.add_argument("run_dir", metavar="RUN_DIR", help="folder of a creep run (its cracks.csv, history.csv, params.json)")
     p.add_argument("--log-time", action="store_true",
@@ -15,7 +15,7 @@ def register(sub, common):
 
 
 def cmd_animate(args) -> int:
-    from ..animation import animate_run
+    from ..analysis.animation import animate_run
     out = animate_run(args.run_dir, log_time=args.log_time, fps=args.fps, frames=args.frames, mp4=not args.no_mp4)
     mp4 = out["mp4"] or ("not written (--no-mp4)" if args.no_mp4 else "not written (no ffmpeg)")
     print(f"{out['frames']} frames: {out['gif']}, MP4 {mp4}, last frame {out['frame_png']} ({out['grains']})")

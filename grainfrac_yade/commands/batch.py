@@ -10,12 +10,22 @@ the exit status is 1 when a row did not finish a run, naming those rows.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from ..errors import GrainfracError
+from ..geometry.specimen import MAX_SEED, check_cell_count
+from ..geometry.tessellation import n_cells_for
+from ..params import load_parameters, require_plane, shipped_values
+from ..params.schema import field_spec
+from ..runs.batchrun import ON_CHANGE, RUN_COLUMNS, cell_value, check_columns, read_table_rows, row_outcomes, run_batch
+from .brazilian import require_disc_model
+from .creep import CREEP_ROW_COLUMNS, check_stress_range, outcome, resolve_stress
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}
+#: Bad rows listed by a refusal; the rest are counted (a file that is no table would list every line).
+MAX_LISTED_PROBLEMS = 10
 #: Exit status of a batch in which some row did not finish (rows checked and run; not a user error).
 EXIT_ROWS_FAILED = 1
 
@@ -43,18 +53,57 @@ def guess_test(columns, name: str = "") -> str:
 
 def row_columns(test: str) -> dict:
     """The run-control columns of a kind of row, with defaults (parameters aside)."""
-    from ..runs.batchrun import RUN_COLUMNS
     if test == "creep":
-        from .creep import CREEP_ROW_COLUMNS
         return dict(RUN_COLUMNS, **CREEP_ROW_COLUMNS)
     return dict(RUN_COLUMNS)
+
+
+def expected_cell(col: str, defaults: dict, controls: dict) -> str:
+    """What a cell of column ``col`` must be, as a fix: its type from the schema (unit, choices), else from the
+    type of its default (run columns: seed, out, study, ratio, ...)."""
+    try:
+        spec = field_spec(col)
+    except GrainfracError:
+        spec = None
+    if spec is not None:
+        unit = f" [{spec['unit']}]" if spec["unit"] not in ("", "1") else ""
+        if spec["check"] == "bool":
+            return f"column {col} takes True or False"
+        if spec["check"] == "choice":
+            return f"column {col} takes quoted text, one of {', '.join(repr(c) for c in spec['choices'])}"
+        if spec["check"].endswith("_int"):
+            return f"column {col} takes a whole number, e.g. {defaults.get(col, 1)!r}"
+        return f"column {col} takes a number{unit}, e.g. {defaults.get(col, 1.0)!r}"
+    default = defaults.get(col, controls.get(col))
+    if isinstance(default, str):
+        return f"column {col} takes quoted text, e.g. {default or 'name'!r}"
+    if isinstance(default, bool):
+        return f"column {col} takes True or False"
+    if isinstance(default, int):
+        return f"column {col} takes a whole number, e.g. {default!r}"
+    if isinstance(default, float):
+        return f"column {col} takes a number, e.g. {default!r}"
+    return "text cells must be quoted, e.g. 'fem'; numbers as they are, e.g. 1.5e6"
+
+
+def check_out_writable(out: str, where: str):
+    """GrainfracError (one line naming ``where``) if the row's ``out`` folder cannot be made or written: its
+    nearest existing folder must be a writable folder (checked with the rows, before any row runs)."""
+    path = Path(out).expanduser().absolute()
+    probe = path
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir():
+        raise GrainfracError(f"batch table {where}: out = {out!r}: {probe} is a file, not a folder; fix: give the "
+                             "row an out below a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise GrainfracError(f"batch table {where}: out = {out!r}: {probe} is not writable; fix: give the row an out "
+                             "in a folder you can write, or make that folder writable")
 
 
 def check_row(test: str, columns, cells: dict, where: str):
     """(overrides, controls) of one row, checked as the CLI and the row script check them; GrainfracError
     (one line, naming ``where``) if the row would be refused."""
-    from ..runs.batchrun import ON_CHANGE, cell_value, check_columns
-    from ..params import load_parameters, shipped_values
     defaults, controls = shipped_values(), row_columns(test)
     check_columns(columns, {**defaults, **controls}, where)
     values = {}
@@ -64,22 +113,23 @@ def check_row(test: str, columns, cells: dict, where: str):
         try:
             values[col] = cell_value(text)
         except ValueError as exc:
-            raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: text cells must be quoted, e.g. "
-                                 "'fem'") from None
+            raise GrainfracError(f"batch table {where}: column {col}: {exc}; fix: "
+                                 f"{expected_cell(col, defaults, controls)}") from None
     overrides = [(k, v) for k, v in values.items() if k in defaults and v != defaults[k]]
     controls.update({k: v for k, v in values.items() if k in controls})
     if controls["on_change"] not in ON_CHANGE:
         raise GrainfracError(f"batch table {where}: on_change = {controls['on_change']!r}; fix: use one of "
                              f"{', '.join(repr(v) for v in ON_CHANGE)}")
-    if not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool) or controls["seed"] < 0:
-        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number >= 0")
+    if (not isinstance(controls["seed"], int) or isinstance(controls["seed"], bool)
+            or not 0 <= controls["seed"] <= MAX_SEED):
+        raise GrainfracError(f"batch table {where}: seed = {controls['seed']!r}; fix: a whole number from 0 to "
+                             f"{MAX_SEED} (the range of a 32-bit seed)")
+    check_out_writable(str(controls["out"]) or str(Path("results", str(controls["study"]))), where)
     try:
         params = load_parameters(overrides=overrides)
     except GrainfracError as exc:
         raise GrainfracError(f"batch table {where}: {exc}") from None
     try:
-        from ..specimen import check_cell_count
-        from ..tessellation import n_cells_for
         sp = params.specimen
         check_cell_count(n_cells_for([sp.width, sp.height], sp.grain_size), "the row's specimen", sp.grain_size)
         _check_kind(test, params, controls)
@@ -89,10 +139,7 @@ def check_row(test: str, columns, cells: dict, where: str):
 
 
 def _check_kind(test, params, controls):
-    from ..params import require_plane
-    from .creep import check_stress_range, resolve_stress
     if test == "brazilian":
-        from .brazilian import require_disc_model
         require_disc_model(params)
         return
     require_plane(params, test)
@@ -108,7 +155,6 @@ def _check_kind(test, params, controls):
 def check_table(table, test=None) -> tuple:
     """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row`;
     else GrainfracError with one line per bad row."""
-    from ..runs.batchrun import read_table_rows
     columns, rows, problems = read_table_rows(table)
     test = test or guess_test(columns, Path(table).name)
     checked = {}
@@ -119,12 +165,14 @@ def check_table(table, test=None) -> tuple:
             problems.append(str(exc))
     if problems:
         problems.sort(key=_line_of)
-        raise GrainfracError(f"{table}: {len(problems)} bad row(s), nothing run; fix each:\n" + "\n".join(problems))
+        listed = problems[:MAX_LISTED_PROBLEMS]
+        if len(problems) > len(listed):
+            listed.append(f"... and {len(problems) - len(listed)} more bad rows (fix the ones above first)")
+        raise GrainfracError(f"{table}: {len(problems)} bad row(s), nothing run; fix each:\n" + "\n".join(listed))
     return test, checked
 
 
 def _line_of(problem: str) -> int:
-    import re
     m = re.search(r":(\d+)\b", problem)
     return int(m.group(1)) if m else 0
 
@@ -132,7 +180,6 @@ def _line_of(problem: str) -> int:
 def describe(summary: dict) -> str:
     """The result phrase of a finished row."""
     if "lifetime_s" in summary:
-        from .creep import outcome
         return f"creep {summary['stress_pa'] / 1e6:.1f} MPa: {outcome(summary)}"
     if "tensile_strength_pa" in summary:
         t = summary["tensile_strength_pa"]
@@ -142,7 +189,6 @@ def describe(summary: dict) -> str:
 
 
 def cmd_batch(args) -> int:
-    from ..runs.batchrun import row_outcomes, run_batch
     table = Path(args.table)
     if args.jobs < 1:
         raise GrainfracError(f"--jobs {args.jobs}: fix: at least 1")
@@ -173,5 +219,6 @@ def cmd_batch(args) -> int:
     if failed:
         print(f"{len(failed)} of {len(rows)} rows failed: lines {', '.join(str(o.line) for o in failed)} of {table}")
         return EXIT_ROWS_FAILED
-    print(f"all {len(rows)} rows finished")
+    skipped = sum(o.skipped for o in done.values())
+    print(f"all {len(rows)} rows finished" + (f" ({skipped} skipped: finished before)" if skipped else ""))
     return 0

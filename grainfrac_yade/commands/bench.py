@@ -42,6 +42,8 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ..engines.registry import ENGINE_NAMES, engine, engine_for
+
 #: Where the full bench writes by default.
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
 #: The finite-element-cells preset.
@@ -93,7 +95,7 @@ def register(sub, common):
                         f"{QUICK.events} events per scene, no runs to failure")
     p.add_argument("--out", help=f"JSON file to write (default {DEFAULT_OUT.relative_to(DEFAULT_OUT.parents[1])}; "
                                  "with --quick, results/bench_quick.json)")
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seed", type=seed_type, default=1, help="specimen seed (default 1)")
     p.add_argument("--ratio", type=float, default=DEFAULT_RATIO,
                    help="creep load as a ratio of each scene's calibration.reference_ucs (default 0.7)")
@@ -188,8 +190,7 @@ def scene_params(user_files, scene_files, user_overrides, scene_overrides):
 def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
     """Ramp, hold and relax one scene as a creep run does; time a few events, then its stepping and bond I/O."""
     from ..errors import GrainfracError
-    from ..specimen import build_specimen
-    from ..engines import engine_for
+    from ..geometry.specimen import build_specimen
     engine = engine_for(params)
     stress = ratio * params.calibration.reference_ucs
     specimen = build_specimen(params, seed)
@@ -219,8 +220,7 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
     """Creep to failure with the event and with the paper clock, one run each, same specimen and load.
 
     ``params_for_clock(clock)`` gives the parameters with ``stress_corrosion.clock`` set."""
-    from ..engines import engine_for
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     out = {}
     for clock in ("event", "paper"):
         params = params_for_clock(clock)
@@ -260,8 +260,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
     from ..errors import GrainfracError
     from ..grains import critical_dem_step
     from ..runs.runio import code_version, write_json
-    from ..specimen import build_specimen
-    from ..engines import engine_for
+    from ..geometry.specimen import build_specimen
     progress = progress or (lambda msg: None)
     if creep_stress_mpa is not None and not creep_stress_mpa > 0:
         raise GrainfracError(f"--creep-stress {creep_stress_mpa}: a creep stress must be positive [MPa]; fix: e.g. "
@@ -307,8 +306,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
 def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
     """One paper-size finite-element creep run to failure (seed 1, event clock): lifetime or what ended it, DEM
     steps, CPU time, and the relaxation steps per event."""
-    from ..engines import engine_for
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     _, width, height = FEM_SIZES[-1]
     params = scene_params(extra_files, (FEM_PRESET,), [f"specimen.width={width}", f"specimen.height={height}",
                                                       *overrides], ("stress_corrosion.clock=event",))
@@ -371,7 +369,6 @@ def cpu_model() -> str:
 
 def machine() -> dict:
     import numpy
-    from ..engines import ENGINE_NAMES, engine
     return {"cpu_model": cpu_model(), "cores": os.cpu_count(), "cores_usable": len(os.sched_getaffinity(0)),
             "omp_num_threads": os.environ.get("OMP_NUM_THREADS", "unset"), "python": platform.python_version(),
             **{name: engine(name).version() for name in ENGINE_NAMES}, "numpy": numpy.__version__,

@@ -4,7 +4,7 @@ load_strain.png, crack maps at the peak and at the end.
 Tensile strength sigma_t = 2 P / (pi D t) (ISRM 1978 suggested method) at the peak load P of a
 disc of diameter D (``brazilian.diameter``) and thickness t (``specimen.thickness``), the disc a
 Voronoi tessellation clipped to the circle with the grain size and composition of the UCS
-specimen (:mod:`grainfrac_yade.disc`), loaded by two rigid jaws
+specimen (:mod:`grainfrac_yade.geometry.disc`), loaded by two rigid jaws
 (:mod:`grainfrac_yade.protocols.brazilian`).
 """
 from __future__ import annotations
@@ -13,7 +13,11 @@ import math
 
 import numpy as np
 
+from ..engines.registry import engine_for
 from ..errors import GrainfracError
+from ..protocols import brazilian as brazilian_test
+from ..protocols.cracks import bond_segments, crack_table
+from ..protocols.levers import Levers, new_breaks
 
 
 def register(sub, common):
@@ -22,7 +26,7 @@ def register(sub, common):
     p.add_argument("--diameter", type=float, help="disc diameter [m] (brazilian.diameter)")
     p.add_argument("--grain-size", type=float, help="grain size [m] (specimen.grain_size)")
     p.add_argument("--spheres-per-cell", type=int, help="resolution.spheres_per_cell")
-    from ..cli import seed_type
+    from ._args import seed_type
     p.add_argument("--seed", type=seed_type, default=1, help="random seed of the specimen (>= 0)")
     p.add_argument("--tensile-scale", type=float, metavar="F",
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
@@ -43,7 +47,7 @@ def register(sub, common):
 
 
 def cmd_brazilian(args) -> int:
-    from ..cli import load_params_from_args
+    from ._args import load_params_from_args
     if args.resume:
         from .resume import refuse_resume_conflicts, resumable_run
         refuse_resume_conflicts(args)
@@ -63,7 +67,6 @@ def cmd_brazilian(args) -> int:
         if args.tensile_scale is not None:
             extra += tensile_scale_overrides(params, args.tensile_scale)
         params = _reload(args, extra, params, args.tensile_scale)
-    from ..protocols.levers import Levers
     levers = Levers(slit_fraction=args.slit_fraction, strength_cv=args.strength_cv, block_rotation=args.block_rotation)
     out = args.out or f"results/brazilian_seed{args.seed}"
     summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers,
@@ -73,7 +76,7 @@ def cmd_brazilian(args) -> int:
 
 
 def _reload(args, extra, base, factor):
-    from ..cli import overrides_from_args
+    from ._args import overrides_from_args
     from ..params import load_parameters
     params = load_parameters(extra_files=args.params, overrides=overrides_from_args(args) + extra)
     if factor is not None:
@@ -144,14 +147,11 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     ``vtk_every``: VTK series in ``out/vtk/`` at every k-th history row and the end (None: none; not
     carried across a resume)."""
     from pathlib import Path
-    from ..brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
+    from ..analysis.brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                       crack_location, hondros_centre_factor)
     from ..analysis.figures import run_brazilian_load_figure
-    from ..specimen import build_disc_specimen
+    from ..geometry.specimen import build_disc_specimen
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
-    from ..engines import engine_for
-    from ..protocols import brazilian as brazilian_test
-    from ..protocols.levers import Levers, new_breaks
     require_disc_model(params)
     specimen = build_disc_specimen(params, seed)     # bad geometry stops before the folder is made
     if resume:
@@ -199,9 +199,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
 def write_disc_cracks(path, scene):
     """cracks.csv: one row per bond broken during the test (DEM step, mode, kind, position, orientation, and
     whether it lies in the central band); slits (:mod:`~grainfrac_yade.yade_adapter.levers`) are left out."""
-    from ..brazilian_analysis import in_central_band
-    from ..protocols.cracks import crack_table
-    from ..protocols.levers import new_breaks
+    from ..analysis.brazilian_analysis import in_central_band
     from ..runs.runio import write_csv
     idx = np.flatnonzero(new_breaks(scene))
     t = scene.specimen.tessellation
@@ -212,7 +210,7 @@ def write_disc_cracks(path, scene):
 
 def band_guides(tessellation) -> np.ndarray:
     """(2, 2, 2) the central band's two edges x = x_c +- D/6, clipped to the disc [m]."""
-    from ..brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
+    from ..analysis.brazilian_analysis import CENTRAL_BAND_HALF_WIDTH
     c, r = tessellation.centre, tessellation.radius
     dx = CENTRAL_BAND_HALF_WIDTH * 2 * r
     dy = math.sqrt(r * r - dx * dx)
@@ -222,9 +220,7 @@ def band_guides(tessellation) -> np.ndarray:
 def draw_crack_maps(scene, summary, broken_peak, mode_peak, out):
     """crack_map_peak.png (broken bonds at the failure load, the peak before the split) and crack_map_end.png
     (at the end of the test), with the central band's edges dashed."""
-    from ..plotting import crack_map
-    from ..protocols.cracks import bond_segments
-    from ..protocols.levers import new_breaks
+    from ..analysis.plotting import crack_map
     specimen, seed = scene.specimen, summary["seed"]
     guides = band_guides(specimen.tessellation)
     sigma = summary["tensile_strength_pa"]
@@ -246,7 +242,6 @@ def run_brazilian_in_yade(rows):
     goes on from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
     ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.yade_adapter.batch`)."""
     from ..params import load_parameters
-    from ..protocols.levers import Levers
     from ..runs.runio import read_checkpoint_state
     read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name
     with row_errors():
@@ -260,7 +255,8 @@ def run_brazilian_in_yade(rows):
             Levers().to_dict():   # a CLI test with levers in this folder: not this row's (rows have none)
         action, note = "run", f"{out}: its checkpoint is of a test with levers (brazilian --slit-fraction ...): started again"
     if action == "skip":
-        print(f"Brazilian row already finished, skipped: {out}")
+        from ..runs.batchrun import ROW_SKIPPED
+        print(f"Brazilian {ROW_SKIPPED}: {out}")
         return
     if note:
         print(note)

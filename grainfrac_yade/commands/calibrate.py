@@ -13,11 +13,19 @@ before and after, and to ``OUT/calibration.csv`` (one row per seed and round).
 """
 from __future__ import annotations
 
+import dataclasses
+import multiprocessing as mp
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import GrainfracError
+from ..params import load_parameters, require_plane
+from ..runs.runio import commit_run_dir, prepare_run_dir, write_csv
+from ._args import seed_type
+from .creep import positive_flag, stress_flag
+from .ucs import run_ucs_to_folder
 
 #: UCS target [Pa]: the paper's simulated UCS, section 3.1 (shared/reference/paper_values.csv).
 TARGET_UCS = 234.5e6
@@ -32,17 +40,14 @@ PA_PER_GPA = 1e9
 
 def _gpa(text: str) -> float:
     """argparse type of a modulus flag: GPa, returned in Pa."""
-    from .creep import positive_flag
     return positive_flag(text, "a modulus", "GPa", PA_PER_GPA, "69")
 
 
 def register(sub, common):
     p = sub.add_parser("calibrate", help="fit strength/stiffness scale factors to UCS 234.5 MPa and E 69 GPa")
     common(p, geometry=True)
-    from ..cli import seed_type
     p.add_argument("--seeds", type=seed_type, nargs="+", default=[1, 2, 3, 4, 5], help="specimen seeds (>= 0)")
     p.add_argument("--rounds", type=int, default=2, help="fixed-point rounds after the 'before' round")
-    from .creep import stress_flag
     p.add_argument("--target-ucs", type=stress_flag, default=TARGET_UCS, metavar="MPA",
                    help=f"UCS target [MPa, like every stress flag] (default {TARGET_UCS / 1e6:g})")
     p.add_argument("--target-young", type=_gpa, default=TARGET_YOUNG, metavar="GPA",
@@ -53,8 +58,6 @@ def register(sub, common):
 
 
 def cmd_calibrate(args, params) -> int:
-    from ..params import load_parameters, require_plane
-    from ..runs.runio import commit_run_dir, prepare_run_dir, write_csv
     base = list(args.resolved_overrides)   # the overrides of ``params``, for each round's parameter set
     require_plane(params, "calibrate")
     out = prepare_run_dir(args.out or "results/calibration", "calibrate", params, args.seeds,
@@ -89,7 +92,6 @@ def cmd_calibrate(args, params) -> int:
 
 
 def _run_one(job):
-    from .ucs import run_ucs_to_folder
     params, seed, folder = job
     return run_ucs_to_folder(params, seed, folder, overwrite=True)
 
@@ -99,8 +101,6 @@ def _run_seeds(params, seeds, folders, jobs):
     work = [(params, seed, folder) for seed, folder in zip(seeds, folders)]
     if jobs <= 1:
         return [_run_one(w) for w in work]
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
     with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
         return list(pool.map(_run_one, work))
 
@@ -117,7 +117,6 @@ FITTED_KEYS = ("strength_scale", "stiffness_scale", "reference_ucs")
 
 def carried_lines(calibration) -> list:
     """``key = value  # unit, meaning`` lines of the [calibration] keys not fitted here, at ``calibration``'s values."""
-    import dataclasses
     return [f"{f.name} = {getattr(calibration, f.name)!r}    # {f.metadata['unit']}, {f.metadata['doc']}"
             for f in dataclasses.fields(calibration) if f.name not in FITTED_KEYS]
 

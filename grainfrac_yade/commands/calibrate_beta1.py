@@ -17,6 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import GrainfracError
+from ..law import scales_with_beta1
+from ..params import write_parameter_file
+from ..runs.runio import code_version
+
 #: Relative tolerance on the creep stress when selecting runs at the paper's load.
 STRESS_MATCH_RTOL = 1e-6
 
@@ -42,8 +47,6 @@ def select_reference_runs(runs, stress_pa: float):
     """Event-clock creep runs of a strength law at ``stress_pa`` that failed in creep: a positive lifetime,
     as the lifetime analysis classifies them (a run that ran away at creep time 0 failed at load)."""
     from ..analysis.lifetimes import classify_runs
-    from ..law import scales_with_beta1
-    from ..errors import GrainfracError
     need = ("stress_pa", "lifetime_s", "failed", "clock", "law")
     if runs.empty or any(c not in runs for c in need):
         raise GrainfracError("no finished creep runs in the folder; fix: run params/lifetime_ldb.table first")
@@ -63,8 +66,6 @@ def select_reference_runs(runs, stress_pa: float):
 def cmd_calibrate_beta1(args) -> int:
     from ..analysis.collect import collect_runs
     from ..analysis.labdata import paper_reference
-    from ..errors import GrainfracError
-    from ..runs.runio import code_version
     folder = Path(args.folder)
     if not folder.is_dir():
         raise GrainfracError(f"{folder}: study folder not found; fix: give the folder of the creep study")
@@ -72,7 +73,6 @@ def cmd_calibrate_beta1(args) -> int:
     runs, beta1_run = select_reference_runs(collect_runs(folder), ref.stress_pa)
     fit = beta1_factor(runs["lifetime_s"].astype(float), ref.lifetime_s)
     beta1 = beta1_run * fit["factor"]
-    from ..params import write_parameter_file
     out = Path(args.out or Path(__file__).resolve().parents[2] / "params" / "stress_corrosion_calibrated.toml")
     header = [
         "Calibrated stress-corrosion rate: ONE factor on beta1, the same for every load.",

@@ -18,7 +18,14 @@ import json
 import math
 from pathlib import Path
 
+from ..analysis.lifetime_calibration import ModelPoint, fit
 from ..errors import GrainfracError
+from ..law import scales_with_beta1, time_scaling_laws
+from ..params import flat_values, load_parameters, require_plane, write_parameter_file
+from ..runs.batchrun import run_batch, write_table
+from ..runs.runio import code_version, comparable_parameters, write_csv
+from ._args import float_list_type, seed_list_type
+from .creep import stress_flag
 
 #: Keys of the fitted parameters, by law.
 BETA2_KEY = {"hillig_charles": "stress_corrosion.beta2", "normalised": "stress_corrosion.beta2_normalised"}
@@ -28,27 +35,18 @@ STRESS_RTOL = 1e-9
 DEFAULT_SEEDS = (1, 2, 3)
 
 
-def _floats(text):
-    return [float(x) for x in text.split(",") if x.strip()]
-
-
-def _ints(text):
-    return [int(x) for x in text.split(",") if x.strip()]
-
-
 def register(sub, common):
-    from .creep import stress_flag
     p = sub.add_parser("calibrate-lifetimes", help="fit beta1, beta2 (and a threshold) to lab lifetimes (runs "
                                                    "the creep rows it needs through yade-batch)")
     common(p)
     p.add_argument("study", help="study folder: its finished creep runs are reused; new runs go to STUDY/calibrate/")
     p.add_argument("--lab", required=True, help="CSV driving_stress_ratio,lifetime_s[,source]")
-    p.add_argument("--seeds", type=_ints, default=None,
+    p.add_argument("--seeds", type=seed_list_type, default=None,
                    help="specimen seeds of each ratio (default: those of the study's creep runs, else 1,2,3)")
     p.add_argument("--ucs", type=stress_flag, default=None, metavar="MPA",
                    help="UCS [MPa, like every stress flag; files and batch columns in Pa] the lab ratios refer to (default: the study's runs' ucs_pa if they agree, else "
                         "calibration.reference_ucs)")
-    p.add_argument("--threshold-ratios", type=_floats, default=None, metavar="R1,R2,...",
+    p.add_argument("--threshold-ratios", type=float_list_type, default=None, metavar="R1,R2,...",
                    help="also fit stress_corrosion.threshold_ratio among these values, e.g. 0,0.3,0.4")
     p.add_argument("--jobs", type=int, default=1, help="creep runs at a time")
     p.set_defaults(func=cmd_calibrate_lifetimes, with_params=True)
@@ -57,7 +55,6 @@ def register(sub, common):
 def _digest(tree: dict) -> str:
     """Identity of a parameter tree (params.json layout) for reuse: every key that changes results."""
     from ..analysis.study import VARIANT_IGNORE
-    from ..runs.runio import comparable_parameters
     flat = {k: v for k, v in comparable_parameters(tree).items() if k not in VARIANT_IGNORE}
     return hashlib.sha256(json.dumps(flat, sort_keys=True).encode()).hexdigest()
 
@@ -83,7 +80,6 @@ def model_point(ratio, summaries) -> "ModelPoint | None":
     """The model at one ratio from its seeds' summaries: geometric mean of the lifetimes; a lower bound if a
     seed did not fail; None if no seed gives a value (failed on loading, numerical failure, broken apart before the
     test)."""
-    from ..analysis.lifetime_calibration import ModelPoint
     logs, censored, notes = [], False, []
     for s in summaries:
         if s.get("numerical_failure"):
@@ -109,7 +105,6 @@ class BatchModel:
     yade-batch (missing rows only) or reused from the study."""
 
     def __init__(self, args, params, ratios, seeds, ucs, study: Path, progress=print):
-        from ..params import flat_values
         self.args, self.params, self.ratios, self.seeds, self.ucs = args, params, ratios, seeds, ucs
         self.study, self.progress = study, progress
         self.base = flat_values(args.params, args.resolved_overrides)
@@ -117,12 +112,10 @@ class BatchModel:
         self.runs = 0
 
     def trial_params(self, beta2, threshold):
-        from ..params import load_parameters
         extra = [(self.beta2_key, beta2), (THRESHOLD_KEY, threshold)]
         return load_parameters(extra_files=self.args.params, overrides=list(self.args.resolved_overrides) + extra)
 
     def __call__(self, beta2, threshold):
-        from ..runs.batchrun import run_batch, write_table
         params = self.trial_params(beta2, threshold)
         digest = _digest(params.to_dict())
         known = [r for r in finished_runs(self.study) if r[0] == digest]
@@ -182,10 +175,6 @@ def _fit_lines(result, trial, beta1) -> list:
 
 def cmd_calibrate_lifetimes(args, params) -> int:
     from ..analysis.labdata import read_lab_csv
-    from ..analysis.lifetime_calibration import fit
-    from ..law import scales_with_beta1, time_scaling_laws
-    from ..params import require_plane, write_parameter_file
-    from ..runs.runio import code_version, write_csv
     require_plane(params, "calibrate-lifetimes")
     sc = params.stress_corrosion
     if not scales_with_beta1(sc.law) or sc.clock != "event":

@@ -6,7 +6,14 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engines.registry import engine_for
 from ..errors import GrainfracError
+from ..protocols.cracks import bond_segments, broken_counts, crack_table
+
+
+#: Fractions of the lifetime that ``--vtk-fractions`` alone writes: the crack maps' (``analysis.figures.MAP_FRACTIONS``,
+#: held equal by tests/test_newcomer_inputs.py; not imported here, which would load matplotlib to build the parser).
+LIFE_FRACTIONS = (0.1, 0.5, 0.9, 1.0)
 
 
 def register(sub, common):
@@ -28,7 +35,8 @@ def register(sub, common):
     p.add_argument("--vtk-every", type=_positive_int, default=None, metavar="K",
                    help="also write VTK files at every K-th history row (one row per event of the event clock, "
                         "per creep step of the paper clock) and at the end, into DIR/vtk/")
-    p.add_argument("--vtk-fractions", type=_fractions, nargs="?", const=None, default=False, metavar="F1,F2,...",
+    p.add_argument("--vtk-fractions", type=_fractions, nargs="?", const=list(LIFE_FRACTIONS), default=False,
+                   metavar="F1,F2,...",
                    help="after the run, write the bond states at these fractions of the lifetime (of the run if "
                         "it did not fail; default the crack maps' 0.1,0.5,0.9,1) on the undeformed specimen, into "
                         "DIR/vtk/life_cells.pvd and life_bonds.pvd")
@@ -304,7 +312,7 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
     import json
 
     from ..analysis.runparams import load_run_parameters
-    from ..runs.runio import CHECKPOINT, SUMMARY, checkpoint_folder, read_checkpoint_state
+    from ..runs.runio import CHECKPOINT, SUMMARY, check_files, checkpoint_folder, read_checkpoint_state
     folder = Path(folder)
     try:
         command = json.loads((folder / "run.json").read_text()).get("command")
@@ -315,6 +323,8 @@ def resume_creep_folder(folder, progress=None) -> dict | None:
         raise GrainfracError(f"{folder}: holds a {command!r} run, not a creep run; fix: give the folder of a creep run")
     if (folder / SUMMARY).exists():
         return None
+    if checkpoint_folder(folder) is not None:
+        check_files(checkpoint_folder(folder))
     state = read_checkpoint_state(folder)
     if state is None and checkpoint_folder(folder) is not None:
         where = checkpoint_folder(folder)
@@ -354,15 +364,13 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     import time
 
     from ..analysis.figures import MAP_FRACTIONS, run_bond_stress_figure, run_strain_time_figure
-    from ..creep_analysis import CreepStages, damage_index, resolve_creep_stages
+    from ..analysis.creep_analysis import CreepStages, damage_index, resolve_creep_stages
     from ..params import require_plane
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..runs.runio import (commit_run_dir, prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                          write_json)
-    from ..specimen import build_specimen
+    from ..geometry.specimen import build_specimen
     from ..wave import budget_fields
-    from ..engines import engine_for
-    from ..protocols.cracks import bond_segments, broken_counts
     t0, c0 = time.time(), time.process_time()
     require_plane(params, "creep")
     out = Path(out) if resume else prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
@@ -423,6 +431,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
         "vtk_creep_times_s": run.vtk_written,
+        "vtk_merged_times": run.vtk_merged,
+        "vtk_times_not_reached_s": list(run.vtk_times) if run.vtk_folder is not None else [],
         **summary_header(params, seed),
     }
     if getattr(run, "resumes", None):
@@ -481,8 +491,7 @@ def history_columns(rows) -> dict:
 def write_crack_list(path, run):
     """cracks.csv: bond, creep time (empty for a crack of the ramp), phase (``ramp`` or ``creep``), mode, kind,
     position, orientation, segment end points and the creep time its cells separated (macrocrack; empty if
-    never); docs/output_files.md."""
-    from ..protocols.cracks import bond_segments, crack_table
+    never); docs/reference/output_files.md."""
     from ..runs.runio import write_csv
     sc = run.scene
     idx = np.flatnonzero(sc.broken)
@@ -529,7 +538,8 @@ def run_creep_in_yade(rows):
         out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
                                      {"seed": int(controls["seed"]), "stress_pa": stress})
     if action == "skip":
-        print(f"creep row already finished, skipped: {out}")
+        from ..runs.batchrun import ROW_SKIPPED
+        print(f"creep {ROW_SKIPPED}: {out}")
         return
     if note:
         print(note)

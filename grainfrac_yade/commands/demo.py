@@ -16,25 +16,23 @@ import os
 import time
 from pathlib import Path
 
+from ..errors import GrainfracError
+from ..params import flat_values, require_plane
+from ..runs.batchrun import read_table_rows, row_outcomes, run_batch, write_table
+from ._args import float_list_type, seed_list_type
+from .creep import outcome
+
 #: Demo defaults: a 10 x 20 mm specimen (about 200 cells; a creep run takes 15-40 s on one core).
 DEMO_WIDTH_M, DEMO_HEIGHT_M = 10e-3, 20e-3
 DEMO_SEEDS = (1, 2)
 DEMO_RATIOS = (0.7, 0.8, 0.9)
 
 
-def _floats(text):
-    return [float(x) for x in text.split(",") if x.strip()]
-
-
-def _ints(text):
-    return [int(x) for x in text.split(",") if x.strip()]
-
-
 def register(sub, common):
     p = sub.add_parser("demo", help="main job: small lifetime study (specimen, UCS, creep at 3 ratios, report)")
     common(p, geometry=False)
-    p.add_argument("--ratios", type=_floats, default=list(DEMO_RATIOS), help="driving-stress ratios, e.g. 0.7,0.8,0.9")
-    p.add_argument("--seeds", type=_ints, default=list(DEMO_SEEDS), help="specimen seeds, e.g. 1,2")
+    p.add_argument("--ratios", type=float_list_type, default=list(DEMO_RATIOS), help="driving-stress ratios, e.g. 0.7,0.8,0.9")
+    p.add_argument("--seeds", type=seed_list_type, default=list(DEMO_SEEDS), help="specimen seeds, e.g. 1,2")
     p.add_argument("--width", type=float, default=DEMO_WIDTH_M, help="specimen width [m]")
     p.add_argument("--height", type=float, default=DEMO_HEIGHT_M, help="specimen height [m]")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time (default: cores)")
@@ -46,9 +44,6 @@ def _say(t0, msg):
 
 
 def cmd_demo(args, params) -> int:
-    from ..runs.batchrun import run_batch, write_table
-    from ..errors import GrainfracError
-    from ..params import flat_values, require_plane
     from .specimen import run_specimen
     t0 = time.time()
     repo = Path(__file__).resolve().parents[2]
@@ -98,7 +93,6 @@ def cmd_demo(args, params) -> int:
 def check_demo_arguments(args, params) -> None:
     """Refuse, before anything runs, what would make rows fail: ratios outside (0, 1), negative seeds, no
     seeds or ratios, fewer than one job (one line each)."""
-    from ..errors import GrainfracError
     bad = [r for r in args.ratios if not 0 < r < 1]
     if bad or not args.ratios:
         raise GrainfracError(f"--ratios {','.join(f'{r:g}' for r in args.ratios) or '(none)'}: a driving-stress "
@@ -112,7 +106,6 @@ def check_demo_arguments(args, params) -> None:
 
 def _failed_rows(table, log_dir) -> list:
     """The rows of ``table`` run into ``log_dir`` that did not finish a run (:func:`row_outcomes`)."""
-    from ..runs.batchrun import read_table_rows, row_outcomes
     _, rows, _ = read_table_rows(table)
     return [o for o in row_outcomes(table, log_dir, list(rows)) if not o.ok]
 
@@ -128,6 +121,5 @@ def _ucs_line(summary: dict) -> str:
 
 
 def _creep_line(folder: Path) -> str:
-    from .creep import outcome
     s = _read(folder)
     return f"creep {folder.name}: {s['stress_pa'] / 1e6:.0f} MPa, {outcome(s)}, {s['n_events']} events"

@@ -1,6 +1,15 @@
 """``elastic``: static linear-elastic reference of a specimen (no YADE); summary.json and histograms."""
 from __future__ import annotations
 
+import argparse
+
+from ..elastic import GRAIN_MODELS, contact_ratios, elastic_summary
+from ..geometry.grainmesh import CONTACT_PLACEMENTS
+from ..geometry.specimen import build_specimen
+from ..grains import grain_model
+from ..params import FlagOverride, require_plane
+from ..runs.runio import code_version, commit_run_dir, prepare_run_dir, write_json
+
 
 #: Static models of the YADE fem cells and the grain model each one solves.
 CLUSTER_MODELS = {"fem": "fem"}
@@ -10,8 +19,6 @@ RETIRED_GRAINS = {"deformable": "the triangle-mesh reference is called mesh now;
 
 
 def register(sub, common):
-    from ..elastic import GRAIN_MODELS
-    from ..grainmesh import CONTACT_PLACEMENTS
     p = sub.add_parser("elastic", help="static elastic reference: E, nu and the contact stress tail "
                                        "of rigid, mesh and fem cells (seconds, no YADE)")
     common(p)
@@ -33,14 +40,12 @@ def register(sub, common):
 
 def _grains(text: str) -> str:
     """``--grains`` value; one line for a retired name."""
-    import argparse
     if text in RETIRED_GRAINS:
         raise argparse.ArgumentTypeError(f"{text!r}: {RETIRED_GRAINS[text]}")
     return text
 
 
 def _model_overrides(args) -> list:
-    from ..params import FlagOverride
     out = ([FlagOverride("resolution.nodes_per_face", args.nodes_per_face, "--nodes-per-face")]
            if args.nodes_per_face is not None else [])
     if args.grains in CLUSTER_MODELS:
@@ -49,7 +54,6 @@ def _model_overrides(args) -> list:
 
 
 def cmd_elastic(args, params) -> int:
-    from ..params import require_plane
     require_plane(params, "elastic")
     out = args.out or f"results/elastic_seed{args.seed}"
     summary = run_elastic_to_folder(params, args.seed, out, args.grains, params.resolution.nodes_per_face, args.contacts,
@@ -72,10 +76,6 @@ def run_elastic_to_folder(params, seed, out, grains="mesh", nodes_per_face=2, co
     ``models``.
     """
     from ..analysis.figures import contact_stress_histograms
-    from ..elastic import contact_ratios, elastic_summary
-    from ..grains import grain_model
-    from ..runs.runio import code_version, commit_run_dir, prepare_run_dir, write_json
-    from ..specimen import build_specimen
     out = prepare_run_dir(out, "elastic", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     models, ratios = {}, {}

@@ -5,7 +5,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from ..analysis.runparams import load_run_parameters
 from ..errors import GrainfracError
+from ..runs.runio import CHECKPOINT, SUMMARY, check_files, checkpoint_folder, read_checkpoint_state
 
 #: Options that shape a run: refused with --resume (the run folder holds them).
 RESUME_CONFLICTS = (("overrides", "--set"), ("params", "--params"), ("width", "--width"), ("height", "--height"),
@@ -33,8 +35,6 @@ def refuse_resume_conflicts(args):
 def resumable_run(folder, command: str):
     """(parameters, checkpoint state) of the unfinished ``command`` run in ``folder``, or None if it is
     finished (summary.json).  GrainfracError (one line) if the folder holds no such run or no checkpoint."""
-    from ..analysis.runparams import load_run_parameters
-    from ..runs.runio import CHECKPOINT, SUMMARY, read_checkpoint_state
     folder = Path(folder)
     try:
         found = json.loads((folder / "run.json").read_text()).get("command")
@@ -46,6 +46,8 @@ def resumable_run(folder, command: str):
                              f"`{found} --resume {folder}`, or give the folder of a {command} run")
     if (folder / SUMMARY).exists():
         return None
+    if checkpoint_folder(folder) is not None:
+        check_files(checkpoint_folder(folder))
     state = read_checkpoint_state(folder)
     if state is None:
         raise GrainfracError(f"{folder}: no checkpoint to resume from ({CHECKPOINT}/ missing: the run stopped before "

@@ -5,10 +5,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engines.registry import engine_for
 from ..grains import critical_dem_step, layout_for
-from ..plotting import specimen_figure
+from ..analysis.plotting import specimen_figure
 from ..runs.runio import commit_run_dir, prepare_run_dir, write_json
-from ..specimen import build_specimen
+from ..geometry.specimen import build_specimen
 
 
 def specimen_record(specimen, layout, params=None) -> dict:
@@ -60,7 +61,6 @@ def run_specimen_in_yade(rows):
     """Entry of ``yade_scripts/specimen.py``: parameters from the batch table; counts read from the scene
     its engine builds.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
     ``run_folder_name``)."""
-    from ..engines import engine_for
     from ..params import load_parameters
     read_table, row_errors, run_folder_name = rows.read_table, rows.row_errors, rows.run_folder_name
     with row_errors():

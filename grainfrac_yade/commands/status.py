@@ -9,8 +9,10 @@ answer; without them the states come from the files alone, and the output says s
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 
-from ..runs.slurm import STATES
+from ..runs.slurm import STATES, study_states
 
 
 def register(sub, common):
@@ -22,7 +24,6 @@ def register(sub, common):
 
 def status_report(folder) -> dict:
     """The states of a submitted study as one JSON-ready dict."""
-    from ..runs.slurm import study_states
     record, states, queue, acct = study_states(folder)
     counts = {s: sum(1 for x in states if x.state == s) for s in STATES}
     return {"study": record["study"], "folder": str(folder), "table": record["source_table"],
@@ -35,13 +36,11 @@ def status_report(folder) -> dict:
 
 def _short(path: str) -> str:
     """``path`` relative to the current folder when inside it."""
-    import os
     rel = os.path.relpath(path)
     return path if rel.startswith("..") else rel
 
 
 def cmd_status(args) -> int:
-    from pathlib import Path
     rep = status_report(Path(args.folder))
     if args.json:
         print(json.dumps(rep, indent=2))

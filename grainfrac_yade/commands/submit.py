@@ -13,8 +13,17 @@ one starts again, or resumes where the batch code resumes it).
 """
 from __future__ import annotations
 
+import shutil
 import subprocess
 from pathlib import Path
+
+from ..errors import GrainfracError
+from ..params import shipped_values
+from ..runs.batchrun import RUN_COLUMNS, check_columns
+from ..runs.slurm import (SubmitOptions, cell_value, frozen_table_text, log_path, new_record, now_iso, read_batch_table,
+                          read_json_file, record_path, render_sbatch, slurm_dir, study_dir_of, study_states,
+                          table_digest, write_record, write_text_atomically)
+from .creep import CREEP_ROW_COLUMNS
 
 #: Scripts by the table columns that make a row a creep row.
 CREEP_COLUMNS = ("ratio", "stress")
@@ -44,7 +53,6 @@ def _repo() -> Path:
 
 def choose_script(table, script) -> Path:
     """The YADE script of the rows: ``script`` if given, else creep.py for creep tables, else ucs.py."""
-    from ..errors import GrainfracError
     if script is None:
         name = "creep.py" if any(c in table.columns for c in CREEP_COLUMNS) else "ucs.py"
         return _repo() / "yade_scripts" / name
@@ -57,11 +65,8 @@ def choose_script(table, script) -> Path:
 
 def check_table_columns(table, command: str) -> None:
     """Columns must be parameter paths or run columns the script reads (one line naming the column)."""
-    from ..params import shipped_values
-    from ..runs.batchrun import RUN_COLUMNS, check_columns
     extra = {}
     if command == "creep":
-        from .creep import CREEP_ROW_COLUMNS
         extra = CREEP_ROW_COLUMNS
     elif command not in ("ucs",):
         return   # another script: its own columns
@@ -71,8 +76,6 @@ def check_table_columns(table, command: str) -> None:
 
 def check_out_column(table, study_dir: Path) -> None:
     """A row's ``out`` cell must keep its run folder inside the study folder (or be empty)."""
-    from ..errors import GrainfracError
-    from ..runs.slurm import cell_value
     for r in table.rows:
         out = cell_value(r.cells.get("out", "''"))
         if out in ("", None):
@@ -85,8 +88,6 @@ def check_out_column(table, study_dir: Path) -> None:
 
 def rows_to_submit(study_dir, record, table) -> tuple:
     """(rows, states, note) of a study submitted before: rows neither finished nor queued/running."""
-    from ..errors import GrainfracError
-    from ..runs.slurm import record_path, study_states, table_digest
     if record.get("table_digest") != table_digest(table):
         raise GrainfracError(f"{record_path(study_dir)}: study {record['study']!r} was submitted from "
                              f"{record['source_table']} with other rows or columns than {table.path}; fix: "
@@ -102,10 +103,6 @@ def rows_to_submit(study_dir, record, table) -> tuple:
 
 
 def cmd_submit(args) -> int:
-    from ..errors import GrainfracError
-    from ..runs.slurm import (SubmitOptions, frozen_table_text, log_path, new_record, now_iso, read_batch_table,
-                         read_json_file, record_path, render_sbatch, slurm_dir, study_dir_of, write_record,
-                         write_text_atomically)
     options = SubmitOptions(study=args.study, partition=args.partition, time=args.time,
                             cpus_per_task=args.cpus_per_task, max_running=args.max_running)
     table = read_batch_table(args.table)
@@ -143,7 +140,6 @@ def cmd_submit(args) -> int:
         print(f"# dry run: {len(todo)} row(s) {rows_text} of {args.table} would run into {study_dir}/; "
               "nothing written or submitted")
         return 0
-    import shutil
     sbatch = shutil.which("sbatch")
     if sbatch is None:
         raise GrainfracError("sbatch not found on PATH; fix: submit from a SLURM login node (Debian: apt-get install "

@@ -5,6 +5,9 @@ import sys
 
 import numpy as np
 
+from ..engines.registry import engine_for
+from ..protocols import ucs as ucs_test
+from ..protocols.cracks import bond_segments, crack_table
 from .creep import add_confinement_option, check_stress_range, confinement_override
 from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
@@ -78,13 +81,10 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     from pathlib import Path
     from ..analysis.figures import run_stress_strain_figure
     from ..params import require_plane
-    from ..plotting import crack_map
+    from ..analysis.plotting import crack_map
     from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
-    from ..specimen import build_specimen
-    from ..engines import engine_for
-    from ..protocols import ucs as ucs_test
-    from ..protocols.cracks import bond_segments
-    from ..ucs_analysis import ucs_summary
+    from ..geometry.specimen import build_specimen
+    from ..analysis.ucs_analysis import ucs_summary
     require_plane(params, "ucs")
     out = Path(out) if resume else prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
@@ -119,7 +119,6 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
 
 def write_cracks(path, scene):
     """cracks.csv: one row per broken bond (step of its break, mode, kind, position, orientation)."""
-    from ..protocols.cracks import crack_table
     from ..runs.runio import write_csv
     idx = np.flatnonzero(scene.broken)
     table = crack_table(scene, idx)
@@ -142,7 +141,8 @@ def run_ucs_in_yade(rows):
                                      f"{run_folder_name(controls, overrides)}",
                                      params, controls, {"seed": int(controls["seed"])})
     if action == "skip":
-        print(f"UCS row already finished, skipped: {out}")
+        from ..runs.batchrun import ROW_SKIPPED
+        print(f"UCS {ROW_SKIPPED}: {out}")
         return
     if note:
         print(note)

@@ -20,7 +20,7 @@ import importlib
 
 from ..layout import ClumpLayout, bond_properties
 from ..params import Parameters
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 from ._interface import GrainModel
 
 #: Values of ``resolution.grain_model``: each is the name of a module of this package.

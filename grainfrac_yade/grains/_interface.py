@@ -15,7 +15,7 @@ import numpy as np
 
 from ..layout import BondProperties, ClumpLayout
 from ..params import Parameters
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 
 
 class GrainModel:

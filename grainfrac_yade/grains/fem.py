@@ -1,7 +1,7 @@
 """Finite-element cells for the DEM: each Voronoi cell a cluster of spheres on its triangle mesh (pure numpy).
 
 The cluster is an image of the static reference's mesh
-(:func:`grainfrac_yade.grainmesh.grain_mesh`, contacts at the face corners,
+(:func:`grainfrac_yade.geometry.grainmesh.grain_mesh`, contacts at the face corners,
 ``resolution.nodes_per_face`` per face):
 
 * one sphere per mesh node, the mesh shrunk about the cell's centroid by
@@ -38,10 +38,10 @@ from scipy.spatial import cKDTree
 from ..dem_step import lift_short_steps
 from ..elastic import cluster_network, node_stiffness
 from ..errors import GrainfracError
-from ..grainmesh import grain_mesh
+from ..geometry.grainmesh import grain_mesh
 from ..layout import BondProperties, ClumpLayout, cell_mass_inertia
 from ..params import Parameters
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 from ._interface import GrainModel
 
 NAME = "fem"

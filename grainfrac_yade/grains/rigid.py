@@ -33,7 +33,7 @@ from ..dem_step import lift_short_steps, oscillation_steps
 from ..errors import GrainfracError
 from ..layout import BondProperties, ClumpLayout, cell_mass_inertia
 from ..params import Parameters
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 from ._interface import GrainModel
 
 NAME = "rigid"

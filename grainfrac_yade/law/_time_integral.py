@@ -16,6 +16,8 @@ a creep time) by Newton's method on t(u) with the exact derivative psi(u), kept 
 
 All results are logs of times, so nothing overflows; every exponent is clipped to +-LOG_LIMIT.
 """
+import functools
+
 import numpy as np
 
 from ._common import LOG_LIMIT
@@ -28,8 +30,6 @@ def logaddexp(x, y):
 
 def _quiet(function):
     """Run ``function`` with float warnings off: inf, 0 and -inf are meant (log space, clipped exponents)."""
-    import functools
-
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
         with np.errstate(all="ignore"):

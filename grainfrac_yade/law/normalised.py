@@ -24,7 +24,7 @@ import numpy as np
 from . import _time_integral as ti
 from ._common import LOG_LIMIT, check_dt, check_rate_constants, check_shear, finite, shear_strength, time_from_log
 from .area import _one_minus_x_ex_e1
-from .hillig_charles import StrengthLaw
+from .hillig_charles import StrengthLaw, earliest
 
 NAME = "normalised"
 
@@ -124,7 +124,6 @@ class Normalised(StrengthLaw):
 
     def time_to_failure(self, state, stresses):
         # activity (threshold and s > 0) is part of the channel times already
-        from .hillig_charles import earliest
         return earliest(*self.channel_times(state, stresses))
 
     def degrade(self, state, stresses, dt):

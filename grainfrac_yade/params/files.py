@@ -22,6 +22,13 @@ def read_toml(path) -> dict:
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(str(path), "(syntax)", f"not valid TOML ({exc})",
                              "fix the syntax at that line") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(str(path), "(file)", f"not a text file (byte {exc.start} is not UTF-8)",
+                             "give a TOML parameter file (UTF-8 text), e.g. "
+                             f"{PARAMS_DIR / 'presets' / 'fem.toml'}") from None
+    except IsADirectoryError:
+        raise ParameterError(str(path), "(file)", "a folder, not a file",
+                             f"give a TOML parameter file; shipped files are in {PARAMS_DIR}") from None
 
 
 def _toml_value(value) -> str:

@@ -16,11 +16,11 @@ from typing import Mapping
 from ..arrhenius import betas_from_physical
 from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
-from ..tessellation import n_cells_for
+from ..geometry.tessellation import n_cells_for
 from .files import read_toml
 from .schema import (DEFAULT_FILES, FRACTION_SUM_TOLERANCE, PARAMS_DIR, SECTION_CLASSES, ContactParams, GrainParams,
-                     Parameters, SpecimenParams, StressCorrosionParams, _check_value, average_contact, nearest_key,
-                     pair_key)
+                     Parameters, SpecimenParams, StressCorrosionParams, _check_value, average_contact, field_spec,
+                     nearest_key, pair_key)
 
 #: Keys renamed in the schema: old dotted key -> (new dotted key, {old value: new value}).  Parameter
 #: files and --set refuse the old key in one line; params.json of older runs are migrated on reading
@@ -217,6 +217,7 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
     merged, origins = {}, {}
     for path in files:
         _merge(merged, read_toml(path), origins, str(path))
+    _check_overridden_file_values(merged, origins, overrides)
     for text in overrides:
         key, value = parse_override(text) if isinstance(text, str) else text
         origin = override_origin(text)
@@ -230,6 +231,23 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
                                  "parameter files, e.g. stress_corrosion.beta1")
         _merge(merged, _nest(key, value), origins, origin)
     return build_parameters(merged, origins, tuple(str(p) for p in files))
+
+
+def _check_overridden_file_values(merged: Mapping, origins: Mapping, overrides):
+    """A file's value is checked even where a flag or ``--set`` replaces it: a file is valid whatever overrides it
+    (else the same file fails on the next run without the flag).  Schema keys only (their unit and check); the
+    mineral tables (contacts, grains, composition) are checked by their own builders whenever they are read."""
+    flat = flatten(merged)
+    for item in overrides:
+        key = (parse_override(item) if isinstance(item, str) else item)[0]
+        origin = origins.get(key.replace('"', ""))
+        if key not in flat or origin is None:
+            continue
+        try:
+            spec = field_spec(key)
+        except ParameterError:
+            continue
+        _check_value(flat[key], spec, origin, key)
 
 
 def _is_new_pair_key(key: str) -> bool:

@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import ParameterError
-from ..engines import ENGINE_NAMES
 from ..law import LAW_NAMES
 
 PARAMS_DIR = Path(__file__).resolve().parents[2] / "params"
@@ -115,7 +114,7 @@ class ResolutionParams:
 class NumericsParams:
     """DEM integration knobs, and the engine that computes the scene."""
     engine: str = _spec("", "choice", "mechanical engine of the scene (grainfrac_yade.engines): yade = YADE's "
-                        "explicit DEM with dynamic relaxation", ENGINE_NAMES)
+                        "explicit DEM with dynamic relaxation", ("yade",))
     damping: float = _spec("1", "unit_interval_open", "Cundall non-viscous damping")
     timestep_safety: float = _spec("1", "unit_interval_open", "fraction of the critical time step")
     density_scale: float = _spec("1", "positive", "mass scaling factor for quasi-static runs")

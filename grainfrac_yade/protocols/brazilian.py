@@ -2,7 +2,7 @@
 
 ISRM (1978) suggested method: a disc of diameter D and thickness t is loaded along a diameter
 until it splits; its tensile strength is sigma_t = 2 P / (pi D t) at the peak load P
-(:mod:`grainfrac_yade.brazilian_analysis`).
+(:mod:`grainfrac_yade.analysis.brazilian_analysis`).
 
 The jaws are cells of the disc, as the UCS test's platens are (the scene's ``attach_jaws``; YADE's:
 :mod:`grainfrac_yade.yade_adapter.jaws`): the cells whose
@@ -40,8 +40,8 @@ import time
 
 import numpy as np
 
-from ..brazilian_analysis import splits, tensile_stress
-from ..engines import engine_for
+from ..analysis.brazilian_analysis import splits, tensile_stress
+from ..engines.registry import engine_for
 from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoints import (LoadingCheckpoints, base_state, history_arrays, read, restore_scene, resume_record,
@@ -169,7 +169,7 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None, chec
     """Run the test; return (history columns, result dict, scene, snapshot at the failure load).
 
     The snapshot (bonds broken, their modes) is taken at the failure load: the peak before the split
-    (:func:`grainfrac_yade.brazilian_analysis.split_peak_index`, the same rows), else at the largest
+    (:func:`grainfrac_yade.analysis.brazilian_analysis.split_peak_index`, the same rows), else at the largest
     load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
     Broken counts and the snapshot leave out slits.  ``checkpoint_folder``: the run folder,
     checkpoints go to its ``checkpoint/`` (None: none); ``run_values``: stored with them (seed, levers).

@@ -48,20 +48,17 @@ import json
 import os
 import shutil
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import GrainfracError
 from ..grains import grain_model
-from ..runs.runio import CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, checkpoint_folder, code_version
+from ..runs.runio import (ARRAYS_FILE, CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, SCENE_FILE,  # noqa: F401
+                          check_files, checkpoint_folder, code_version)
 from .columns import HISTORY_RENAMED
 
-#: The engine's scene inside a checkpoint (:meth:`Scene.save`; the name is YADE's gzip'd binary archive's, which
-#: every checkpoint so far holds).
-SCENE_FILE = "scene.yade.gz"
-#: Per-bond arrays of the driver.
-ARRAYS_FILE = "arrays.npz"
 #: Layout of state.json and arrays.npz; a checkpoint of another layout is refused.
 FORMAT = 1
 #: Safe points of each test's driver at which a checkpoint can be taken (the phase it resumes in);
@@ -201,7 +198,7 @@ def read(run_folder, test: str = "creep") -> tuple:
         state = json.loads((where / CHECKPOINT_STATE).read_text())
         with np.load(where / ARRAYS_FILE) as data:
             arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise GrainfracError(f"{where}: checkpoint unreadable ({type(exc).__name__}: {exc}); fix: start the run "
                              "again with --overwrite") from None
     if state.get("format") != FORMAT or state.get("phase") not in PHASES.get(state.get("test", "creep"), ()):

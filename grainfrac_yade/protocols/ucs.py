@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from ..engines import engine_for
+from ..engines.registry import engine_for
 from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoints import (LoadingCheckpoints, base_state, history_arrays, inexact_note, platen_state, read,

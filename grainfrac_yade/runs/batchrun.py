@@ -8,6 +8,7 @@ the file>`` (yade utils.py), so a task runs
 """
 from __future__ import annotations
 
+import ast
 import json
 import os
 import re
@@ -99,14 +100,29 @@ def _ended_rows(output: Path) -> list:
     return lines
 
 
-class RowOutcome:
-    """What one table row did: ``ok`` (its run folder holds a finished run), the folder, and one line."""
+#: What a row script prints (after "creep", "UCS" or "Brazilian") when its folder already holds its finished run.
+ROW_SKIPPED = "row already finished, skipped"
 
-    def __init__(self, line: int, ok: bool, text: str, folder=None, log=None):
+
+class RowOutcome:
+    """What one table row did: ``ok`` (its run folder holds a finished run), ``skipped`` (finished before this
+    batch: the row script found its finished run and did not run it), the folder, and one line."""
+
+    def __init__(self, line: int, ok: bool, text: str, folder=None, log=None, skipped=False):
         self.line, self.ok, self.text, self.folder, self.log = line, ok, text, folder, log
+        self.skipped = skipped
 
     def __str__(self):
-        return f"line {self.line}: {'ok' if self.ok else 'FAILED'}: {self.text}"
+        state = ("skipped (finished)" if self.skipped else "ok") if self.ok else "FAILED"
+        return f"line {self.line}: {state}: {self.text}"
+
+
+def _skipped(log: Path) -> bool:
+    """Whether the row's log says its script skipped it (a finished run of the row was already there)."""
+    try:
+        return ROW_SKIPPED in log.read_text(errors="replace")
+    except OSError:
+        return False
 
 
 def row_outcomes(table, log_dir, lines, describe=None) -> list:
@@ -132,7 +148,7 @@ def row_outcomes(table, log_dir, lines, describe=None) -> list:
                 summary = None
         if summary is not None and not summary.get("failed_before_test"):
             text = describe(summary) if describe else "finished"
-            out.append(RowOutcome(line, True, f"{text} -> {folder}", folder, log))
+            out.append(RowOutcome(line, True, f"{text} -> {folder}", folder, log, skipped=_skipped(log)))
             continue
         reason = summary.get("end_reason") if summary else _log_reason(log)
         out.append(RowOutcome(line, False, f"{reason} (log {log})", folder, log))
@@ -155,6 +171,9 @@ def _log_reason(log: Path) -> str:
     return "no finished run (no summary.json): the row stopped without an error line"
 
 
+#: A column name: a parameter path (section.key, a quoted mineral pair in contacts."a/b".key) or a run column,
+#: optionally with YADE's leading or trailing ``!``.
+COLUMN_NAME = re.compile(r'^!?[A-Za-z_][A-Za-z0-9_./"-]*!?$')
 #: A table cell that repeats the value of the line above (yade-batch's rule).
 SAME_AS_ABOVE = "="
 
@@ -164,7 +183,6 @@ def read_table_rows(path) -> tuple:
     YADE's ``TableParamReader`` reads it (``#`` comments, blank lines skipped, whitespace-separated cells,
     ``=`` repeats the line above, a trailing ``!`` on a column name dropped) but without its
     IndexError: a line with another number of cells than the header is one problem line naming it."""
-    import re
     path = Path(path)
     try:
         text = path.read_text()
@@ -176,7 +194,13 @@ def read_table_rows(path) -> tuple:
     if not used:
         raise GrainfracError(f"{path}: no header line (column names); fix: a first line of column names, "
                              "then one line per run")
-    (_, header), body = used[0], used[1:]
+    (header_line, header), body = used[0], used[1:]
+    not_names = [h for h in header if not COLUMN_NAME.match(h)]
+    if not_names:
+        raise GrainfracError(f"{path}:{header_line}: not a batch table: its first line is not column names "
+                             f"({', '.join(repr(h) for h in not_names[:3])}); fix: a batch table is a first line of "
+                             "column names (parameter paths such as specimen.width, ratio or stress, seed, study, "
+                             "out), then one line of values per run, e.g. `ratio seed` then `0.7 1`")
     columns = [h[:-1] if h.endswith("!") and h != "!" else h for h in header]
     rows, problems, previous = {}, [], None
     for number, cells in body:
@@ -203,7 +227,6 @@ def read_table_rows(path) -> tuple:
 
 def cell_value(text: str):
     """A table cell as YADE evaluates it (a Python literal); ValueError if it is not one (e.g. unquoted text)."""
-    import ast
     try:
         return ast.literal_eval(text)
     except (ValueError, SyntaxError):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import functools
+import gzip
 import hashlib
 import json
 import math
@@ -20,11 +21,16 @@ import platform
 import shutil
 import subprocess
 import sys
+import zipfile
+import zlib
 from pathlib import Path
+
+import numpy as np
 
 from .. import __version__
 from ..atomic import write_atomically, write_text_atomically
 from ..errors import GrainfracError
+from ..params import flatten, load_parameters, migrate_tree
 
 #: Files whose presence marks a folder as holding a finished or running run.
 RUN_MARKERS = ("run.json",)
@@ -42,6 +48,10 @@ RESULT_NEUTRAL_KEYS = ("numerics.checkpoint_interval",)
 CHECKPOINT = "checkpoint"
 CHECKPOINT_STATE = "state.json"
 CHECKPOINT_TMP, CHECKPOINT_OLD = CHECKPOINT + ".tmp", CHECKPOINT + ".old"
+#: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
+SCENE_FILE = "scene.yade.gz"
+#: Per-bond arrays of the driver.
+ARRAYS_FILE = "arrays.npz"
 
 
 @functools.lru_cache(maxsize=None)
@@ -203,7 +213,6 @@ def commit_run_dir(where) -> Path:
 
 def remove_checkpoints(folder) -> None:
     """Delete a run folder's checkpoint folders (a finished or replaced run has nothing to resume)."""
-    import shutil
     for name in (CHECKPOINT, CHECKPOINT_TMP, CHECKPOINT_OLD):
         shutil.rmtree(Path(folder) / name, ignore_errors=True)
 
@@ -262,7 +271,6 @@ MISSING = "(missing)"
 def _parameter_pairs(stored_tree: dict, params) -> dict:
     """{dotted key: (stored value, value of ``params``)} over both parameter trees; a key missing
     from an older stored tree counts as the shipped default, as the analysis reads it."""
-    from ..params import load_parameters
     stored = comparable_parameters(stored_tree)
     now = comparable_parameters(params.to_dict())
     defaults = comparable_parameters(load_parameters().to_dict())
@@ -277,7 +285,6 @@ def _differences(pairs: dict) -> list:
 
 def flatten_values(values: dict) -> dict:
     """``run_values`` as JSON stores them, flattened to dotted keys."""
-    from ..params import flatten
     return flatten(json.loads(json.dumps(_clean(values))))
 
 
@@ -285,7 +292,6 @@ def comparable_parameters(tree: dict) -> dict:
     """A parameter tree (``Parameters.to_dict()`` or a params.json) as {dotted key: value} as JSON
     stores it, without the provenance entries (:data:`PROVENANCE_KEYS`) and the parameters that do
     not change results (:data:`RESULT_NEUTRAL_KEYS`)."""
-    from ..params import flatten, migrate_tree
     tree = json.loads(json.dumps(_clean({k: v for k, v in tree.items() if k not in PROVENANCE_KEYS})))
     migrate_tree(tree)   # renamed keys of older params.json (stress_corrosion.mode -> law)
     return {k: v for k, v in flatten(tree).items() if k not in RESULT_NEUTRAL_KEYS}
@@ -318,3 +324,34 @@ def run_digest(params, run_values: dict) -> str:
     """8 hex digits identifying the resolved parameters and run values (e.g. seed, load) of a run."""
     data = {"params": comparable_parameters(params.to_dict()), "run": _clean(run_values)}
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:8]
+
+
+def check_files(where) -> None:
+    """GrainfracError (one line naming the file) if checkpoint folder ``where`` has a state file that is not JSON,
+    an arrays file that numpy cannot read whole, or a scene that is not a complete gzip stream (truncated): checked
+    before YADE is loaded and before anything is written.  Reads every file once (the scene's gzip stream to its
+    end: about a second per 100 MB)."""
+    where = Path(where)
+    fix = "fix: start the run again with the same command (run.json) and --overwrite"
+    try:
+        state = json.loads((where / CHECKPOINT_STATE).read_text())
+        if not isinstance(state, dict):
+            raise ValueError("not a JSON object")
+    except (OSError, ValueError) as exc:
+        raise GrainfracError(f"{where}: the checkpoint's state file ({where.name}/{CHECKPOINT_STATE}) is unreadable "
+                             f"(not the JSON this code writes: garbage or truncated; {type(exc).__name__}); "
+                             f"{fix}") from None
+    try:
+        with np.load(where / ARRAYS_FILE) as data:
+            for k in data.files:
+                data[k]
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise GrainfracError(f"{where / ARRAYS_FILE}: the checkpoint's arrays are unreadable "
+                             f"(truncated or not numpy's npz; {type(exc).__name__}: {exc}); {fix}") from None
+    try:
+        with gzip.open(where / SCENE_FILE, "rb") as fh:
+            while fh.read(1 << 24):
+                pass
+    except (OSError, EOFError, zlib.error) as exc:
+        raise GrainfracError(f"{where / SCENE_FILE}: the checkpoint's scene is unreadable (truncated "
+                             f"gzip or not a YADE scene; {type(exc).__name__}: {exc}); {fix}") from None

@@ -6,6 +6,8 @@ its Python package lives outside ``sys.path`` (see shared/yade_notes.md).
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import sys
 
@@ -21,6 +23,9 @@ DEBIAN_PYTHON = "/usr/bin/python3"
 DEFAULT_THREADS = "1"
 
 _yade = None
+#: What YADE's import printed (its "Using python version ..." banner), kept off the console: a command's output
+#: is the project's own lines.  Under ``yade -x`` (batch rows) the binary prints it first, into the row's log.
+import_output = ""
 
 
 def use_default_threads():
@@ -38,9 +43,12 @@ def load_yade():
     use_default_threads()
     if YADE_PY_PATH not in sys.path:
         sys.path.insert(0, YADE_PY_PATH)
+    global import_output
     try:
-        import yade  # noqa: F401
-        from yade import wrapper  # noqa: F401
+        with contextlib.redirect_stdout(io.StringIO()) as printed:   # YADE's "Using python version ..." banner
+            import yade  # noqa: F401
+            from yade import wrapper  # noqa: F401
+        import_output = printed.getvalue()
     except ImportError as exc:
         raise GrainfracError(
             f"YADE cannot be imported in {sys.executable} ({exc}); fix: run with {DEBIAN_PYTHON} "

@@ -69,6 +69,7 @@ def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") ->
         "run": {"rows": run.rows, "ramp_broken": run.ramp_broken, "failed": run.failed,
                 "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
                 "n_events": run.n_events, "vtk_times": run.vtk_times, "vtk_written": run.vtk_written,
+                "vtk_merged": run.vtk_merged,
                 "vtk_rows": run._vtk_rows, "vtk": run.vtk_folder is not None, "vtk_every": run.vtk_every,
                 "last_relaxation_steps": run.last_relaxation_steps, "resumes": run.resumes,
                 "consolidation": run.consolidation},
@@ -110,6 +111,7 @@ def restore(run, where, state: dict, arrays: dict):
     run.failed_on_loading, run.n_events = r["failed_on_loading"], r["n_events"]
     run.vtk_times, run.vtk_written, run._vtk_rows = r["vtk_times"], r["vtk_written"], r["vtk_rows"]
     run.vtk_every = int(r.get("vtk_every", 0))   # older checkpoints: times only
+    run.vtk_merged = r.get("vtk_merged", [])   # older checkpoints: none recorded
     run.last_relaxation_steps = r["last_relaxation_steps"]
     run.consolidation = r.get("consolidation", {})
     run.resumes = r["resumes"] + [{"dem_steps": state["dem_steps"], "creep_time_s": state["creep_time_s"],

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..tessellation import SIDES
+from ..geometry.tessellation import SIDES
 from ..wave import hold_budget, scene_density
 from ..protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
 from .platens import StressServo, free_bodies, held_at_equilibrium

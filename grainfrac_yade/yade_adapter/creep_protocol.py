@@ -45,6 +45,7 @@ from ..errors import NumericalFailure
 from ..protocols.creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
 from ..law import shear_strength
 from ..params import unbalanced_threshold
+from ..vtkio import due_times, merged_frame_note
 from ..wave import hold_budget, scene_density
 from .checkpoint import Checkpointer, capture, inexact_note, read, restore
 from .confinement import Confinement, broken_apart_reason, consolidate
@@ -93,6 +94,8 @@ class CreepRun:
         #: also a snapshot at every ``vtk_every``-th history row (one row per creep step or event; 0: none)
         self.vtk_every = int(vtk_every)
         self.vtk_written = []
+        #: requested times that fell into one frame: [{"requested_s": [...], "frame_s": t}] (summary.json)
+        self.vtk_merged = []
         self._vtk_rows = -1   # number of history rows when the last snapshot was written
         #: called with the rows so far every HISTORY_FLUSH_ROWS rows (partial history.csv)
         self.history_sink = history_sink
@@ -311,9 +314,13 @@ class CreepRun:
 
     def record_now(self, creep_time):
         self.record(creep_time, self.servo.stress)
-        while self.vtk_folder is not None and self.vtk_times and self.vtk_times[0] <= creep_time:
-            self.vtk_times.pop(0)
-            self.write_vtk(creep_time)
+        if self.vtk_folder is not None and self.vtk_times:
+            due, self.vtk_times = due_times(self.vtk_times, creep_time)
+            if due:
+                self.write_vtk(creep_time)
+            if len(due) > 1:   # the clock jumped over several requested times: one frame holds them all
+                self.vtk_merged.append({"requested_s": due, "frame_s": creep_time})
+                self.progress(merged_frame_note(due, creep_time))
         if self.vtk_folder is not None and self.vtk_every and len(self.rows) % self.vtk_every == 0:
             self.write_vtk(creep_time)
         if self.history_sink is not None and len(self.rows) % HISTORY_FLUSH_ROWS == 0:

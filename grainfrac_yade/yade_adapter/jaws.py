@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..disc import DiscTessellation
+from ..geometry.disc import DiscTessellation
 from ..errors import GrainfracError
 
 #: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
@@ -23,7 +23,7 @@ class DiscJaws:
         t = scene.specimen.tessellation
         if not isinstance(t, DiscTessellation):
             raise GrainfracError("Brazilian test: the specimen is not a disc; fix: build it with "
-                                 "grainfrac_yade.specimen.build_disc_specimen")
+                                 "grainfrac_yade.geometry.specimen.build_disc_specimen")
         self.scene = scene
         self.diameter, self.centre = t.diameter, t.centre
         half = 0.5 * loading_arc

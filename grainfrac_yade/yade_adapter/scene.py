@@ -1,4 +1,4 @@
-"""Turn a :class:`~grainfrac_yade.specimen.Specimen` into a YADE scene and read bonds back.
+"""Turn a :class:`~grainfrac_yade.geometry.specimen.Specimen` into a YADE scene and read bonds back.
 
 The scene holds only what a test asks for (guide: "simulate only the effects a
 scene calls for"): a plain mechanical scene has exactly ForceResetter,
@@ -35,7 +35,7 @@ from ..law import MODE_NEVER, MODE_SHEAR, MODE_TENSION
 from ..layout import BondProperties, ClumpLayout, bond_properties
 from ..params import Parameters
 from ..protocols.cracks import bond_is_inter
-from ..specimen import Specimen
+from ..geometry.specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
 from .confinement import Confinement
 from .jaws import DiscJaws

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from .post_peak import dropped_past_peak
+from ..post_peak import dropped_past_peak
 
 #: Half-width of the central band about the loaded diameter, as a fraction of the diameter.
 CENTRAL_BAND_HALF_WIDTH = 1.0 / 6.0

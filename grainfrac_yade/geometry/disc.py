@@ -4,7 +4,7 @@ Pure numpy/scipy.  Seeds are drawn uniformly in the disc; each seed is mirrored
 radially across the circle (p' = c + (2R - |p - c|) (p - c)/|p - c|): the bisector
 of p and p' is the tangent at the rim point nearest p, so the mirrored seeds'
 cells lie outside the disc and the real seeds' cells cover it exactly (the box
-tessellation's mirroring, :mod:`grainfrac_yade.tessellation`, with the circle's
+tessellation's mirroring, :mod:`grainfrac_yade.geometry.tessellation`, with the circle's
 tangents as walls).  A ring of far points keeps every cell finite.  Each cell, a
 convex polygon, is then intersected with the disc: its boundary is straight
 pieces (Voronoi faces) and circular arcs (the rim).  Lloyd iterations move the
@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Voronoi
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
 from .tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _check_one_region_per_seed
 
 #: Largest angle between two samples of a rim arc in ``cell_vertices`` [deg].
@@ -55,7 +55,7 @@ TWO_PI = 2.0 * math.pi
 
 @dataclass(frozen=True)
 class DiscTessellation(Tessellation):
-    """A :class:`~grainfrac_yade.tessellation.Tessellation` of a disc (see module doc).
+    """A :class:`~grainfrac_yade.geometry.tessellation.Tessellation` of a disc (see module doc).
 
     Extra attributes: ``centre`` (2,) [m], ``radius`` [m], ``boundary_arc`` (nb, 2) start and
     end angle [rad] of each rim arc, counter-clockwise (start in [-pi, pi), end > start).

@@ -18,8 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import GrainfracError
-from .params import flat_values, load_parameters, read_toml, shipped_values
+from ..errors import GrainfracError
+from ..params import flat_values, load_parameters, read_toml, shipped_values
 
 #: The shipped defaults' setting: in every knob's series, never itself a knob.
 DEFAULT_SETTING = "default"
@@ -84,7 +84,7 @@ def load_study(path, quick: bool = False, repo=None) -> Study:
     the settings it lists, plus their knobs' references).  Every setting's parameters are loaded and
     validated here, so a typo stops the command before anything runs."""
     path = Path(path)
-    repo = Path(repo) if repo else Path(__file__).resolve().parents[1]
+    repo = Path(repo) if repo else Path(__file__).resolve().parents[2]
     if not path.exists():
         raise GrainfracError(f"{path}: no such file; fix: give the study file, e.g. params/accuracy_cost.toml")
     data = read_toml(path)

@@ -24,7 +24,7 @@ exactly (their corners are shared), so their areas sum to the box's or disc's ar
 Cells and faces the collapses do not touch keep their arrays bit for bit; a moved face gets its length,
 midpoint and the unit normal of its new line (from its lower to its higher cell), a moved cell its
 polygon, area and centroid (and, in the disc, its rim arcs: exact circular segments as in
-:mod:`grainfrac_yade.disc`).  Threshold 0 returns the tessellation object itself, untouched.
+:mod:`grainfrac_yade.geometry.disc`).  Threshold 0 returns the tessellation object itself, untouched.
 """
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .disc import SAME_POINT_FRACTION, _arc_points, _quadrant_side, _segment_area_moment, _shoelace
-from .errors import GrainfracError
+from ..errors import GrainfracError
 from .tessellation import MIN_FACE_FRACTION, SIDES, Tessellation, _ccw, _polygon_area_centroid
 
 #: A corner of a regularised cell must turn by more than this fraction of the product of its two

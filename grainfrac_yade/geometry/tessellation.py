@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, Voronoi
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
 
 #: Faces shorter than this fraction of the grain size are dropped as degenerate
 #: (they come from four nearly co-circular seeds; their bonds would carry nothing).

@@ -35,10 +35,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .contact_strength import NO_SCATTER
+from ..contact_strength import NO_SCATTER
 
 #: The lab properties of LdB granite with their sources (a copy of shared/reference/).
-LAB_PROPERTIES_CSV = Path(__file__).resolve().parents[1] / "params" / "reference" / "ldb_lab_properties.csv"
+LAB_PROPERTIES_CSV = Path(__file__).resolve().parents[2] / "params" / "reference" / "ldb_lab_properties.csv"
 
 
 @dataclass(frozen=True)

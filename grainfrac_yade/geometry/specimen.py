@@ -5,14 +5,15 @@ parameters and seed give the same specimen, bit for bit.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from .disc import check_disc_size, n_cells_for_disc, voronoi_disc
-from .errors import GrainfracError
+from ..errors import GrainfracError
 from .minerals import allocate_minerals, area_fractions, clump_statistics, mineral_clumps
-from .params import Parameters
+from ..params import Parameters
 from .regularise import regularise
 from .tessellation import Tessellation, n_cells_for, voronoi_box
 
@@ -86,6 +87,11 @@ def specimen_from_tessellation(tess: Tessellation, mineral, names, thickness: fl
                     clump_label=mineral_clumps(tess.face_cells, mineral), thickness=thickness, seed=seed)
 
 
+#: Largest specimen seed: 2**32 - 1, the range of a 32-bit seed (numpy's ``RandomState`` and ``np.random.seed``
+#: accept no more; ``default_rng`` would take any size, but a seed beyond 64 bits no longer reads back as an
+#: integer from the run tables, and no study needs more than a few billion specimens).
+MAX_SEED = 2**32 - 1
+
 #: Memory one cell takes while its specimen is built [bytes]: measured 11.4-11.9 kB per cell (peak resident
 #: size of build_specimen, 2,559 and 25,465 cells, 2026-12-01); the YADE scene adds to it, so this is a
 #: lower bound of a run's need.
@@ -94,7 +100,6 @@ BYTES_PER_CELL = 12e3
 
 def memory_bytes() -> float:
     """Physical memory of this machine [bytes] (inf where the system does not say)."""
-    import os
     try:
         return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
     except (ValueError, OSError, AttributeError):
@@ -114,7 +119,7 @@ def check_cell_count(n_cells: int, what: str, grain_size: float, flags: str = ""
 
 def build_specimen(params: Parameters, seed: int) -> Specimen:
     """Tessellate the specimen of ``params.specimen``, collapse its short edges
-    (``specimen.min_edge_fraction``, :mod:`grainfrac_yade.regularise`) and allocate minerals (seeded)."""
+    (``specimen.min_edge_fraction``, :mod:`grainfrac_yade.geometry.regularise`) and allocate minerals (seeded)."""
     sp = params.specimen
     box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
     check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
+from .runparams import rebuild_specimen
 
 #: Frames of an animation by default: 4 s at the default rate.
 DEFAULT_FRAMES = 60
@@ -32,6 +33,8 @@ FIGSIZE, DPI = (8.4, 6.4), 100
 GIF_COLOURS = 128
 MICRO_WIDTH, MACRO_WIDTH = 0.8, 2.2   # crack line widths [pt]
 MM = 1e3
+#: Strain in percent, as the report's figures draw it.
+PERCENT = 100.0
 #: Output names in the run folder.
 GIF_NAME, MP4_NAME, FRAME_NAME = "animation.gif", "animation.mp4", "animation_frame.png"
 
@@ -73,7 +76,7 @@ def _read_run(folder: Path):
     hist = pd.read_csv(folder / "history.csv")
     cracks = pd.read_csv(folder / "cracks.csv")
     if "phase" in cracks:   # the ramp's cracks have no creep time: they are there from the first frame on
-        from .analysis.crack_phases import RAMP_TIME
+        from .crack_phases import RAMP_TIME
         cracks["creep_time_s"] = cracks["creep_time_s"].where(cracks["phase"] != "ramp", RAMP_TIME)
     for name, frame, cols in (("history.csv", hist, ("creep_time_s", "axial_strain")),
                               ("cracks.csv", cracks, ("creep_time_s", "mode"))):
@@ -88,7 +91,6 @@ def _read_run(folder: Path):
 
 def _specimen(folder, run, summary, cracks):
     """(specimen or None, note): the run's grains rebuilt and verified, else the reason."""
-    from .analysis.runparams import rebuild_specimen
     try:
         rebuilt = rebuild_specimen(folder, run.get("seed"), n_bonds=summary.get("n_bonds"), cracks=cracks)
     except GrainfracError as exc:
@@ -97,8 +99,17 @@ def _specimen(folder, run, summary, cracks):
 
 
 def _segments(cracks: pd.DataFrame, grain_size: float) -> np.ndarray:
-    from .analysis.crackmaps import crack_segments
+    from .crackmaps import crack_segments
     return crack_segments(cracks, grain_size)
+
+
+def macro_legend(macro_time_s) -> str:
+    """Legend of the thick crack lines: what they are, or that the run has none (a legend line the map never
+    draws would mislead); ``macro_time_s``: each crack's separation time (NaN: never)."""
+    t = np.asarray(macro_time_s, float)
+    if not np.isfinite(t).any():
+        return "macrocrack: none in this run (or times not recorded)"
+    return "macrocrack (face fully separated): thick, in its mode's colour"
 
 
 class _Renderer:
@@ -133,7 +144,7 @@ class _Renderer:
         ax.add_collection(self.lines)
         handles = [Line2D([], [], color=CRACK_COLOURS[1], lw=1.5, label="tensile crack"),
                    Line2D([], [], color=CRACK_COLOURS[2], lw=1.5, label="shear crack"),
-                   Line2D([], [], color="k", lw=MACRO_WIDTH, label="macrocrack")] + handles
+                   Line2D([], [], color=CRACK_COLOURS[1], lw=MACRO_WIDTH, label=macro_legend(macro))] + handles
         self.fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.57, 0.36), ncol=2, fontsize=8,
                         frameon=False)
         inset = self.fig.add_axes((0.59, 0.47, 0.37, 0.38))
@@ -143,13 +154,13 @@ class _Renderer:
         if log_time:
             left = t_end * 10.0 ** -LOG_TIME_DECADES
             inset.set_xscale("log")   # rows before the axis starts (creep time 0) drawn at its left end
-            inset.plot(np.maximum(t, left), strain * 1e3, color="#444444", lw=1.2, drawstyle="steps-post")
+            inset.plot(np.maximum(t, left), strain * PERCENT, color="#444444", lw=1.2, drawstyle="steps-post")
             inset.set_xlim(left, t_end)
         else:
-            inset.plot(t, strain * 1e3, color="#444444", lw=1.2, drawstyle="steps-post")
+            inset.plot(t, strain * PERCENT, color="#444444", lw=1.2, drawstyle="steps-post")
             inset.set_xlim(0, t_end if t_end > 0 else 1.0)
         inset.set_xlabel("creep time [s]")
-        inset.set_ylabel("axial strain [1e-3]")
+        inset.set_ylabel("axial strain [%]")
         inset.set_title("strain - time", fontsize=9)
         inset.grid(alpha=0.3)
         (self.marker,) = inset.plot([], [], "o", color="#d62728", ms=7, zorder=5)
@@ -170,11 +181,11 @@ class _Renderer:
         self.lines.set_color(list(self.colours[present]))
         self.lines.set_linewidth(np.where(macro[present], MACRO_WIDTH, MICRO_WIDTH))
         strain = self.strain_at(time)
-        self.marker.set_data([time], [strain * 1e3])
+        self.marker.set_data([time], [strain * PERCENT])
         self.cursor.set_xdata([time, time])
         frac = time / t_end if t_end > 0 else 1.0
         self.text.set_text(f"creep time {time:.4g} s ({frac:.1%} of the run)\n"
-                           f"{int(present.sum())} cracks ({int(macro.sum())} on macrocracks)")
+                           f"{int(present.sum())} cracks, {int(macro.sum())} of them macro")
         self.fig.canvas.draw()
         return np.asarray(self.fig.canvas.buffer_rgba())[:, :, :3].copy()
 

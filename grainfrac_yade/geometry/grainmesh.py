@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import GrainfracError
+from ..errors import GrainfracError
 from .specimen import Specimen
 
 #: Polygon edges shorter than this fraction of the grain size are not subdivided (no face, no contact).

@@ -1,0 +1,61 @@
+"""Argument helpers that the CLI (``cli.py``) and the command modules share: the seed type, the parameter
+overrides a command line gives, and the parameter set they load.  Here, not in ``cli.py``, because
+command modules never import ``cli.py`` (it loads them)."""
+from __future__ import annotations
+
+import argparse
+
+from ..params import FlagOverride, load_parameters, override_origin
+from ..geometry.specimen import MAX_SEED, check_cell_count
+from ..geometry.tessellation import n_cells_for
+
+
+def seed_type(text: str, example: str = "1") -> int:
+    """argparse type of a specimen seed: a whole number in [0, MAX_SEED] (numpy's generators take no negative
+    seed; :data:`~grainfrac_yade.geometry.specimen.MAX_SEED` is the range of a 32-bit seed)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (e.g. {example})") from None
+    if value < 0 or value > MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{value}: a seed is a whole number from 0 to {MAX_SEED} (the range of a "
+                                         f"32-bit seed; e.g. {example})")
+    return value
+
+
+def seed_list_type(text: str) -> list:
+    """argparse type of a list of specimen seeds separated by commas, e.g. 1,2: each as :func:`seed_type`."""
+    return [seed_type(x, example="1,2") for x in text.split(",") if x.strip()]
+
+
+def float_list_type(text: str) -> list:
+    """argparse type of a list of numbers separated by commas, e.g. 0.7,0.8."""
+    return [float(x) for x in text.split(",") if x.strip()]
+
+
+def overrides_from_args(args) -> list:
+    """``--set`` strings plus the geometry shortcuts (--width etc.) and the command's own (``param_overrides``);
+    a shortcut's override is a :class:`~grainfrac_yade.params.FlagOverride` (its errors name the flag)."""
+    out = list(args.overrides)
+    extra = getattr(args, "param_overrides", None)
+    if extra is not None:
+        out += list(extra(args))
+    for opt, key in (("width", "specimen.width"), ("height", "specimen.height"),
+                     ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell")):
+        value = getattr(args, opt, None)
+        if value is not None:
+            out.append(FlagOverride(key, value, "--" + opt.replace("_", "-")))
+    return out
+
+
+def load_params_from_args(args):
+    """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
+    args.resolved_overrides = overrides_from_args(args)
+    params = load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
+    sp = params.specimen   # refused before any folder is made or anything allocated
+    box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
+    flags = ", ".join(override_origin(o) for o in args.resolved_overrides
+                      if override_origin(o) != "--set" and o[0].startswith("specimen."))
+    check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
+                     sp.grain_size, flags)
+    return params

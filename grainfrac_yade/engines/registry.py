@@ -1,0 +1,27 @@
+"""The engine registry: ``numerics.engine`` -> the module that implements it (imported on first use, so that
+YADE loads only when a scene is built).  Its names are the choices of ``numerics.engine`` in the schema
+(``tests/test_engines.py`` holds the two equal)."""
+from __future__ import annotations
+
+import importlib
+
+from ..errors import ParameterError
+
+#: Values of ``numerics.engine``, each with the module that implements it.
+ENGINE_MODULES = {"yade": "grainfrac_yade.yade_adapter.engine"}
+#: The names of :data:`ENGINE_MODULES` (the choices of ``numerics.engine``).
+ENGINE_NAMES = tuple(ENGINE_MODULES)
+
+
+def engine(name: str, source: str = "parameters"):
+    """The engine module ``name``; ParameterError naming the key and the choices if there is none
+    (``source``: where the name came from)."""
+    if name not in ENGINE_MODULES:
+        raise ParameterError(source, "numerics.engine", f"{name!r} is not one of {list(ENGINE_NAMES)}",
+                             f"use one of {list(ENGINE_NAMES)}")
+    return importlib.import_module(ENGINE_MODULES[name])
+
+
+def engine_for(params):
+    """The engine module of ``params`` (``numerics.engine``)."""
+    return engine(params.numerics.engine)
