@@ -38,12 +38,14 @@ def test_engine_module_loads_without_yade():
 
 @needs_yade
 @pytest.mark.yade
-def test_yade_state_round_trip():
+@pytest.mark.parametrize("model", ["rigid", "fem"])
+def test_yade_state_round_trip(model):
     """Load a tiny specimen until bonds carry force (some broken by hand), export its state, build a new
     YADE scene from it, and export again: every field equal bit for bit, but the rotations, which pass
     through a quaternion (angle -> quaternion -> angle: 1e-15 rad of rounding).  One step of the rebuilt
-    scene keeps the bonds' reference gaps (a fresh bond would have them reset by YADE's law)."""
-    p = load_parameters(overrides=TINY)
+    scene keeps the bonds' reference gaps (a fresh bond would have them reset by YADE's law).  Both grain
+    models: one body per cell, and a body per sphere with bonds on their faces' planes."""
+    p = load_parameters(overrides=[*TINY, f"resolution.grain_model={model}"])
     specimen = build_specimen(p, 1)
     yade = engine_for(p)
     scene = yade.build_scene(specimen, p)
@@ -91,3 +93,22 @@ def test_old_step_names_are_read_as_today():
     assert list(frame.columns) == ["step", "time_s", "axial_strain"]
     assert history_as_today({"creep_time_s": 0.0, "dem_steps": 7}) == {"creep_time_s": 0.0, "step": 7}
     assert summary_as_today({"dem_steps": 5, "wall_s": 1.0}) == {"steps": 5, "wall_s": 1.0}
+
+
+def test_the_paper_clock_needs_a_dynamic_engine(monkeypatch, tmp_path):
+    """An engine without dynamics (a static solver) is refused for the paper clock in one line, before any
+    folder is made; YADE's is dynamic."""
+    import sys
+    from types import SimpleNamespace
+    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.engines import registry
+    import dataclasses
+    assert registry.require_dynamic(load_parameters(), "the paper clock").NAME == "yade"
+    monkeypatch.setitem(sys.modules, "static_stand_in", SimpleNamespace(NAME="static", DYNAMIC=False))
+    monkeypatch.setitem(registry.ENGINE_MODULES, "static", "static_stand_in")
+    p = load_parameters(overrides=["stress_corrosion.clock=paper"])
+    p = dataclasses.replace(p, numerics=dataclasses.replace(p.numerics, engine="static"))
+    with pytest.raises(ParameterError) as err:
+        run_creep_to_folder(p, 1, tmp_path / "run", 200e6, 0.7, 285e6)
+    assert "numerics.engine" in str(err.value) and "paper clock" in str(err.value) and "\n" not in str(err.value)
+    assert not (tmp_path / "run").exists()

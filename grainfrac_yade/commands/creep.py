@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engines.registry import engine_for
+from ..engines.registry import engine_for, require_dynamic
 from ..errors import GrainfracError
 from ..protocols.cracks import bond_segments, broken_counts, crack_table
 
@@ -373,6 +373,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     from ..wave import budget_fields
     t0, c0 = time.time(), time.process_time()
     require_plane(params, "creep")
+    if params.stress_corrosion.clock == "paper":
+        require_dynamic(params, "the paper clock (its unbalanced force, Eq. 8)")
     out = Path(out) if resume else prepare_run_dir(out, "creep", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     run_values = {"seed": seed, "stress_pa": stress, "driving_stress_ratio": ratio, "ucs_pa": ref_ucs}

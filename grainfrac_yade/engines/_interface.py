@@ -43,7 +43,8 @@ class SceneState:
     Bonds follow the layout's bond order.  ``bond_normal_force`` and ``bond_shear_force`` are the
     force vectors the bond's second sphere exerts on its first [N], in the specimen's frame;
     ``bond_reference_gap`` the bond's stress-free normal gap (overlap positive) [m]; ``bond_slip`` the
-    path the bond's faces slid [m] (0 where an engine does not track it).  Capacities are what the
+    path the bond's faces slid [m] (0 where an engine does not track it); ``bond_plane_normal`` the unit
+    normal of the plane a bond acts on, for bonds that act on their face's plane (zero otherwise).  Capacities are what the
     bond can carry now [N], in tension and in cohesion (strength x intact area ``layout.bond_area``;
     0 once broken), kept as forces so that a state passes between engines bit for bit.
     ``platens``: the platens' state (reference positions, speed, last reaction), None without platens.
@@ -68,6 +69,7 @@ class SceneState:
     bond_shear_force: np.ndarray
     bond_reference_gap: np.ndarray
     bond_slip: np.ndarray
+    bond_plane_normal: np.ndarray
     platens: dict | None = field(default=None)
 
     def arrays(self) -> dict:

@@ -25,3 +25,13 @@ def engine(name: str, source: str = "parameters"):
 def engine_for(params):
     """The engine module of ``params`` (``numerics.engine``)."""
     return engine(params.numerics.engine)
+
+
+def require_dynamic(params, what: str):
+    """The engine of ``params`` if it integrates motion in time (``DYNAMIC``: inertia, an unbalanced force);
+    ParameterError naming ``what`` needs it otherwise (the paper clock's Eq. 8 measures the unbalanced force)."""
+    module = engine_for(params)
+    if not getattr(module, "DYNAMIC", False):
+        raise ParameterError("parameters", "numerics.engine", f"{params.numerics.engine!r} has no dynamics, and {what} "
+                             "needs them", "use a dynamic engine (e.g. 'yade') or stress_corrosion.clock = \"event\"")
+    return module

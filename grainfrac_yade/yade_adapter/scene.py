@@ -418,6 +418,8 @@ class GrainScene:
             bond_normal_force=-normal, bond_shear_force=-shear,
             bond_reference_gap=np.array([ph.initD for ph in phys]),
             bond_slip=np.array([ph.jointCumulativeSliding for ph in phys]),
+            bond_plane_normal=(np.array([tuple(ph.jointNormal) for ph in phys]).reshape(-1, 3) if self.cells.BONDS_ON_FACES
+                               else np.zeros((len(phys), 3))),
             platens=None if platens is None else platens.state_dict())
 
     def apply_state(self, state: SceneState):
@@ -452,6 +454,8 @@ class GrainScene:
             ph.shearForce = Vector3(*(-state.bond_shear_force[k]))
             ph.initD = float(state.bond_reference_gap[k])
             ph.jointCumulativeSliding = float(state.bond_slip[k])
+            if self.cells.BONDS_ON_FACES:   # YADE's smooth joint: its normal as the bond's first step aligned it
+                ph.jointNormal = Vector3(*state.bond_plane_normal[k])
             if state.bond_broken[k]:
                 ph.isCohesive, ph.isBroken = False, True
             inter.iterMadeReal = -1   # not fresh: the law would reset initD and the forces in the next step
