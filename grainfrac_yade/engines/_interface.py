@@ -137,6 +137,10 @@ class Scene(Protocol):
         """The engine's time [s]: DEM time, or a static engine's load parameter."""
 
     @property
+    def dt(self) -> float:
+        """The engine's step [s] (a dynamic engine's time step; a static engine's load-parameter increment)."""
+
+    @property
     def n_bonds(self) -> int:
         """Breakable bonds (the layout's)."""
 
