@@ -1,0 +1,252 @@
+"""Static equilibrium at a platen closure: tangent assembly, SuperLU, the active-set iteration (pure scipy).
+
+At fixed contact statuses (:mod:`.contacts`) the internal force is affine in the displacements,
+
+    f_int(u) = K(s) u + G^T b(s),   K(s) = K_g + G_n^T A_nn C_n + G_t^T (A_sn C_n + A_ss C_t),
+
+so the equilibrium f_int = f_ext on the free dofs, with the platen dofs at -d/2 and +d/2 (closure d), is one
+linear solve.  The statuses themselves follow from the solution (open/closed, stick/slip by the return mapping
+from the last converged state); the active-set iteration (a semi-smooth Newton method on the piecewise linear
+law) solves, re-reads the statuses and repeats until they agree.  A consistent set is the exact solution (to
+round-off): no residual tolerance enters the answer.  The status changes of one iteration are capped, the most
+violated first; the cap halves whenever an iteration does not reduce the number of inconsistent contacts
+(what ends open/close and stick/slip cycling).
+
+The SuperLU factor (COLAMD ordering) of the free block is kept while the tangent does not change (same
+statuses, same free set), so the tangent response to the closure and a following solve cost one
+back-substitution each.  Cells cut loose (their node group has no closed contact or bond to a platen's group)
+carry no load: their dofs are held where they are and counted; a group held by the platens but free to slide
+sideways gets one lateral dof pinned, as the intact specimen does (``elastic.solve_uniaxial``).  A singular
+or ill-conditioned system (a mechanism in the loading path) raises :class:`NumericalFailure`, one line.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import connected_components
+
+from ..errors import NumericalFailure
+from . import contacts as cl
+from .network import StaticNetwork
+
+#: Active-set iterations per equilibrium before giving up [1]: each is one factorisation; a consistent set is
+#: normally found in a handful (measured on 10 x 20 mm, docs/studies/static_engine.md).
+MAX_ACTIVE_SET_ITERATIONS = 200
+#: Status changes allowed in the first iteration [1]: all of them; the cap halves when an iteration does not
+#: reduce the number of inconsistent contacts (module doc).
+STATUS_CHANGES_PER_ITERATION = 10**9
+#: Relative residual of a linear solve above which the system counts as ill-conditioned [1]: SuperLU with partial
+#: pivoting leaves ~1e-12 on these matrices; 1e-6 means a (near) mechanism.
+ILL_CONDITIONED_RESIDUAL = 1e-6
+
+
+@dataclass
+class State:
+    """A converged equilibrium (arrays over bonds in the network's canonical order)."""
+    closure: float              # platen closure d [m]
+    u: np.ndarray               # (ndof,) [m]
+    broken: np.ndarray          # (m,) bool
+    status: np.ndarray          # (m,) contacts.INTACT / OPEN / STICK / SLIP
+    sign: np.ndarray            # (m,) slip direction
+    s_p: np.ndarray             # (m,) shear reference of broken contacts [m]
+    fn: np.ndarray              # (m,) [N], tension positive
+    fs: np.ndarray              # (m,) [N]
+    stress: float               # platen stress, compression positive [Pa]
+    break_mode: np.ndarray = field(default=None)   # (m,) 0 intact, contacts.TENSION / SHEAR
+    held: int = 0               # dofs of cells cut loose, held in place
+    iterations: int = 0         # active-set iterations of the solve that made it
+
+    def copy(self) -> "State":
+        return replace(self, u=self.u.copy(), broken=self.broken.copy(), status=self.status.copy(),
+                       sign=self.sign.copy(), s_p=self.s_p.copy(), fn=self.fn.copy(), fs=self.fs.copy(),
+                       break_mode=self.break_mode.copy())
+
+
+@dataclass
+class Counters:
+    """Work done, for the cost tables."""
+    equilibria: int = 0
+    iterations: int = 0
+    factorisations: int = 0
+    solves: int = 0
+    factor_seconds: float = 0.0     # CPU
+    solve_seconds: float = 0.0      # CPU
+
+
+class Equilibrium:
+    """Equilibria of one network under a constant lateral traction ``confinement`` [Pa] (module doc)."""
+
+    def __init__(self, net: StaticNetwork, confinement: float = 0.0,
+                 max_iterations: int = MAX_ACTIVE_SET_ITERATIONS,
+                 changes_per_iteration: int = STATUS_CHANGES_PER_ITERATION):
+        if max_iterations < 1 or changes_per_iteration < 1:
+            raise ValueError("max_iterations and changes_per_iteration must be >= 1")
+        self.net, self.max_iterations, self.changes_per_iteration = net, int(max_iterations), int(changes_per_iteration)
+        self.f_ext = net.confinement_force(confinement)
+        self.e = net.platen_vector()
+        fixed = np.zeros(net.ndof, bool)
+        fixed[net.dofs[net.top | net.bottom, 1]] = True
+        rot = net.dofs[net.top | net.bottom, 2]
+        fixed[rot[rot >= 0]] = True
+        self.platen_fixed = fixed
+        self.platen_nodes = net.top | net.bottom
+        self.counters = Counters()
+        self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
+        tri = net_tri_edges(net)
+        self._tri_edges = tri
+        self._order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
+
+    # ------------------------------------------------------------------ assembly
+    def tangent(self, status, sign, s_p):
+        """(K, b): tangent stiffness (ndof x ndof) and constant generalised force of the affine law."""
+        n = self.net
+        a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
+        k = (n.k_grain + n.gn.T @ sp.diags(a_nn) @ n.cn + n.gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct))
+        return k.tocsc(), n.gn.T @ b_n + n.gt.T @ b_s
+
+    def fixed_dofs(self, status):
+        """(fixed mask, number of dofs held because their group was cut loose, lateral pins)."""
+        n = self.net
+        closed = status != cl.OPEN
+        a, b = n.bond_nodes[closed, 0], n.bond_nodes[closed, 1]
+        ea, eb = self._tri_edges
+        nn = len(n.node_pos)
+        g = sp.coo_matrix((np.ones(len(a) + len(ea)), (np.concatenate([a, ea]), np.concatenate([b, eb]))),
+                          shape=(nn, nn))
+        _, label = connected_components(g, directed=False)
+        anchored = np.zeros(label.max() + 1, bool)
+        anchored[label[self.platen_nodes]] = True
+        fixed = self.platen_fixed.copy()
+        loose = ~anchored[label]
+        held = n.dofs[loose]
+        held = held[held >= 0]
+        fixed[held] = True
+        # one lateral pin per anchored group: its lowest (then leftmost) platen node, as elastic pins the specimen
+        pins = 0
+        seen = np.zeros(label.max() + 1, bool)
+        for node in self._order_pin:
+            if self.platen_nodes[node] and not seen[label[node]]:
+                seen[label[node]] = True
+                fixed[n.dofs[node, 0]] = True
+                pins += 1
+        return fixed, int(len(held)), pins
+
+    def _factor(self, status, sign, s_p):
+        key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
+        if key != self._key:
+            fixed, held, _ = self.fixed_dofs(status)
+            k, b = self.tangent(status, sign, s_p)
+            free = ~fixed
+            kff = k[free][:, free].tocsc()
+            t0 = time.process_time()
+            try:
+                lu = spla.splu(kff, permc_spec="COLAMD")
+            except RuntimeError as exc:
+                raise NumericalFailure(f"static equilibrium: the stiffness matrix is singular ({exc}); a mechanism "
+                                       "in the loading path (a cell or group held by one sliding contact)") from None
+            self.counters.factor_seconds += time.process_time() - t0
+            self.counters.factorisations += 1
+            self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
+            self._kfc = k[free][:, fixed].tocsr()
+        n = self.net
+        _, _, _, _, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
+        return self._lu, self._k, n.gn.T @ b_n + n.gt.T @ b_s, self._fixed
+
+    def _solve(self, lu, kff, rhs):
+        t0 = time.process_time()
+        x = lu.solve(rhs)
+        self.counters.solve_seconds += time.process_time() - t0
+        self.counters.solves += 1
+        if not np.all(np.isfinite(x)):
+            raise NumericalFailure("static equilibrium: the solution is NaN or infinite (a singular system: a "
+                                   "mechanism in the loading path)")
+        scale = max(np.abs(rhs).max(), 1e-300)
+        res = np.abs(kff @ x - rhs).max() / scale
+        if res > ILL_CONDITIONED_RESIDUAL:
+            raise NumericalFailure(f"static equilibrium: ill-conditioned system (relative residual {res:.1e} > "
+                                   f"{ILL_CONDITIONED_RESIDUAL:g}): a near mechanism in the loading path")
+        return x
+
+    def displacements(self, closure, status, sign, s_p, held_u):
+        """u at ``closure`` under fixed statuses (held dofs at ``held_u``)."""
+        lu, k, b, fixed = self._factor(status, sign, s_p)
+        u = np.where(fixed, held_u, 0.0)
+        plat = self.platen_fixed
+        u[plat] = closure * self.e[plat]
+        free = ~fixed
+        rhs = self.f_ext[free] - b[free] - self._kfc @ u[fixed]
+        u[free] = self._solve(lu, self._kff, rhs)
+        return u
+
+    def response(self, state: State):
+        """du/dd at ``state``'s statuses (the tangent response to the closure): (v, dF_n, dF_s, dstress)."""
+        lu, k, b, fixed = self._factor(state.status, state.sign, state.s_p)
+        v = np.zeros(self.net.ndof)
+        v[self.platen_fixed] = self.e[self.platen_fixed]
+        free = ~fixed
+        v[free] = self._solve(lu, self._kff, -(self._kfc @ v[fixed]))
+        n = self.net
+        a_nn, a_ns, a_sn, a_ss, _, _ = cl.affine_law(state.status, state.sign, state.s_p, n.kn, n.ks, n.tan_residual)
+        dn, ds = n.cn @ v, n.ct @ v
+        fn1, fs1 = a_nn * dn + a_ns * ds, a_sn * dn + a_ss * ds
+        return v, fn1, fs1, self.platen_stress(v, fn1, fs1, constant=False)
+
+    def platen_stress(self, u, fn, fs, constant=True):
+        """Platen stress [Pa, compression positive] of the internal forces (as ``elastic.solve_uniaxial``)."""
+        n = self.net
+        r = n.k_grain @ u + n.gn.T @ fn + n.gt.T @ fs
+        if constant:
+            r = r - self.f_ext
+        return 0.5 * (r[n.dofs[n.bottom, 1]].sum() - r[n.dofs[n.top, 1]].sum()) / (n.width * n.thickness)
+
+    # ------------------------------------------------------------------ the active-set iteration
+    def solve(self, closure: float, base: State) -> State:
+        """The equilibrium at ``closure`` from the last converged state ``base`` (its broken set, statuses as
+        the first guess, shear references for the return mapping)."""
+        n = self.net
+        status, sign = base.status.copy(), base.sign.copy()
+        cap, best = self.changes_per_iteration, None
+        for it in range(1, self.max_iterations + 1):
+            u = self.displacements(closure, status, sign, base.s_p, base.u)
+            dn, ds = n.cn @ u, n.ct @ u
+            new, new_sign, viol = cl.trial_status(dn, ds, base.broken, base.s_p, n.kn, n.ks, n.tan_residual)
+            wrong = np.flatnonzero((new != status) | ((new == cl.SLIP) & (new_sign != sign)))
+            self.counters.iterations += 1
+            if not len(wrong):
+                fn, fs = cl.forces(dn, ds, status, sign, base.s_p, n.kn, n.ks, n.tan_residual)
+                s_p = np.where(base.broken, cl.converged_slip(ds, status, fs, n.ks), base.s_p)
+                self.counters.equilibria += 1
+                return State(closure, u, base.broken.copy(), status, sign, s_p, fn, fs,
+                             self.platen_stress(u, fn, fs), base.break_mode.copy(), self._held, it)
+            if best is not None and len(wrong) >= best:
+                cap = max(1, cap // 2)
+            best = len(wrong) if best is None else min(best, len(wrong))
+            pick = wrong[np.argsort(-viol[wrong], kind="stable")[:cap]]
+            status[pick], sign[pick] = new[pick], new_sign[pick]
+        raise NumericalFailure(f"static equilibrium: contact statuses did not settle in {self.max_iterations} "
+                               f"active-set iterations ({len(wrong)} inconsistent) at closure {closure:.6g} m")
+
+    def initial(self, closure: float = 0.0) -> State:
+        """The intact specimen at ``closure`` (all bonds intact)."""
+        m = self.net.n_bonds
+        z = np.zeros(m)
+        base = State(closure, np.zeros(self.net.ndof), np.zeros(m, bool), np.full(m, cl.INTACT), np.ones(m), z,
+                     z, z, 0.0, np.zeros(m, int))
+        return self.solve(closure, base)
+
+
+def net_tri_edges(net: StaticNetwork):
+    """(a, b) node pairs that hold a cell's nodes together (the grain stiffness's couplings)."""
+    k = net.k_grain.tocoo()
+    nodes_of = np.full(net.ndof, -1)
+    for col in range(3):
+        d = net.dofs[:, col]
+        ok = d >= 0
+        nodes_of[d[ok]] = np.flatnonzero(ok)
+    a, b = nodes_of[k.row], nodes_of[k.col]
+    keep = (a != b) & (k.data != 0)
+    return a[keep], b[keep]
