@@ -24,6 +24,9 @@ from ..law import failed_now
 
 #: Status of a contact: intact bond, broken and open, broken and sticking, broken and slipping.
 INTACT, OPEN, STICK, SLIP = 0, 1, 2, 3
+#: Relative force band [1] within which a contact at the friction limit keeps its status (stick or slip): the
+#: round-off of a solve (~1e-12 of the contact forces) would otherwise flip it back and forth.
+STATUS_HYSTERESIS = 1e-9
 #: Failure modes, the codes of YADE's JCFpm crack file (as :mod:`grainfrac_yade.law`).
 TENSION, SHEAR = 1, 2
 
@@ -48,20 +51,32 @@ def forces(du_n, du_s, status, sign, s_p, kn, ks, tan_r):
     return a_nn * du_n + a_ns * du_s + b_n, a_sn * du_n + a_ss * du_s + b_s
 
 
-def trial_status(du_n, du_s, broken, s_p, kn, ks, tan_r):
+def trial_status(du_n, du_s, broken, s_p, kn, ks, tan_r, status=None, sign=None):
     """Statuses the broken contacts take at (du_n, du_s) by the return mapping from their last converged shear
     reference ``s_p``: (status, sign, violation [N]).  Open where du_n > 0; else the trial shear force
     k_s (du_s - s_p) against the friction limit -F_n tan(phi_r) = -k_n du_n tan(phi_r): stick inside, slip
-    (its sign) beyond.  ``violation``: how far the contact is from its other status, in force (what orders
-    the status changes of one iteration)."""
+    (its sign) beyond.  A contact now slipping (``status``, ``sign``: the statuses the solution was made with)
+    stays slipping only while its slip goes its way (sign x trial force beyond the limit); else it sticks first.
+    ``violation``: how far the contact is from its other status, in force (what orders the status changes of one
+    iteration)."""
     fn = kn * np.minimum(du_n, 0.0)
     f_trial = ks * (du_s - s_p)
     cap = -fn * tan_r
-    status = np.where(du_n > 0, OPEN, np.where(np.abs(f_trial) > cap, SLIP, STICK))
-    status = np.where(broken, status, INTACT)
-    sign = np.where(f_trial >= 0, 1.0, -1.0)
+    new = np.where(du_n > 0, OPEN, np.where(np.abs(f_trial) > cap, SLIP, STICK))
+    new_sign = np.where(f_trial >= 0, 1.0, -1.0)
+    if status is not None:
+        reversed_slip = (status == SLIP) & (new == SLIP) & (new_sign != sign)
+        new = np.where(reversed_slip, STICK, new)
+        new_sign = np.where(reversed_slip, sign, new_sign)
+    if status is not None:   # at the friction limit within round-off a closed contact keeps stick or slip
+        band = STATUS_HYSTERESIS * (np.abs(fn) + np.abs(f_trial))
+        both_closed = ((status == STICK) | (status == SLIP)) & ((new == STICK) | (new == SLIP))
+        keep = both_closed & (np.abs(np.abs(f_trial) - cap) <= band)
+        new = np.where(keep, status, new)
+        new_sign = np.where(keep, sign, new_sign)
+    new = np.where(broken, new, INTACT)
     violation = np.where(du_n > 0, kn * du_n, np.minimum(-fn, np.abs(np.abs(f_trial) - cap)))
-    return status, sign, violation
+    return new, new_sign, violation
 
 
 def converged_slip(du_s, status, fs, ks):

@@ -44,6 +44,14 @@ STATUS_CHANGES_PER_ITERATION = 10**9
 ILL_CONDITIONED_RESIDUAL = 1e-6
 
 
+#: Halvings of a step whose active set cycles [1]: at most 2**12 sub-steps before NumericalFailure.
+MAX_SPLIT_DEPTH = 12
+
+
+class _Cycling(Exception):
+    """The active set came back to a status set it had tried, or did not settle."""
+
+
 @dataclass
 class State:
     """A converged equilibrium (arrays over bonds in the network's canonical order)."""
@@ -75,6 +83,7 @@ class Counters:
     solves: int = 0
     factor_seconds: float = 0.0     # CPU
     solve_seconds: float = 0.0      # CPU
+    splits: int = 0                 # steps split in two because the active set cycled
 
 
 class Equilibrium:
@@ -102,11 +111,11 @@ class Equilibrium:
 
     # ------------------------------------------------------------------ assembly
     def tangent(self, status, sign, s_p):
-        """(K, b): tangent stiffness (ndof x ndof) and constant generalised force of the affine law."""
+        """Tangent stiffness (ndof x ndof) of the affine law at these statuses."""
         n = self.net
         a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
-        k = (n.k_grain + n.gn.T @ sp.diags(a_nn) @ n.cn + n.gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct))
-        return k.tocsc(), n.gn.T @ b_n + n.gt.T @ b_s
+        gn, gt = n.force_rows(status != cl.INTACT)
+        return (n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)).tocsc()
 
     def fixed_dofs(self, status):
         """(fixed mask, number of dofs held because their group was cut loose, lateral pins)."""
@@ -139,7 +148,8 @@ class Equilibrium:
         key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
         if key != self._key:
             fixed, held, _ = self.fixed_dofs(status)
-            k, b = self.tangent(status, sign, s_p)
+            k = self.tangent(status, sign, s_p)
+            self._gn, self._gt = n_rows = self.net.force_rows(status != cl.INTACT)
             free = ~fixed
             kff = k[free][:, free].tocsc()
             t0 = time.process_time()
@@ -154,7 +164,7 @@ class Equilibrium:
             self._kfc = k[free][:, fixed].tocsr()
         n = self.net
         _, _, _, _, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
-        return self._lu, self._k, n.gn.T @ b_n + n.gt.T @ b_s, self._fixed
+        return self._lu, self._k, self._gt.T @ b_s, self._fixed
 
     def _solve(self, lu, kff, rhs):
         t0 = time.process_time()
@@ -171,14 +181,15 @@ class Equilibrium:
                                    f"{ILL_CONDITIONED_RESIDUAL:g}): a near mechanism in the loading path")
         return x
 
-    def displacements(self, closure, status, sign, s_p, held_u):
-        """u at ``closure`` under fixed statuses (held dofs at ``held_u``)."""
+    def displacements(self, closure, status, sign, s_p, held_u, extra=None):
+        """u at ``closure`` under fixed statuses (held dofs at ``held_u``; ``extra``: a further dead load)."""
         lu, k, b, fixed = self._factor(status, sign, s_p)
         u = np.where(fixed, held_u, 0.0)
         plat = self.platen_fixed
         u[plat] = closure * self.e[plat]
         free = ~fixed
-        rhs = self.f_ext[free] - b[free] - self._kfc @ u[fixed]
+        f = self.f_ext if extra is None else self.f_ext + extra
+        rhs = f[free] - b[free] - self._kfc @ u[fixed]
         u[free] = self._solve(lu, self._kff, rhs)
         return u
 
@@ -193,27 +204,65 @@ class Equilibrium:
         a_nn, a_ns, a_sn, a_ss, _, _ = cl.affine_law(state.status, state.sign, state.s_p, n.kn, n.ks, n.tan_residual)
         dn, ds = n.cn @ v, n.ct @ v
         fn1, fs1 = a_nn * dn + a_ns * ds, a_sn * dn + a_ss * ds
-        return v, fn1, fs1, self.platen_stress(v, fn1, fs1, constant=False)
+        return v, fn1, fs1, self.platen_stress(v, fn1, fs1, state.status != cl.INTACT, constant=False)
 
-    def platen_stress(self, u, fn, fs, constant=True):
+    def platen_stress(self, u, fn, fs, broken, constant=True):
         """Platen stress [Pa, compression positive] of the internal forces (as ``elastic.solve_uniaxial``)."""
         n = self.net
-        r = n.k_grain @ u + n.gn.T @ fn + n.gt.T @ fs
+        gn, gt = n.force_rows(broken)
+        r = n.k_grain @ u + gn.T @ fn + gt.T @ fs
         if constant:
             r = r - self.f_ext
         return 0.5 * (r[n.dofs[n.bottom, 1]].sum() - r[n.dofs[n.top, 1]].sum()) / (n.width * n.thickness)
 
     # ------------------------------------------------------------------ the active-set iteration
-    def solve(self, closure: float, base: State) -> State:
+    def solve(self, closure: float, base: State, release=None) -> State:
         """The equilibrium at ``closure`` from the last converged state ``base`` (its broken set, statuses as
-        the first guess, shear references for the return mapping)."""
+        the first guess, shear references for the return mapping).  ``release``: the generalised force that the
+        bonds broken since ``base`` carried beyond what they carry as broken contacts (:meth:`release_force`).
+
+        Where the active set cycles or does not settle, the step is split in two halves (closure and release
+        both halved), each solved from the converged state of the one before (a finer path, down to
+        ``2**MAX_SPLIT_DEPTH`` sub-steps); only then NumericalFailure."""
+        return self._split(closure, base, release, 0)
+
+    def _split(self, closure, base, release, depth, lam0=0.0, lam1=1.0):
+        try:
+            return self._active_set(closure, base, None if release is None else (1.0 - lam1) * release)
+        except _Cycling as exc:
+            if depth >= MAX_SPLIT_DEPTH:
+                raise NumericalFailure(f"static equilibrium: contact statuses did not settle ({exc}) even in "
+                                       f"{2 ** depth} sub-steps at closure {closure:.6g} m") from None
+        self.counters.splits += 1
+        mid = 0.5 * (base.closure + closure)
+        lam = 0.5 * (lam0 + lam1)
+        half = self._split(mid, base, release, depth + 1, lam0, lam)
+        return self._split(closure, half, release, depth + 1, lam, lam1)
+
+    def release_force(self, state: State, broken_now: State) -> np.ndarray:
+        """(ndof,) what the bonds broken between ``state`` (intact there) and ``broken_now`` (the same displacement,
+        those bonds broken) carried beyond their broken-contact forces, as a generalised force on the nodes."""
+        n = self.net
+        new = broken_now.broken & ~state.broken
+        dn, ds = n.cn @ state.u, n.ct @ state.u
+        fn_b, fs_b = cl.forces(dn, ds, broken_now.status, broken_now.sign, broken_now.s_p, n.kn, n.ks, n.tan_residual)
+        gn, gt = n.force_rows(state.broken)
+        gnb, gtb = n.force_rows(broken_now.broken)
+        w = new.astype(float)
+        return -(gn.T @ (w * state.fn) + gt.T @ (w * state.fs) - gnb.T @ (w * fn_b) - gtb.T @ (w * fs_b))
+
+    def _active_set(self, closure, base, extra) -> State:
         n = self.net
         status, sign = base.status.copy(), base.sign.copy()
-        cap, best = self.changes_per_iteration, None
+        cap, best, seen = self.changes_per_iteration, None, set()
         for it in range(1, self.max_iterations + 1):
-            u = self.displacements(closure, status, sign, base.s_p, base.u)
+            key = (status.tobytes(), sign.tobytes())
+            if key in seen:
+                raise _Cycling(f"a status set came back after {it - 1} iterations")
+            seen.add(key)
+            u = self.displacements(closure, status, sign, base.s_p, base.u, extra)
             dn, ds = n.cn @ u, n.ct @ u
-            new, new_sign, viol = cl.trial_status(dn, ds, base.broken, base.s_p, n.kn, n.ks, n.tan_residual)
+            new, new_sign, viol = cl.trial_status(dn, ds, base.broken, base.s_p, n.kn, n.ks, n.tan_residual, status, sign)
             wrong = np.flatnonzero((new != status) | ((new == cl.SLIP) & (new_sign != sign)))
             self.counters.iterations += 1
             if not len(wrong):
@@ -221,14 +270,13 @@ class Equilibrium:
                 s_p = np.where(base.broken, cl.converged_slip(ds, status, fs, n.ks), base.s_p)
                 self.counters.equilibria += 1
                 return State(closure, u, base.broken.copy(), status, sign, s_p, fn, fs,
-                             self.platen_stress(u, fn, fs), base.break_mode.copy(), self._held, it)
+                             self.platen_stress(u, fn, fs, base.broken), base.break_mode.copy(), self._held, it)
             if best is not None and len(wrong) >= best:
                 cap = max(1, cap // 2)
             best = len(wrong) if best is None else min(best, len(wrong))
             pick = wrong[np.argsort(-viol[wrong], kind="stable")[:cap]]
             status[pick], sign[pick] = new[pick], new_sign[pick]
-        raise NumericalFailure(f"static equilibrium: contact statuses did not settle in {self.max_iterations} "
-                               f"active-set iterations ({len(wrong)} inconsistent) at closure {closure:.6g} m")
+        raise _Cycling(f"{len(wrong)} inconsistent after {self.max_iterations} iterations")
 
     def initial(self, closure: float = 0.0) -> State:
         """The intact specimen at ``closure`` (all bonds intact)."""
