@@ -185,6 +185,7 @@ class Path:
         """Follow the path until ``max_closure`` or until ``stop(state, records)`` says so; returns the last state."""
         quiet = 0
         while state.closure < max_closure:
+            self.last_state = state
             state, what = self.step(state, None, max_closure)
             if what == "none":
                 return state

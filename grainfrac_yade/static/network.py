@@ -173,12 +173,26 @@ def from_network(net: Network, *, top, bottom, left, right, width, height, thick
         height=float(height), thickness=float(thickness))
 
 
-def build_static_network(specimen, params, layout) -> StaticNetwork:
+def build_static_network(specimen, params, layout, bond_permutation=None) -> StaticNetwork:
     """The static network of ``specimen`` under the grain model that built ``layout`` (rigid or fem cells),
-    with the bonds' Table 2 strengths and friction (:func:`grainfrac_yade.layout.bond_properties`)."""
+    with the bonds' Table 2 strengths and friction (:func:`grainfrac_yade.layout.bond_properties`).
+    ``bond_permutation``: the same bonds numbered otherwise (input bond k is layout bond permutation[k])."""
     from ..layout import bond_properties
     net = build_network(specimen, params, layout.model, layout)
     props = bond_properties(specimen, layout, params)
+    if bond_permutation is not None:
+        q = np.asarray(bond_permutation)
+        net = Network(node_pos=net.node_pos, node_rotates=net.node_rotates, node_cell=net.node_cell,
+                      spring_nodes=net.spring_nodes[q], spring_normal=net.spring_normal[q], spring_arm=net.spring_arm[q],
+                      spring_kn=net.spring_kn[q], spring_ks=net.spring_ks[q], spring_area=net.spring_area[q],
+                      spring_face=net.spring_face[q], tri_nodes=net.tri_nodes, tri_stiffness=net.tri_stiffness,
+                      spring_torque_arm=None if net.spring_torque_arm is None else net.spring_torque_arm[q],
+                      spring_shear_translation_scale=None if net.spring_shear_translation_scale is None
+                      else net.spring_shear_translation_scale[q])
+        props = type(props)(**{k: v[q] for k, v in vars(props).items()})
+        layout_point = layout.bond_point[q]
+    else:
+        layout_point = layout.bond_point
     t = specimen.tessellation
     top = np.isin(net.node_cell, t.cells_on_side("top"))
     bottom = np.isin(net.node_cell, t.cells_on_side("bottom")) & ~top
@@ -187,4 +201,4 @@ def build_static_network(specimen, params, layout) -> StaticNetwork:
                         height=float(t.box[1]), thickness=specimen.thickness,
                         tensile_strength=props.tensile_strength, cohesion=props.cohesion,
                         friction_angle=props.friction_angle, residual_friction_angle=props.residual_friction_angle,
-                        key_point=layout.bond_point[:, :2])
+                        key_point=layout_point[:, :2])

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import NumericalFailure
 from .cascade import Path
 from .solver import Equilibrium
 
@@ -62,7 +63,11 @@ def ucs_path(eq: Equilibrium, max_strain: float, stop_stress_ratio: float, confi
             return True
         return False
 
-    state = path.run_closure(state, max_strain * net.height, stop)
+    try:
+        state = path.run_closure(state, max_strain * net.height, stop)
+    except NumericalFailure as exc:      # reported with the path so far; the peak before it stands if passed
+        end[0] = f"numerical failure: {exc}"
+        state = path.last_state
     last_dev = state.stress - confinement
     if last_dev > peak["s"]:
         peak.update(s=last_dev, e=state.closure / net.height, n=int(state.broken.sum()))
