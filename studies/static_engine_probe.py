@@ -31,6 +31,8 @@ from grainfrac_yade.static.ucs import ucs_path
 
 #: Axial strains at which the geometry is read [1]: around the YADE peaks of 10 x 20 mm seed 1 (fem 0.38 %,
 #: docs/studies/paper_fem/mesh/ucs_runs.csv) and beyond.
+#: Cascades of at least this many bonds are listed [1].
+CASCADE_REPORT = 10
 PROBE_STRAINS = (0.002, 0.003, 0.004, 0.005, 0.01, 0.02)
 
 
@@ -93,6 +95,9 @@ def main(argv=None):
                   "iterations_per_equilibrium": c.iterations / max(c.equilibria, 1),
                   "equilibria_per_break": c.equilibria / breaks, "cpu_per_break_s": cpu / breaks}
     out["geometry"] = probes
+    #: cascades of CASCADE_REPORT or more bonds: (strain, bonds, stress before and after [MPa])
+    out["large_cascades"] = [(x.closure / net.height, len(x.bonds), x.stress_before / 1e6, x.stress_after / 1e6)
+                             for x in path.records if len(x.bonds) >= CASCADE_REPORT]
     if a.creep_stress:
         eq2 = Equilibrium(net)
         law = build_law(p.stress_corrosion)

@@ -12,7 +12,7 @@ rolling regularisation of rigid cells, ``elastic.ROLLING_REGULARISATION``).  Loa
 every node of a cell touching the top (bottom) wall moves with that platen in y by -d/2 (+d/2), d the platen
 closure [m]; rotations of platen cells blocked; lateral motion free (smooth platens).
 
-Bonds are kept in a canonical order (by their contact point, then their first node's position), so that
+Bonds are kept in a canonical order (by their contact point, then their nodes' positions), so that
 nothing the engine decides depends on how the input numbered them; ``order`` maps back.
 """
 from __future__ import annotations
@@ -101,9 +101,11 @@ def grain_stiffness(net: Network, dofs, ndof) -> sp.csr_matrix:
                                                              np.tile(tidx, (1, 6)).ravel())), shape=(ndof, ndof)).tocsr()
 
 
-def canonical_order(point: np.ndarray, first_node_pos: np.ndarray) -> np.ndarray:
-    """Bond order by contact point (x, then y), then by the first node's position: a numbering-free key."""
-    return np.lexsort((first_node_pos[:, 1], first_node_pos[:, 0], point[:, 1], point[:, 0]))
+def canonical_order(point: np.ndarray, first_node_pos: np.ndarray, second_node_pos: np.ndarray) -> np.ndarray:
+    """Bond order by contact point (x, then y), then by the first and the second node's positions: a
+    numbering-free key (fem bonds of two faces meeting at a corner share the point and may share a node)."""
+    return np.lexsort((second_node_pos[:, 1], second_node_pos[:, 0], first_node_pos[:, 1], first_node_pos[:, 0],
+                       point[:, 1], point[:, 0]))
 
 
 def _side_nodes(specimen, node_cell):
@@ -140,7 +142,8 @@ def from_network(net: Network, *, top, bottom, left, right, width, height, thick
         pa = net.node_pos[net.spring_nodes[:, 0]] + net.spring_arm[:, 0]
         pb = net.node_pos[net.spring_nodes[:, 1]] + net.spring_arm[:, 1]
         key_point = 0.5 * (pa + pb)
-    order = canonical_order(np.asarray(key_point)[:, :2], net.node_pos[net.spring_nodes[:, 0]])
+    order = canonical_order(np.asarray(key_point)[:, :2], net.node_pos[net.spring_nodes[:, 0]],
+                            net.node_pos[net.spring_nodes[:, 1]])
     k_all, dofs = stiffness_matrix(net)      # for the rolling regularisation scale, as elastic.solve_uniaxial
     _, ndof = _dof_map(net)
     idx, cn, ct = _spring_rows(net, dofs, shear_scale=net.spring_shear_translation_scale)
