@@ -7,6 +7,9 @@ creep interval to the next bond failure under frozen stresses), the clock advanc
 are written to the bonds, the failing bonds break one at a time with their cascade at the reached closure,
 and the path regains S.  The specimen fails by the rule of :mod:`.failure`; the lifetime is the creep time then.
 
+The ramp to S fails only by rule 1 of :mod:`.failure` (no equilibrium ahead: the path's peak lies below S);
+the collapse strain applies to regaining S after an event, as in the YADE runs.
+
 The paper's adaptive clock (Eq. 8) schedules dynamic relaxation steps; the static engine refuses it.
 """
 from __future__ import annotations
@@ -47,7 +50,7 @@ def creep_hold(eq: Equilibrium, law, clock, stress: float, rule: FailureRule, ma
         raise GrainfracError(PAPER_CLOCK_REFUSED)
     net = eq.net
     path = path or Path(eq)
-    state, reason = path.hold(eq.initial(0.0), stress, rule)
+    state, reason = path.hold(eq.initial(0.0), stress, FailureRule(0.0))   # the ramp: only "no equilibrium ahead"
     res = CreepResult(False, "", clock.creep_time, 0, int(state.broken.sum()), state=state)
     if reason:
         res.failed, res.reason = True, "at load: " + reason
