@@ -98,10 +98,29 @@ def test_cell_cut_loose_is_held_and_reported():
     assert state.fn[0] == pytest.approx(net.kn[0] * 1e-7, rel=1e-12) and state.fn[1] == state.fn[2] == 0
 
 
-def test_singular_system_is_one_line_numerical_failure():
-    """A node held by one bond without shear stiffness can slide freely: the solve says so in one line."""
-    net = network([[0, 0], [0, 1e-3], [1e-3, 0]], [[0, 1], [0, 2]], [[0, 1], [1, 0]], top=[1], bottom=[0],
-                  ks=[2e9, 0.0])
+def _hinged(**kw):
+    """Node 2 bonded to node 0 by one bond whose tangent is x and whose shear stiffness is 0: free along x."""
+    return network([[0, 0], [0, 1e-3], [1e-3, 0]], [[0, 1], [0, 2]], [[0, 1], [0, 1]], top=[1], bottom=[0],
+                   right=[2], ks=[2e9, 0.0], **kw)
+
+
+def test_unloaded_mechanism_is_held_by_the_ground_springs():
+    """The free direction carries no load: the factor is made again with the ground springs, counted, and the
+    forces are those of the rest of the network (bond 0 compressed by k_n x closure)."""
+    eq = Equilibrium(_hinged())
+    st = eq.initial(1e-7)
+    assert eq.counters.grounded >= 1
+    assert st.fn[0] == pytest.approx(-net_kn() * 1e-7, rel=1e-9)   # the ground springs' 1e-12 moves it by less
+    assert np.isfinite(st.u).all()
+
+
+def net_kn():
+    from static_tiny import KN
+    return KN
+
+
+def test_loaded_mechanism_is_one_line_numerical_failure():
+    """A confining traction pushes node 2 along its free direction: no equilibrium exists; one line says so."""
     with pytest.raises(NumericalFailure) as err:
-        Equilibrium(net).initial(1e-6)
+        Equilibrium(_hinged(), confinement=1e6).initial(1e-7)
     assert "\n" not in str(err.value) and "mechanism" in str(err.value)

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..clocks import EventClock, PaperClock
-from ..errors import GrainfracError
+from ..errors import GrainfracError, NumericalFailure
 from ..law import Stresses, creep_step
 from .cascade import Path
 from .failure import FailureRule
@@ -41,6 +41,7 @@ class CreepResult:
     strains: list = field(default_factory=list)     # axial strain after each event [1]
     broken_counts: list = field(default_factory=list)
     state: State | None = None
+    numerical_failure: bool = False   # the solver gave up (never a failure of the specimen)
 
 
 def creep_hold(eq: Equilibrium, law, clock, stress: float, rule: FailureRule, max_events: int = 10**6,
@@ -48,10 +49,18 @@ def creep_hold(eq: Equilibrium, law, clock, stress: float, rule: FailureRule, ma
     """Hold ``stress`` [Pa] on ``eq``'s network until it fails or the clock's time limit (module doc)."""
     if isinstance(clock, PaperClock) or not isinstance(clock, EventClock):
         raise GrainfracError(PAPER_CLOCK_REFUSED)
+    res = CreepResult(False, "", clock.creep_time, 0, 0)
+    try:
+        return _hold(eq, law, clock, stress, rule, max_events, path or Path(eq), res)
+    except NumericalFailure as exc:     # reported with what was reached; the lifetime is not a result
+        res.numerical_failure, res.reason, res.lifetime = True, f"numerical failure: {exc}", clock.creep_time
+        return res
+
+
+def _hold(eq, law, clock, stress, rule, max_events, path, res):
     net = eq.net
-    path = path or Path(eq)
     state, reason = path.hold(eq.initial(0.0), stress, FailureRule(0.0))   # the ramp: only "no equilibrium ahead"
-    res = CreepResult(False, "", clock.creep_time, 0, int(state.broken.sum()), state=state)
+    res.broken, res.state = int(state.broken.sum()), state
     if reason:
         res.failed, res.reason = True, "at load: " + reason
         return res
@@ -75,6 +84,7 @@ def creep_hold(eq: Equilibrium, law, clock, stress: float, rule: FailureRule, ma
         state = path.cascade(state)
         state, reason = path.hold(state, stress, rule)
         res.events += 1
+        res.state = state
         res.times.append(clock.creep_time)
         res.strains.append(state.closure / net.height)
         res.broken_counts.append(int(state.broken.sum()))

@@ -44,6 +44,17 @@ STATUS_CHANGES_PER_ITERATION = 10**9
 ILL_CONDITIONED_RESIDUAL = 1e-6
 
 
+#: Stiffness to the ground on every dof, relative to that dof's own diagonal entry in the intact tangent [1], used
+#: only where the plain factor is singular: a cell or group hinged at one node (a zero-energy rotation left when its
+#: other bonds broke and opened) carries no load but makes the matrix singular; with 1e-12 SuperLU factorises and
+#: forces move by ~1e-9 relative (measured on 4 x 8 mm), as ``elastic.ROLLING_REGULARISATION`` does for rolling.
+GROUND_REGULARISATION = 1e-12
+#: A factor whose smallest pivot is below this fraction of its largest is taken as singular [1] and made again
+#: with the ground springs: float64 resolves 1e-16; intact 10 x 20 mm specimens have pivot ratios ~1e-6.
+PIVOT_RATIO = 1e-13
+#: With the ground springs in, a solution whose ground forces exceed this fraction of the largest load on the free
+#: dofs holds a mechanism against a load [1] (an unloaded hinge leaves them at round-off, ~1e-12).
+LOADED_MECHANISM = 1e-6
 #: Halvings of a step whose active set cycles [1]: at most 2**12 sub-steps before NumericalFailure.
 MAX_SPLIT_DEPTH = 12
 
@@ -90,6 +101,7 @@ class Counters:
     factor_seconds: float = 0.0     # CPU
     solve_seconds: float = 0.0      # CPU
     splits: int = 0                 # steps split in two because the active set cycled
+    grounded: int = 0               # factorisations that needed the ground springs (a hinge or sliding group)
 
 
 class Equilibrium:
@@ -113,18 +125,27 @@ class Equilibrium:
         self.platen_fixed = fixed
         self.platen_nodes = net.top | net.bottom
         self.counters = Counters()
+        self._ground = None
         self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
         tri = net_tri_edges(net)
         self._tri_edges = tri
         self._order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
 
     # ------------------------------------------------------------------ assembly
-    def tangent(self, status, sign, s_p):
+    def tangent(self, status, sign, s_p, ground=False):
         """Tangent stiffness (ndof x ndof) of the affine law at these statuses."""
         n = self.net
         a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
         gn, gt = n.force_rows(status != cl.INTACT)
-        return (n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)).tocsc()
+        k = n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)
+        if self._ground is None:      # each dof's own intact stiffness, once (its kind's median where it has none)
+            d = np.abs(k.diagonal())
+            for col in range(3):
+                idx = n.dofs[:, col][n.dofs[:, col] >= 0]
+                if len(idx) and (d[idx] > 0).any():
+                    d[idx] = np.where(d[idx] > 0, d[idx], np.median(d[idx][d[idx] > 0]))
+            self._ground = sp.diags(GROUND_REGULARISATION * d)
+        return (k + self._ground).tocsc() if ground else k.tocsc()
 
     def fixed_dofs(self, status):
         """(fixed mask, number of dofs held because their group was cut loose, lateral pins)."""
@@ -156,8 +177,23 @@ class Equilibrium:
     def _factor(self, status, sign, s_p):
         key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
         if key != self._key:
+            self._grounded = False
+            try:
+                self._factor_now(key, status, sign, s_p, False)
+            except NumericalFailure:    # a hinge or a sliding group: once more with the ground springs
+                self._factor_now(key, status, sign, s_p, True)
+        n = self.net
+        _, _, _, _, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
+        return self._lu, self._k, self._gt.T @ b_s, self._fixed
+
+    def _factor_now(self, key, status, sign, s_p, ground):
+        if True:
+            self._key = None
             fixed, held, _ = self.fixed_dofs(status)
-            k = self.tangent(status, sign, s_p)
+            k = self.tangent(status, sign, s_p, ground)
+            self._grounded = ground
+            if ground:
+                self.counters.grounded += 1
             self._gn, self._gt = n_rows = self.net.force_rows(status != cl.INTACT)
             free = ~fixed
             kff = k[free][:, free].tocsc()
@@ -171,9 +207,11 @@ class Equilibrium:
             self.counters.factorisations += 1
             self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
             self._kfc = k[free][:, fixed].tocsr()
-        n = self.net
-        _, _, _, _, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
-        return self._lu, self._k, self._gt.T @ b_s, self._fixed
+            if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread
+                d = np.abs(lu.U.diagonal())
+                if d.min() <= PIVOT_RATIO * d.max():
+                    self._key = None
+                    raise NumericalFailure("static equilibrium: a pivot of the factor vanishes (a mechanism)")
 
     def _solve(self, lu, kff, rhs):
         if not rhs.size:
@@ -194,23 +232,43 @@ class Equilibrium:
 
     def displacements(self, closure, status, sign, s_p, held_u, extra=None):
         """u at ``closure`` under fixed statuses (held dofs at ``held_u``; ``extra``: a further dead load)."""
-        lu, k, b, fixed = self._factor(status, sign, s_p)
-        u = np.where(fixed, held_u, 0.0)
-        plat = self.platen_fixed
-        u[plat] = closure * self.e[plat]
-        free = ~fixed
-        f = self.f_ext if extra is None else self.f_ext + extra
-        rhs = f[free] - b[free] - self._kfc @ u[fixed]
-        u[free] = self._solve(lu, self._kff, rhs)
-        return u
+        def rhs_of(k, b, fixed):
+            u = np.where(fixed, held_u, 0.0)
+            plat = self.platen_fixed
+            u[plat] = closure * self.e[plat]
+            f = self.f_ext if extra is None else self.f_ext + extra
+            return u, f[~fixed] - b[~fixed] - self._kfc @ u[fixed]
+        return self._solve_state(status, sign, s_p, rhs_of)
+
+    def _solve_state(self, status, sign, s_p, rhs_of):
+        """Factor (or reuse), solve, and where the plain factor fails retry once with the ground springs; a
+        mechanism the ground springs hold against a load is NumericalFailure."""
+        for attempt in range(2):
+            lu, k, b, fixed = self._factor(status, sign, s_p)
+            u, rhs = rhs_of(k, b, fixed)
+            try:
+                u[~fixed] = self._solve(lu, self._kff, rhs)
+            except NumericalFailure:
+                if self._grounded:
+                    raise
+                key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
+                self._factor_now(key, status, sign, s_p, True)
+                continue
+            if self._grounded:
+                pull = np.abs(self._ground.diagonal() * u).max()
+                if pull > LOADED_MECHANISM * max(np.abs(rhs).max(), 1e-300):
+                    raise NumericalFailure(f"static equilibrium: a loaded mechanism (the ground springs carry "
+                                           f"{pull:.3g} N): a cell or group free to move against a load")
+            return u
+        raise NumericalFailure("static equilibrium: no factor solves the system (a mechanism)")
 
     def response(self, state: State):
         """du/dd at ``state``'s statuses (the tangent response to the closure): (v, dF_n, dF_s, dstress)."""
-        lu, k, b, fixed = self._factor(state.status, state.sign, state.s_p)
-        v = np.zeros(self.net.ndof)
-        v[self.platen_fixed] = self.e[self.platen_fixed]
-        free = ~fixed
-        v[free] = self._solve(lu, self._kff, -(self._kfc @ v[fixed]))
+        def rhs_of(k, b, fixed):
+            v = np.zeros(self.net.ndof)
+            v[self.platen_fixed] = self.e[self.platen_fixed]
+            return v, -(self._kfc @ v[fixed])
+        v = self._solve_state(state.status, state.sign, state.s_p, rhs_of)
         n = self.net
         a_nn, a_ns, a_sn, a_ss, _, _ = cl.affine_law(state.status, state.sign, state.s_p, n.kn, n.ks, n.tan_residual)
         dn, ds = n.cn @ v, n.ct @ v
