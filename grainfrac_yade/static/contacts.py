@@ -81,7 +81,7 @@ def trial_status(du_n, du_s, broken, s_p, kn, ks, tan_r, status=None, sign=None)
 
 def converged_slip(du_s, status, fs, ks):
     """Shear reference after a converged state: s_p = du_s - F_s / k_s (slip moves it; open resets it)."""
-    return np.where(status == OPEN, du_s, du_s - fs / ks)
+    return np.where(status == OPEN, du_s, du_s - np.divide(fs, ks, out=np.zeros_like(fs), where=ks > 0))
 
 
 def overstress(fn, fs, area, jt, jc, tan_phi):
@@ -124,4 +124,4 @@ def break_state(du_n, du_s, fs, kn, ks, tan_r):
     fs_c = np.clip(fs, -cap, cap)
     status = np.where(du_n > 0, OPEN, np.where(np.abs(fs) > cap, SLIP, STICK))
     sign = np.where(fs >= 0, 1.0, -1.0)
-    return status, sign, np.where(du_n > 0, du_s, du_s - fs_c / ks)
+    return status, sign, np.where(du_n > 0, du_s, du_s - np.divide(fs_c, ks, out=np.zeros_like(fs_c), where=ks > 0))

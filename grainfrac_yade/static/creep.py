@@ -54,6 +54,7 @@ def creep_hold(eq: Equilibrium, law, clock, stress: float, rule: FailureRule, ma
         return _hold(eq, law, clock, stress, rule, max_events, path or Path(eq), res)
     except NumericalFailure as exc:     # reported with what was reached; the lifetime is not a result
         res.numerical_failure, res.reason, res.lifetime = True, f"numerical failure: {exc}", clock.creep_time
+        res.broken = int(res.state.broken.sum()) if res.state is not None else 0
         return res
 
 
