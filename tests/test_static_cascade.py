@@ -8,6 +8,7 @@ from grainfrac_yade.params import load_parameters
 from grainfrac_yade.specimen import build_specimen
 from grainfrac_yade.static import contacts as cl
 from grainfrac_yade.static.cascade import Path
+from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 from grainfrac_yade.static.ucs import ucs_path
@@ -124,3 +125,16 @@ def test_loaded_mechanism_is_one_line_numerical_failure():
     with pytest.raises(NumericalFailure) as err:
         Equilibrium(_hinged(), confinement=1e6).initial(1e-7)
     assert "\n" not in str(err.value) and "mechanism" in str(err.value)
+
+
+def test_confinement_is_a_constant_lateral_traction():
+    """The confining stress is a dead load on the side nodes summing to sigma_3 x height x thickness on each side,
+    and the confined UCS path starts from the hydrostatic state (axial stress = sigma_3 before the deviator)."""
+    s, p, lay = _tiny("fem")
+    net = build_static_network(s, p, lay)
+    f = net.confinement_force(20e6)
+    assert f[net.dofs[net.left, 0]].sum() == pytest.approx(20e6 * net.height * net.thickness, rel=1e-12)
+    assert f[net.dofs[net.right, 0]].sum() == pytest.approx(-20e6 * net.height * net.thickness, rel=1e-12)
+    eq = Equilibrium(net, confinement=20e6)
+    state, reason = Path(eq).hold(eq.initial(0.0), 20e6, FailureRule(0.0))
+    assert reason is None and state.stress == pytest.approx(20e6, rel=1e-9)   # the bracketing tolerance
