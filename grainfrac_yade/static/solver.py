@@ -187,31 +187,31 @@ class Equilibrium:
         return self._lu, self._k, self._gt.T @ b_s, self._fixed
 
     def _factor_now(self, key, status, sign, s_p, ground):
-        if True:
-            self._key = None
-            fixed, held, _ = self.fixed_dofs(status)
-            k = self.tangent(status, sign, s_p, ground)
-            self._grounded = ground
-            if ground:
-                self.counters.grounded += 1
-            self._gn, self._gt = n_rows = self.net.force_rows(status != cl.INTACT)
-            free = ~fixed
-            kff = k[free][:, free].tocsc()
-            t0 = time.process_time()
-            try:
-                lu = spla.splu(kff, permc_spec="COLAMD") if kff.shape[0] else None
-            except RuntimeError as exc:
-                raise NumericalFailure(f"static equilibrium: the stiffness matrix is singular ({exc}); a mechanism "
-                                       "in the loading path (a cell or group held by one sliding contact)") from None
-            self.counters.factor_seconds += time.process_time() - t0
-            self.counters.factorisations += 1
-            self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
-            self._kfc = k[free][:, fixed].tocsr()
-            if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread
-                d = np.abs(lu.U.diagonal())
-                if d.min() <= PIVOT_RATIO * d.max():
-                    self._key = None
-                    raise NumericalFailure("static equilibrium: a pivot of the factor vanishes (a mechanism)")
+        """Assemble and factorise the free block at these statuses (``ground``: with the ground springs)."""
+        self._key = None
+        fixed, held, _ = self.fixed_dofs(status)
+        k = self.tangent(status, sign, s_p, ground)
+        self._grounded = ground
+        if ground:
+            self.counters.grounded += 1
+        self._gn, self._gt = self.net.force_rows(status != cl.INTACT)
+        free = ~fixed
+        kff = k[free][:, free].tocsc()
+        t0 = time.process_time()
+        try:
+            lu = spla.splu(kff, permc_spec="COLAMD") if kff.shape[0] else None
+        except RuntimeError as exc:
+            raise NumericalFailure(f"static equilibrium: the stiffness matrix is singular ({exc}); a mechanism "
+                                   "in the loading path (a cell or group held by one sliding contact)") from None
+        self.counters.factor_seconds += time.process_time() - t0
+        self.counters.factorisations += 1
+        self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
+        self._kfc = k[free][:, fixed].tocsr()
+        if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread
+            d = np.abs(lu.U.diagonal())
+            if d.min() <= PIVOT_RATIO * d.max():
+                self._key = None
+                raise NumericalFailure("static equilibrium: a pivot of the factor vanishes (a mechanism)")
 
     def _solve(self, lu, kff, rhs):
         if not rhs.size:
