@@ -58,6 +58,8 @@ def main(argv=None):
     ap.add_argument("--creep-stress", type=float)
     ap.add_argument("--time-limit", type=float, default=1e13)
     ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("--skip-ucs", action="store_true")
+    ap.add_argument("--max-events", type=int, default=2000)
     a = ap.parse_args(argv)
     p = load_parameters(extra_files=a.params, overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
     t0 = time.process_time()
@@ -78,6 +80,8 @@ def main(argv=None):
             todo.pop(0)
         return new, what
     path.step = step
+    if a.skip_ucs:
+        a.max_strain = 1e-12
     t1 = time.process_time()
     r = ucs_path(eq, a.max_strain or p.ucs.max_strain, p.ucs.stop_stress_ratio, path=path)
     cpu = time.process_time() - t1
@@ -103,14 +107,21 @@ def main(argv=None):
         law = build_law(p.stress_corrosion)
         clock = EventClock(p.stress_corrosion.max_strength_loss_fraction, a.time_limit)
         t2 = time.process_time()
-        res = creep_hold(eq2, law, clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment))
+        res = creep_hold(eq2, law, clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),
+                         max_events=a.max_events)
         cpu2 = time.process_time() - t2
         c2 = eq2.counters
         out["creep"] = {"stress_mpa": a.creep_stress / 1e6, "failed": res.failed, "reason": res.reason[:300],
                         "lifetime_s": res.lifetime, "events": res.events, "broken": res.broken, "cpu_s": cpu2,
                         "cpu_per_event_s": cpu2 / max(res.events, 1), "equilibria": c2.equilibria,
                         "active_set_iterations": c2.iterations, "factorisations": c2.factorisations,
-                        "splits": c2.splits, "final_strain": res.strains[-1] if res.strains else None}
+                        "splits": c2.splits, "final_strain": res.strains[-1] if res.strains else None,
+                        "iterations_per_equilibrium": c2.iterations / max(c2.equilibria, 1),
+                        "equilibria_per_event": c2.equilibria / max(res.events, 1),
+                        "factor_cpu_s": c2.factor_seconds, "solve_cpu_s": c2.solve_seconds,
+                        "bonds_per_event_p50_max": [float(np.median(np.diff([0] + res.broken_counts))),
+                                                    int(np.max(np.diff([0] + res.broken_counts)))] if res.events else None,
+                        "events_log": [(t, e, b) for t, e, b in zip(res.times, res.strains, res.broken_counts)][::max(1, res.events // 30)]}
     print(json.dumps(out))
 
 
