@@ -61,7 +61,8 @@ def main(argv=None):
     ap.add_argument("--skip-ucs", action="store_true")
     ap.add_argument("--max-events", type=int, default=2000)
     a = ap.parse_args(argv)
-    p = load_parameters(extra_files=a.params, overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
+    size = [f"specimen.width={a.width}", f"specimen.height={a.height}"]
+    p = load_parameters(extra_files=a.params, overrides=size + a.set)
     t0 = time.process_time()
     s = build_specimen(p, a.seed)
     lay = layout_for(s, p)
@@ -110,6 +111,7 @@ def main(argv=None):
         res = creep_hold(eq2, law, clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),
                          max_events=a.max_events)
         cpu2 = time.process_time() - t2
+        per_event = np.diff([0] + res.broken_counts)
         c2 = eq2.counters
         out["creep"] = {"stress_mpa": a.creep_stress / 1e6, "failed": res.failed, "reason": res.reason[:300],
                         "lifetime_s": res.lifetime, "events": res.events, "broken": res.broken, "cpu_s": cpu2,
@@ -119,9 +121,9 @@ def main(argv=None):
                         "iterations_per_equilibrium": c2.iterations / max(c2.equilibria, 1),
                         "equilibria_per_event": c2.equilibria / max(res.events, 1),
                         "factor_cpu_s": c2.factor_seconds, "solve_cpu_s": c2.solve_seconds,
-                        "bonds_per_event_p50_max": [float(np.median(np.diff([0] + res.broken_counts))),
-                                                    int(np.max(np.diff([0] + res.broken_counts)))] if res.events else None,
-                        "events_log": [(t, e, b) for t, e, b in zip(res.times, res.strains, res.broken_counts)][::max(1, res.events // 30)]}
+                        "bonds_per_event_p50_max": [float(np.median(per_event)), int(np.max(per_event))]
+                        if res.events else None,
+                        "events_log": list(zip(res.times, res.strains, res.broken_counts))[::max(1, res.events // 30)]}
     print(json.dumps(out))
 
 

@@ -12,11 +12,12 @@ from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 from grainfrac_yade.static.ucs import ucs_path
-from static_tiny import network
+from static_tiny import KN, network
 
 #: Tiny specimens per grain model: fem 3 x 6 mm; rigid 4 x 8 mm (on 3 x 6 mm seed 1 a rigid cell's mechanism
 #: ends the path within a dozen breaks, reported as NumericalFailure).
-TINY = {"fem": ["specimen.width=3e-3", "specimen.height=6e-3"], "rigid": ["specimen.width=4e-3", "specimen.height=8e-3"]}
+TINY = {"fem": ["specimen.width=3e-3", "specimen.height=6e-3"],
+        "rigid": ["specimen.width=4e-3", "specimen.height=8e-3"]}
 #: Breaks followed on the tiny specimens: enough to pass cascades and friction, few enough for ~1 s.
 BREAKS = 12
 
@@ -111,13 +112,8 @@ def test_unloaded_mechanism_is_held_by_the_ground_springs():
     eq = Equilibrium(_hinged())
     st = eq.initial(1e-7)
     assert eq.counters.grounded >= 1
-    assert st.fn[0] == pytest.approx(-net_kn() * 1e-7, rel=1e-9)   # the ground springs' 1e-12 moves it by less
+    assert st.fn[0] == pytest.approx(-KN * 1e-7, rel=1e-9)   # the ground springs' 1e-12 moves it by less
     assert np.isfinite(st.u).all()
-
-
-def net_kn():
-    from static_tiny import KN
-    return KN
 
 
 def test_loaded_mechanism_is_one_line_numerical_failure():

@@ -85,7 +85,8 @@ class Path:
 
     # ------------------------------------------------------------------ breaking
     def break_bond(self, state: State, bond: int, mode: int) -> State:
-        """``state`` with ``bond`` broken (JCFpm's broken contact, :func:`.contacts.break_state`), re-solved at its closure."""
+        """``state`` with ``bond`` broken (JCFpm's broken contact, :func:`.contacts.break_state`), re-solved at its
+        closure (the bond's intact force released through :meth:`.solver.Equilibrium.release_force`)."""
         n = self.net
         base = state.copy()
         dn, ds = n.cn[bond] @ state.u, n.ct[bond] @ state.u

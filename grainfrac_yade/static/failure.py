@@ -19,7 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 #: Reasons, as written in a summary.
-NO_EQUILIBRIUM = "no equilibrium at the held load: the path's tangent stiffness is not positive and no intact bond can reach its strength"
+NO_EQUILIBRIUM = ("no equilibrium at the held load: the path's tangent stiffness is not positive and no intact bond "
+                  "can reach its strength")
 COLLAPSE = "collapse: regaining the held load needs an axial strain increment above collapse_strain_increment"
 
 
@@ -34,4 +35,5 @@ class FailureRule:
 
     def collapsed(self, start_closure: float, closure: float, height: float) -> bool:
         """Rule 2: the closure grew by more than the collapse strain since the event began."""
-        return self.collapse_strain_increment > 0 and (closure - start_closure) > self.collapse_strain_increment * height
+        limit = self.collapse_strain_increment * height
+        return self.collapse_strain_increment > 0 and (closure - start_closure) > limit

@@ -97,8 +97,8 @@ def grain_stiffness(net: Network, dofs, ndof) -> sp.csr_matrix:
     bm, area = _triangle_b(net)
     ke = area[:, None, None] * np.einsum("eji,ejk,ekl->eil", bm, net.tri_stiffness, bm)
     tidx = dofs[net.tri_nodes][:, :, :2].reshape(-1, 6)
-    return sp.coo_matrix((ke.reshape(len(ke), -1).ravel(), (np.repeat(tidx, 6, axis=1).ravel(),
-                                                             np.tile(tidx, (1, 6)).ravel())), shape=(ndof, ndof)).tocsr()
+    rows, cols = np.repeat(tidx, 6, axis=1).ravel(), np.tile(tidx, (1, 6)).ravel()
+    return sp.coo_matrix((ke.reshape(len(ke), -1).ravel(), (rows, cols)), shape=(ndof, ndof)).tocsr()
 
 
 def canonical_order(point: np.ndarray, first_node_pos: np.ndarray, second_node_pos: np.ndarray) -> np.ndarray:
@@ -186,7 +186,8 @@ def build_static_network(specimen, params, layout, bond_permutation=None) -> Sta
     if bond_permutation is not None:
         q = np.asarray(bond_permutation)
         net = Network(node_pos=net.node_pos, node_rotates=net.node_rotates, node_cell=net.node_cell,
-                      spring_nodes=net.spring_nodes[q], spring_normal=net.spring_normal[q], spring_arm=net.spring_arm[q],
+                      spring_nodes=net.spring_nodes[q], spring_normal=net.spring_normal[q],
+                      spring_arm=net.spring_arm[q],
                       spring_kn=net.spring_kn[q], spring_ks=net.spring_ks[q], spring_area=net.spring_area[q],
                       spring_face=net.spring_face[q], tri_nodes=net.tri_nodes, tri_stiffness=net.tri_stiffness,
                       spring_torque_arm=None if net.spring_torque_arm is None else net.spring_torque_arm[q],

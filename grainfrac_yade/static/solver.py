@@ -343,7 +343,8 @@ class Equilibrium:
             seen.add(key)
             u = self.displacements(closure, status, sign, base.s_p, base.u, extra)
             dn, ds = n.cn @ u, n.ct @ u
-            new, new_sign, viol = cl.trial_status(dn, ds, base.broken, base.s_p, n.kn, n.ks, n.tan_residual, status, sign)
+            new, new_sign, viol = cl.trial_status(dn, ds, base.broken, base.s_p, n.kn, n.ks, n.tan_residual,
+                                                  status, sign)
             wrong = np.flatnonzero((new != status) | ((new == cl.SLIP) & (new_sign != sign)))
             self.counters.iterations += 1
             if not len(wrong):
