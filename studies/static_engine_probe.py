@@ -26,7 +26,7 @@ from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.creep import creep_hold
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.static.solver import MAX_ACTIVE_SET_ITERATIONS, STATUS_CHANGES_PER_ITERATION, Equilibrium
 from grainfrac_yade.static.ucs import ucs_path
 
 #: Axial strains at which the geometry is read [1]: around the YADE peaks of 10 x 20 mm seed 1 (fem 0.38 %,
@@ -59,6 +59,8 @@ def main(argv=None):
     ap.add_argument("--time-limit", type=float, default=1e13)
     ap.add_argument("--set", action="append", default=[])
     ap.add_argument("--skip-ucs", action="store_true")
+    ap.add_argument("--changes-per-iteration", type=int, default=STATUS_CHANGES_PER_ITERATION)
+    ap.add_argument("--max-iterations", type=int, default=MAX_ACTIVE_SET_ITERATIONS)
     ap.add_argument("--max-events", type=int, default=2000)
     a = ap.parse_args(argv)
     size = [f"specimen.width={a.width}", f"specimen.height={a.height}"]
@@ -67,7 +69,8 @@ def main(argv=None):
     s = build_specimen(p, a.seed)
     lay = layout_for(s, p)
     net = build_static_network(s, p, lay)
-    eq = Equilibrium(net)
+    settings = {"changes_per_iteration": a.changes_per_iteration, "max_iterations": a.max_iterations}
+    eq = Equilibrium(net, **settings)
     out = {"grain_model": lay.model, "seed": a.seed, "bonds": net.n_bonds, "dofs": net.ndof,
            "build_cpu_s": time.process_time() - t0}
     path = Path(eq)
@@ -104,7 +107,7 @@ def main(argv=None):
     out["large_cascades"] = [(x.closure / net.height, len(x.bonds), x.stress_before / 1e6, x.stress_after / 1e6)
                              for x in path.records if len(x.bonds) >= CASCADE_REPORT]
     if a.creep_stress:
-        eq2 = Equilibrium(net)
+        eq2 = Equilibrium(net, **settings)
         law = build_law(p.stress_corrosion)
         clock = EventClock(p.stress_corrosion.max_strength_loss_fraction, a.time_limit)
         t2 = time.process_time()
