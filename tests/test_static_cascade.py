@@ -5,7 +5,7 @@ import pytest
 from grainfrac_yade.errors import NumericalFailure
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.static import contacts as cl
 from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.failure import FailureRule

@@ -9,7 +9,7 @@ from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.law.hillig_charles import HilligCharles
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.creep import creep_hold
 from grainfrac_yade.static.failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule

@@ -5,7 +5,7 @@ import pytest
 from grainfrac_yade.elastic import DEFAULT_STRAIN, build_network, solve_uniaxial
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.specimen import build_specimen
+from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 

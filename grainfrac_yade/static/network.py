@@ -25,6 +25,7 @@ import scipy.sparse as sp
 from ..elastic import (ROLLING_REGULARISATION, Network, _dof_map, _spring_rows, _triangle_b, build_network,
                        stiffness_matrix)
 from ..errors import GrainfracError
+from ..layout import bond_properties
 
 
 @dataclass
@@ -180,7 +181,6 @@ def build_static_network(specimen, params, layout, bond_permutation=None) -> Sta
     """The static network of ``specimen`` under the grain model that built ``layout`` (rigid or fem cells),
     with the bonds' Table 2 strengths and friction (:func:`grainfrac_yade.layout.bond_properties`).
     ``bond_permutation``: the same bonds numbered otherwise (input bond k is layout bond permutation[k])."""
-    from ..layout import bond_properties
     net = build_network(specimen, params, layout.model, layout)
     props = bond_properties(specimen, layout, params)
     if bond_permutation is not None:

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import NumericalFailure
 from .cascade import Path
+from .failure import FailureRule
 from .solver import Equilibrium
 
 #: Why a UCS path ended.
@@ -79,5 +80,4 @@ def ucs_path(eq: Equilibrium, max_strain: float, stop_stress_ratio: float, confi
 
 
 def _no_collapse():
-    from .failure import FailureRule
     return FailureRule(0.0)
