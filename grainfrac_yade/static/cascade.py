@@ -1,0 +1,213 @@
+"""Bonds broken one at a time: the sequentially linear path in the platen closure (pure).
+
+Between breaks the equilibrium is piecewise linear in the closure d (:mod:`.solver`).  From a converged state
+the tangent response gives every intact bond's force along the path, F = F0 + x dF/dd, and so the closure
+increment x at which it reaches its strength (paper Eq. 4-5, :func:`.contacts.crossing_increment`); the engine
+moves to the smallest one (or to the held load, if that comes first) and solves there.  If contact statuses
+changed on the way (the path bent), the closure where the first bond reaches its strength (or the load its
+target) is bracketed (Illinois) until the largest stress-to-strength ratio is 1 within ``bracket_tol``.
+
+There the most overstressed bond breaks, alone, and the equilibrium is restored at the same closure; any bond
+now at its strength breaks next, the most overstressed first, until none is (the cascade).  Ties: ratios within
+``TIE_REL_TOL`` of the largest count as equal, and the first bond in the network's canonical order (by contact
+point) wins, so nothing depends on how the input numbered the bonds.
+
+Control: the closure only grows (a stiff machine).  A snap-back (the load falling while the closure would have to
+fall too) is not followed: the stress drops at fixed closure through the cascade, and the curve continues from
+there; the UCS is the largest platen stress on the path (no loading rate enters).  A held load (creep) is
+regained after each event by the same path (:meth:`Path.hold`), with the failure rule of :mod:`.failure`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import NumericalFailure
+from . import contacts as cl
+from .failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
+from .solver import Equilibrium, State
+
+#: Ratios within this relative distance of the largest are tied [1]: a few ulps of the assembly's round-off.
+TIE_REL_TOL = 1e-12
+#: A bond whose ratio is within this of 1 has reached its strength [1] (the round-off of ratio = 1 at a crossing).
+BREAK_RATIO_TOL = 1e-12
+#: Default bracketing tolerance on the largest ratio (and on stress / target) [1].
+BRACKET_TOL = 1e-9
+#: Bracketing iterations before the first state past the crossing is taken [1]; Illinois halves the bracket
+#: at worst every other step, so 200 reach the float resolution of any closure.
+MAX_BRACKET_ITERATIONS = 200
+#: Path steps without a break before the path counts as stuck [1] (each step moves to a status change at least).
+MAX_STEPS_WITHOUT_BREAK = 10_000
+
+
+@dataclass
+class Record:
+    """One row of the path: after a break (or a reached target)."""
+    closure: float
+    stress_before: float        # platen stress where the bond reached its strength [Pa]
+    stress_after: float         # after the cascade [Pa]
+    bonds: list = field(default_factory=list)   # canonical numbers broken, in order
+    modes: list = field(default_factory=list)
+
+
+class Path:
+    """The breaking path of one network (module doc); ``jt``, ``jc`` the current strengths [Pa] (creep lowers them)."""
+
+    def __init__(self, eq: Equilibrium, bracket_tol: float = BRACKET_TOL):
+        self.eq, self.net, self.bracket_tol = eq, eq.net, float(bracket_tol)
+        self.jt, self.jc = eq.net.tensile_strength.copy(), eq.net.cohesion.copy()
+        self.records: list[Record] = []
+        self.steps = 0
+
+    # ------------------------------------------------------------------ ratios and the tie rule
+    def ratios(self, state: State):
+        """(ratio, mode) of every bond; -inf for broken ones."""
+        n = self.net
+        r, mode = cl.overstress(state.fn, state.fs, n.area, self.jt, self.jc, n.tan_friction)
+        return np.where(state.broken, -np.inf, r), mode
+
+    def over(self, state: State) -> np.ndarray:
+        """Intact bonds at their strength (exact paper Eq. 4-5, or a ratio within BREAK_RATIO_TOL of 1)."""
+        n = self.net
+        r, _ = self.ratios(state)
+        hit = cl.failing(state.fn, state.fs, n.area, self.jt, self.jc, n.tan_friction) | (r >= 1 - BREAK_RATIO_TOL)
+        return hit & ~state.broken
+
+    @staticmethod
+    def pick(ratio: np.ndarray, candidates: np.ndarray) -> int:
+        """The most overstressed of ``candidates``; ties (TIE_REL_TOL) to the first in canonical order."""
+        r = ratio[candidates]
+        top = r.max()
+        tied = candidates[r >= top - TIE_REL_TOL * abs(top)] if math.isfinite(top) else candidates[np.isinf(r)]
+        return int(tied.min())
+
+    # ------------------------------------------------------------------ breaking
+    def break_bond(self, state: State, bond: int, mode: int) -> State:
+        """``state`` with ``bond`` broken (JCFpm's broken contact, :func:`.contacts.break_state`), re-solved at its
+        closure (the bond's intact force released through :meth:`.solver.Equilibrium.release_force`)."""
+        n = self.net
+        base = state.copy()
+        dn, ds = n.cn[bond] @ state.u, n.ct[bond] @ state.u
+        st, sg, s_p = cl.break_state(np.atleast_1d(dn), np.atleast_1d(ds), np.atleast_1d(state.fs[bond]),
+                                     n.kn[bond:bond + 1], n.ks[bond:bond + 1], n.tan_residual[bond:bond + 1])
+        base.broken[bond], base.status[bond], base.sign[bond], base.s_p[bond] = True, st[0], sg[0], s_p[0]
+        base.break_mode[bond] = mode
+        return self.eq.solve(state.closure, base, self.eq.release_force(state, base))
+
+    def cascade(self, state: State, first: int | None = None, record: Record | None = None) -> State:
+        """Break ``first`` (if given), then every bond at its strength, one at a time, the most overstressed first."""
+        while True:
+            ratio, mode = self.ratios(state)
+            if first is not None:
+                bond, first = first, None
+            else:
+                hit = np.flatnonzero(self.over(state))
+                if not len(hit):
+                    return state
+                bond = self.pick(ratio, hit)
+            state = self.break_bond(state, bond, int(mode[bond]))
+            if record is not None:
+                record.bonds.append(bond)
+                record.modes.append(int(mode[bond]))
+
+    # ------------------------------------------------------------------ the path
+    def _h(self, state: State, target):
+        r, _ = self.ratios(state)
+        h = float(r.max()) - 1.0 if np.any(~state.broken) else -np.inf
+        if target is not None:
+            h = max(h, (state.stress - target) / target)
+        return h
+
+    def step(self, state: State, target=None, max_closure=math.inf):
+        """One move along the path from ``state``: to the next bond crossing (then its cascade), to the target
+        stress, or to ``max_closure``.  Returns (new state, what: "break" / "target" / "end" / "none");
+        "none": nothing lies ahead (no crossing, no target reachable, no closure limit)."""
+        n = self.net
+        v, fn1, fs1, p1 = self.eq.response(state)
+        x = cl.crossing_increment(state.fn, state.fs, fn1, fs1, n.area, self.jt, self.jc, n.tan_friction)
+        x = np.where(state.broken, np.inf, x)
+        x_break = float(x.min()) if len(x) else math.inf
+        x_target = max(target - state.stress, 0.0) / p1 if target is not None and p1 > 0 else math.inf
+        x_end = max_closure - state.closure
+        dx = min(x_break, x_target, x_end)
+        if not math.isfinite(dx):
+            return state, "none"
+        self.steps += 1
+        trial = self.eq.solve(state.closure + dx, state)
+        h = self._h(trial, target)
+        if h > self.bracket_tol:
+            trial = self._bracket(state, trial, target)
+            h = self._h(trial, target)
+        if h < -self.bracket_tol:        # the path bent away: neither reached yet
+            return trial, "end" if trial.closure >= max_closure else "moved"
+        r, _ = self.ratios(trial)
+        if np.any(~trial.broken) and r.max() >= 1 - self.bracket_tol:
+            rec = Record(trial.closure, trial.stress, trial.stress)
+            bond = self.pick(r, np.flatnonzero(r >= 1 - self.bracket_tol))
+            trial = self.cascade(trial, first=bond, record=rec)
+            rec.stress_after = trial.stress
+            self.records.append(rec)
+            return trial, "break"
+        if target is not None and trial.stress >= target * (1 - self.bracket_tol):
+            return trial, "target"
+        return trial, "end" if trial.closure >= max_closure else "moved"
+
+    def _bracket(self, state: State, beyond: State, target):
+        """Illinois on h(d) = max(largest ratio - 1, stress / target - 1) between ``state`` (h < 0) and
+        ``beyond`` (h > 0), each trial solved from ``state`` (the last converged state)."""
+        a, ha = state.closure, self._h(state, target)
+        b, hb, sb = beyond.closure, self._h(beyond, target), beyond
+        side = 0
+        for _ in range(MAX_BRACKET_ITERATIONS):
+            c = b - hb * (b - a) / (hb - ha) if hb != ha else 0.5 * (a + b)
+            if not a < c < b:
+                c = 0.5 * (a + b)
+            if c == a or c == b:
+                return sb
+            sc = self.eq.solve(c, state)
+            hc = self._h(sc, target)
+            if abs(hc) <= self.bracket_tol:
+                return sc
+            if hc > 0:
+                b, hb, sb = c, hc, sc
+                if side == 1:
+                    ha *= 0.5
+                side = 1
+            else:
+                a, ha = c, hc
+                if side == -1:
+                    hb *= 0.5
+                side = -1
+        return sb
+
+    def run_closure(self, state: State, max_closure: float, stop=None):
+        """Follow the path until ``max_closure`` or until ``stop(state, records)`` says so; returns the last state."""
+        quiet = 0
+        while state.closure < max_closure:
+            self.last_state = state
+            state, what = self.step(state, None, max_closure)
+            if what == "none":
+                return state
+            quiet = 0 if what == "break" else quiet + 1
+            if quiet > MAX_STEPS_WITHOUT_BREAK:
+                raise NumericalFailure(f"static path: {quiet} steps without a break at closure {state.closure:.6g} m")
+            if stop is not None and stop(state, self.records):
+                return state
+        return state
+
+    def hold(self, state: State, target: float, rule: FailureRule):
+        """Regain the platen stress ``target`` [Pa] from ``state`` along the path: (state, failure reason or None)."""
+        start, quiet = state.closure, 0
+        while True:
+            if state.stress >= target * (1 - self.bracket_tol) and not self.over(state).any():
+                return state, None
+            state, what = self.step(state, target)
+            if what == "none":
+                return state, NO_EQUILIBRIUM
+            if rule.collapsed(start, state.closure, self.net.height):
+                return state, COLLAPSE
+            quiet = 0 if what == "break" else quiet + 1
+            if quiet > MAX_STEPS_WITHOUT_BREAK:
+                raise NumericalFailure(f"static hold: {quiet} steps without a break at closure {state.closure:.6g} m")

@@ -1,0 +1,381 @@
+"""Static equilibrium at a platen closure: tangent assembly, SuperLU, the active-set iteration (pure scipy).
+
+At fixed contact statuses (:mod:`.contacts`) the internal force is affine in the displacements,
+
+    f_int(u) = K(s) u + G^T b(s),   K(s) = K_g + G_n^T A_nn C_n + G_t^T (A_sn C_n + A_ss C_t),
+
+so the equilibrium f_int = f_ext on the free dofs, with the platen dofs at -d/2 and +d/2 (closure d), is one
+linear solve.  The statuses themselves follow from the solution (open/closed, stick/slip by the return mapping
+from the last converged state); the active-set iteration (a semi-smooth Newton method on the piecewise linear
+law) solves, re-reads the statuses and repeats until they agree.  A consistent set is the exact solution (to
+round-off): no residual tolerance enters the answer.  The status changes of one iteration are capped, the most
+violated first; the cap halves whenever an iteration does not reduce the number of inconsistent contacts
+(what ends open/close and stick/slip cycling).
+
+The SuperLU factor (COLAMD ordering) of the free block is kept while the tangent does not change (same
+statuses, same free set), so the tangent response to the closure and a following solve cost one
+back-substitution each.  Cells cut loose (their node group has no closed contact or bond to a platen's group)
+carry no load: their dofs are held where they are and counted; a group held by the platens but free to slide
+sideways gets one lateral dof pinned, as the intact specimen does (``elastic.solve_uniaxial``).  A singular
+or ill-conditioned system (a mechanism in the loading path) raises :class:`NumericalFailure`, one line.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import connected_components
+
+from ..errors import NumericalFailure
+from . import contacts as cl
+from .network import StaticNetwork
+
+#: Active-set iterations per equilibrium before giving up [1]: each is one factorisation; a consistent set is
+#: normally found in a handful (measured on 10 x 20 mm, docs/studies/static_engine.md).
+MAX_ACTIVE_SET_ITERATIONS = 200
+#: Status changes allowed in the first iteration [1]: all of them; the cap halves when an iteration does not
+#: reduce the number of inconsistent contacts (module doc).
+STATUS_CHANGES_PER_ITERATION = 10**9
+#: Relative residual of a linear solve above which the system counts as ill-conditioned [1]: SuperLU with partial
+#: pivoting leaves ~1e-12 on these matrices; 1e-6 means a (near) mechanism.
+ILL_CONDITIONED_RESIDUAL = 1e-6
+
+
+#: Stiffness to the ground on every dof, relative to that dof's own diagonal entry in the intact tangent [1], used
+#: only where the plain factor is singular: a cell or group hinged at one node (a zero-energy rotation left when its
+#: other bonds broke and opened) carries no load but makes the matrix singular; with 1e-12 SuperLU factorises and
+#: forces move by ~1e-9 relative (measured on 4 x 8 mm), as ``elastic.ROLLING_REGULARISATION`` does for rolling.
+GROUND_REGULARISATION = 1e-12
+#: A factor whose smallest pivot is below this fraction of its largest is taken as singular [1] and made again
+#: with the ground springs: float64 resolves 1e-16; intact 10 x 20 mm specimens have pivot ratios ~1e-6.
+PIVOT_RATIO = 1e-13
+#: With the ground springs in, a solution whose ground forces exceed this fraction of the largest load on the free
+#: dofs holds a mechanism against a load [1] (an unloaded hinge leaves them at round-off, ~1e-12).
+LOADED_MECHANISM = 1e-6
+#: Halvings of a step whose active set cycles [1]: at most 2**12 sub-steps before NumericalFailure.
+MAX_SPLIT_DEPTH = 12
+
+
+#: A status set that comes back (a cycle) is accepted when its largest inconsistency is below this fraction of the
+#: largest contact normal force [1]: contacts hovering at their open/close or stick/slip point within round-off
+#: of a path's sub-step (measured: 8e-4 N against forces of kN on 10 x 20 mm rigid cells).
+CYCLE_ACCEPT_REL = 1e-6
+
+
+class _Cycling(Exception):
+    """The active set came back to a status set it had tried, or did not settle."""
+
+
+@dataclass
+class State:
+    """A converged equilibrium (arrays over bonds in the network's canonical order)."""
+    closure: float              # platen closure d [m]
+    u: np.ndarray               # (ndof,) [m]
+    broken: np.ndarray          # (m,) bool
+    status: np.ndarray          # (m,) contacts.INTACT / OPEN / STICK / SLIP
+    sign: np.ndarray            # (m,) slip direction
+    s_p: np.ndarray             # (m,) shear reference of broken contacts [m]
+    fn: np.ndarray              # (m,) [N], tension positive
+    fs: np.ndarray              # (m,) [N]
+    stress: float               # platen stress, compression positive [Pa]
+    break_mode: np.ndarray = field(default=None)   # (m,) 0 intact, contacts.TENSION / SHEAR
+    held: int = 0               # dofs of cells cut loose, held in place
+    iterations: int = 0         # active-set iterations of the solve that made it
+
+    def copy(self) -> "State":
+        return replace(self, u=self.u.copy(), broken=self.broken.copy(), status=self.status.copy(),
+                       sign=self.sign.copy(), s_p=self.s_p.copy(), fn=self.fn.copy(), fs=self.fs.copy(),
+                       break_mode=self.break_mode.copy())
+
+
+@dataclass
+class Counters:
+    """Work done, for the cost tables."""
+    equilibria: int = 0
+    iterations: int = 0
+    factorisations: int = 0
+    solves: int = 0
+    factor_seconds: float = 0.0     # CPU
+    solve_seconds: float = 0.0      # CPU
+    splits: int = 0                 # steps split in two because the active set cycled
+    grounded: int = 0               # factorisations that needed the ground springs (a hinge or sliding group)
+
+
+class Equilibrium:
+    """Equilibria of one network under a constant lateral traction ``confinement`` [Pa] (module doc)."""
+
+    def __init__(self, net: StaticNetwork, confinement: float = 0.0,
+                 max_iterations: int = MAX_ACTIVE_SET_ITERATIONS,
+                 changes_per_iteration: int = STATUS_CHANGES_PER_ITERATION, direction: float = 1.0):
+        """``direction`` +1: the platens close as the closure grows (compression); -1: they open (a pull)."""
+        if max_iterations < 1 or changes_per_iteration < 1:
+            raise ValueError("max_iterations and changes_per_iteration must be >= 1")
+        self.net, self.max_iterations, self.changes_per_iteration = net, int(max_iterations), int(changes_per_iteration)
+        self.f_ext = net.confinement_force(confinement)
+        if direction not in (1.0, -1.0):
+            raise ValueError(f"direction must be +1 (compression) or -1 (pull), got {direction!r}")
+        self.e = direction * net.platen_vector()
+        fixed = np.zeros(net.ndof, bool)
+        fixed[net.dofs[net.top | net.bottom, 1]] = True
+        rot = net.dofs[net.top | net.bottom, 2]
+        fixed[rot[rot >= 0]] = True
+        self.platen_fixed = fixed
+        self.platen_nodes = net.top | net.bottom
+        self.counters = Counters()
+        self._ground = None
+        self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
+        tri = net_tri_edges(net)
+        self._tri_edges = tri
+        self._order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
+
+    # ------------------------------------------------------------------ assembly
+    def tangent(self, status, sign, s_p, ground=False):
+        """Tangent stiffness (ndof x ndof) of the affine law at these statuses."""
+        n = self.net
+        a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
+        gn, gt = n.force_rows(status != cl.INTACT)
+        k = n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)
+        if self._ground is None:      # each dof's own intact stiffness, once (its kind's median where it has none)
+            d = np.abs(k.diagonal())
+            for col in range(3):
+                idx = n.dofs[:, col][n.dofs[:, col] >= 0]
+                if len(idx) and (d[idx] > 0).any():
+                    d[idx] = np.where(d[idx] > 0, d[idx], np.median(d[idx][d[idx] > 0]))
+            self._ground = sp.diags(GROUND_REGULARISATION * d)
+        return (k + self._ground).tocsc() if ground else k.tocsc()
+
+    def fixed_dofs(self, status):
+        """(fixed mask, number of dofs held because their group was cut loose, lateral pins)."""
+        n = self.net
+        closed = status != cl.OPEN
+        a, b = n.bond_nodes[closed, 0], n.bond_nodes[closed, 1]
+        ea, eb = self._tri_edges
+        nn = len(n.node_pos)
+        g = sp.coo_matrix((np.ones(len(a) + len(ea)), (np.concatenate([a, ea]), np.concatenate([b, eb]))),
+                          shape=(nn, nn))
+        _, label = connected_components(g, directed=False)
+        anchored = np.zeros(label.max() + 1, bool)
+        anchored[label[self.platen_nodes]] = True
+        fixed = self.platen_fixed.copy()
+        loose = ~anchored[label]
+        held = n.dofs[loose]
+        held = held[held >= 0]
+        fixed[held] = True
+        # one lateral pin per anchored group: its lowest (then leftmost) platen node, as elastic pins the specimen
+        pins = 0
+        seen = np.zeros(label.max() + 1, bool)
+        for node in self._order_pin:
+            if self.platen_nodes[node] and not seen[label[node]]:
+                seen[label[node]] = True
+                fixed[n.dofs[node, 0]] = True
+                pins += 1
+        return fixed, int(len(held)), pins
+
+    def _factor(self, status, sign, s_p):
+        key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
+        if key != self._key:
+            self._grounded = False
+            try:
+                self._factor_now(key, status, sign, s_p, False)
+            except NumericalFailure:    # a hinge or a sliding group: once more with the ground springs
+                self._factor_now(key, status, sign, s_p, True)
+        n = self.net
+        _, _, _, _, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
+        return self._lu, self._k, self._gt.T @ b_s, self._fixed
+
+    def _factor_now(self, key, status, sign, s_p, ground):
+        """Assemble and factorise the free block at these statuses (``ground``: with the ground springs)."""
+        self._key = None
+        fixed, held, _ = self.fixed_dofs(status)
+        k = self.tangent(status, sign, s_p, ground)
+        self._grounded = ground
+        if ground:
+            self.counters.grounded += 1
+        self._gn, self._gt = self.net.force_rows(status != cl.INTACT)
+        free = ~fixed
+        kff = k[free][:, free].tocsc()
+        t0 = time.process_time()
+        try:
+            lu = spla.splu(kff, permc_spec="COLAMD") if kff.shape[0] else None
+        except RuntimeError as exc:
+            raise NumericalFailure(f"static equilibrium: the stiffness matrix is singular ({exc}); a mechanism "
+                                   "in the loading path (a cell or group held by one sliding contact)") from None
+        self.counters.factor_seconds += time.process_time() - t0
+        self.counters.factorisations += 1
+        self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
+        self._kfc = k[free][:, fixed].tocsr()
+        if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread
+            d = np.abs(lu.U.diagonal())
+            if d.min() <= PIVOT_RATIO * d.max():
+                self._key = None
+                raise NumericalFailure("static equilibrium: a pivot of the factor vanishes (a mechanism)")
+
+    def _solve(self, lu, kff, rhs):
+        if not rhs.size:
+            return rhs
+        t0 = time.process_time()
+        x = lu.solve(rhs)
+        self.counters.solve_seconds += time.process_time() - t0
+        self.counters.solves += 1
+        if not np.all(np.isfinite(x)):
+            raise NumericalFailure("static equilibrium: the solution is NaN or infinite (a singular system: a "
+                                   "mechanism in the loading path)")
+        scale = max(np.abs(rhs).max(), 1e-300)
+        res = np.abs(kff @ x - rhs).max() / scale
+        if res > ILL_CONDITIONED_RESIDUAL:
+            raise NumericalFailure(f"static equilibrium: ill-conditioned system (relative residual {res:.1e} > "
+                                   f"{ILL_CONDITIONED_RESIDUAL:g}): a near mechanism in the loading path")
+        return x
+
+    def displacements(self, closure, status, sign, s_p, held_u, extra=None):
+        """u at ``closure`` under fixed statuses (held dofs at ``held_u``; ``extra``: a further dead load)."""
+        def rhs_of(k, b, fixed):
+            u = np.where(fixed, held_u, 0.0)
+            plat = self.platen_fixed
+            u[plat] = closure * self.e[plat]
+            f = self.f_ext if extra is None else self.f_ext + extra
+            return u, f[~fixed] - b[~fixed] - self._kfc @ u[fixed]
+        return self._solve_state(status, sign, s_p, rhs_of)
+
+    def _solve_state(self, status, sign, s_p, rhs_of):
+        """Factor (or reuse), solve, and where the plain factor fails retry once with the ground springs; a
+        mechanism the ground springs hold against a load is NumericalFailure."""
+        for attempt in range(2):
+            lu, k, b, fixed = self._factor(status, sign, s_p)
+            u, rhs = rhs_of(k, b, fixed)
+            try:
+                u[~fixed] = self._solve(lu, self._kff, rhs)
+            except NumericalFailure:
+                if self._grounded:
+                    raise
+                key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
+                self._factor_now(key, status, sign, s_p, True)
+                continue
+            if self._grounded:
+                pull = np.abs(self._ground.diagonal() * u).max()
+                if pull > LOADED_MECHANISM * max(np.abs(rhs).max(), 1e-300):
+                    raise NumericalFailure(f"static equilibrium: a loaded mechanism (the ground springs carry "
+                                           f"{pull:.3g} N): a cell or group free to move against a load")
+            return u
+        raise NumericalFailure("static equilibrium: no factor solves the system (a mechanism)")
+
+    def response(self, state: State):
+        """du/dd at ``state``'s statuses (the tangent response to the closure): (v, dF_n, dF_s, dstress)."""
+        def rhs_of(k, b, fixed):
+            v = np.zeros(self.net.ndof)
+            v[self.platen_fixed] = self.e[self.platen_fixed]
+            return v, -(self._kfc @ v[fixed])
+        v = self._solve_state(state.status, state.sign, state.s_p, rhs_of)
+        n = self.net
+        a_nn, a_ns, a_sn, a_ss, _, _ = cl.affine_law(state.status, state.sign, state.s_p, n.kn, n.ks, n.tan_residual)
+        dn, ds = n.cn @ v, n.ct @ v
+        fn1, fs1 = a_nn * dn + a_ns * ds, a_sn * dn + a_ss * ds
+        return v, fn1, fs1, self.platen_stress(v, fn1, fs1, state.status != cl.INTACT, constant=False)
+
+    def platen_stress(self, u, fn, fs, broken, constant=True):
+        """Platen stress [Pa, compression positive] of the internal forces (as ``elastic.solve_uniaxial``)."""
+        n = self.net
+        gn, gt = n.force_rows(broken)
+        r = n.k_grain @ u + gn.T @ fn + gt.T @ fs
+        if constant:
+            r = r - self.f_ext
+        return 0.5 * (r[n.dofs[n.bottom, 1]].sum() - r[n.dofs[n.top, 1]].sum()) / (n.width * n.thickness)
+
+    # ------------------------------------------------------------------ the active-set iteration
+    def solve(self, closure: float, base: State, release=None) -> State:
+        """The equilibrium at ``closure`` from the last converged state ``base`` (its broken set, statuses as
+        the first guess, shear references for the return mapping).  ``release``: the generalised force that the
+        bonds broken since ``base`` carried beyond what they carry as broken contacts (:meth:`release_force`).
+
+        Where the active set cycles or does not settle, the step is split in two halves (closure and release
+        both halved), each solved from the converged state of the one before (a finer path, down to
+        ``2**MAX_SPLIT_DEPTH`` sub-steps); only then NumericalFailure."""
+        return self._split(closure, base, release, 0)
+
+    def _split(self, closure, base, release, depth, lam0=0.0, lam1=1.0):
+        try:
+            return self._active_set(closure, base, None if release is None else (1.0 - lam1) * release)
+        except _Cycling as exc:
+            if depth >= MAX_SPLIT_DEPTH:
+                raise NumericalFailure(f"static equilibrium: contact statuses did not settle ({exc}) even in "
+                                       f"{2 ** depth} sub-steps at closure {closure:.6g} m") from None
+        self.counters.splits += 1
+        mid = 0.5 * (base.closure + closure)
+        lam = 0.5 * (lam0 + lam1)
+        half = self._split(mid, base, release, depth + 1, lam0, lam)
+        return self._split(closure, half, release, depth + 1, lam, lam1)
+
+    def release_force(self, state: State, broken_now: State) -> np.ndarray:
+        """(ndof,) what the bonds broken between ``state`` (intact there) and ``broken_now`` (the same displacement,
+        those bonds broken) carried beyond their broken-contact forces, as a generalised force on the nodes."""
+        n = self.net
+        new = broken_now.broken & ~state.broken
+        dn, ds = n.cn @ state.u, n.ct @ state.u
+        fn_b, fs_b = cl.forces(dn, ds, broken_now.status, broken_now.sign, broken_now.s_p, n.kn, n.ks, n.tan_residual)
+        gn, gt = n.force_rows(state.broken)
+        gnb, gtb = n.force_rows(broken_now.broken)
+        w = new.astype(float)
+        return -(gn.T @ (w * state.fn) + gt.T @ (w * state.fs) - gnb.T @ (w * fn_b) - gtb.T @ (w * fs_b))
+
+    def _converged(self, closure, base, status, sign, u, it) -> State:
+        n = self.net
+        dn, ds = n.cn @ u, n.ct @ u
+        fn, fs = cl.forces(dn, ds, status, sign, base.s_p, n.kn, n.ks, n.tan_residual)
+        s_p = np.where(base.broken, cl.converged_slip(ds, status, fs, n.ks), base.s_p)
+        self.counters.equilibria += 1
+        return State(closure, u, base.broken.copy(), status, sign, s_p, fn, fs,
+                     self.platen_stress(u, fn, fs, base.broken), base.break_mode.copy(), self._held, it)
+
+    def _active_set(self, closure, base, extra) -> State:
+        n = self.net
+        status, sign = base.status.copy(), base.sign.copy()
+        cap, best, seen, last = self.changes_per_iteration, None, set(), np.zeros(0, int)
+        for it in range(1, self.max_iterations + 1):
+            key = (status.tobytes(), sign.tobytes())
+            if key in seen and len(last) and worst <= CYCLE_ACCEPT_REL * scale:
+                return self._converged(closure, base, status, sign, u_last, it)
+            if key in seen:
+                raise _Cycling(f"a status set came back after {it - 1} iterations; last changes "
+                               f"{[(int(w), int(status[w]), float(viol[w])) for w in last[:4]]}")
+            seen.add(key)
+            u = self.displacements(closure, status, sign, base.s_p, base.u, extra)
+            dn, ds = n.cn @ u, n.ct @ u
+            new, new_sign, viol = cl.trial_status(dn, ds, base.broken, base.s_p, n.kn, n.ks, n.tan_residual,
+                                                  status, sign)
+            wrong = np.flatnonzero((new != status) | ((new == cl.SLIP) & (new_sign != sign)))
+            self.counters.iterations += 1
+            if not len(wrong):
+                return self._converged(closure, base, status, sign, u, it)
+            scale = float(np.abs(n.kn * dn).max())
+            worst, u_last = float(viol[wrong].max()), u
+            if best is not None and len(wrong) >= best:
+                cap = max(1, cap // 2)
+            best = len(wrong) if best is None else min(best, len(wrong))
+            pick = wrong[np.argsort(-viol[wrong], kind="stable")[:cap]]
+            last = pick
+            status[pick], sign[pick] = new[pick], new_sign[pick]
+        raise _Cycling(f"{len(wrong)} inconsistent after {self.max_iterations} iterations")
+
+    def initial(self, closure: float = 0.0) -> State:
+        """The intact specimen at ``closure`` (all bonds intact)."""
+        m = self.net.n_bonds
+        z = np.zeros(m)
+        base = State(closure, np.zeros(self.net.ndof), np.zeros(m, bool), np.full(m, cl.INTACT), np.ones(m), z,
+                     z, z, 0.0, np.zeros(m, int))
+        return self.solve(closure, base)
+
+
+def net_tri_edges(net: StaticNetwork):
+    """(a, b) node pairs that hold a cell's nodes together (the grain stiffness's couplings)."""
+    k = net.k_grain.tocoo()
+    nodes_of = np.full(net.ndof, -1)
+    for col in range(3):
+        d = net.dofs[:, col]
+        ok = d >= 0
+        nodes_of[d[ok]] = np.flatnonzero(ok)
+    a, b = nodes_of[k.row], nodes_of[k.col]
+    keep = (a != b) & (k.data != 0)
+    return a[keep], b[keep]

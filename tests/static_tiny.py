@@ -1,0 +1,41 @@
+"""Tiny static networks with closed-form answers (helpers of tests/test_static_*.py; no YADE)."""
+import numpy as np
+
+from grainfrac_yade.elastic import Network
+from grainfrac_yade.static.network import from_network
+
+#: Bond stiffnesses [N/m] and strengths [Pa] of the tiny networks: Table 2's orders of magnitude.
+KN, KS = 5e9, 2e9
+JT, JC = 10e6, 30e6
+PHI, PHI_R = np.radians(40.0), np.radians(25.0)
+
+
+def network(pos, springs, normals, *, top, bottom, left=(), right=(), area=1e-6, kn=KN, ks=KS, jt=JT, jc=JC,
+            phi=PHI, phi_r=PHI_R, width=1e-3, height=1e-3, thickness=1e-3):
+    """Translating nodes at ``pos`` joined by springs (pairs) with the given unit normals; every spring a bond of
+    ``area`` [m^2]; per-spring arrays or scalars for stiffness and strengths."""
+    pos = np.asarray(pos, float)
+    springs = np.asarray(springs, np.int64)
+    m, n = len(springs), len(pos)
+    full = lambda v: np.broadcast_to(np.asarray(v, float), (m,)).copy()  # noqa: E731
+    net = Network(node_pos=pos, node_rotates=np.zeros(n, bool), node_cell=np.arange(n), spring_nodes=springs,
+                  spring_normal=np.asarray(normals, float), spring_arm=np.zeros((m, 2, 2)), spring_kn=full(kn),
+                  spring_ks=full(ks), spring_area=full(area), spring_face=np.arange(m),
+                  tri_nodes=np.zeros((0, 3), np.int64), tri_stiffness=np.zeros((0, 3, 3)))
+    mask = lambda idx: np.isin(np.arange(n), idx)  # noqa: E731
+    return from_network(net, top=mask(top), bottom=mask(bottom), left=mask(left), right=mask(right), width=width,
+                        height=height, thickness=thickness, tensile_strength=full(jt), cohesion=full(jc),
+                        friction_angle=full(phi), residual_friction_angle=full(phi_r))
+
+
+def shear_pair(**kw):
+    """Two nodes side by side, the left one on the bottom platen, the right one on the top platen, one bond with
+    a vertical face (normal +x): closing the platens shears it; a lateral traction on the sides presses it.
+    width x thickness = area = height x thickness, so platen stress = tau and confinement = -sigma."""
+    return network([[0.0, 0.0], [1e-3, 0.0]], [[0, 1]], [[1.0, 0.0]], top=[1], bottom=[0], left=[0], right=[1], **kw)
+
+
+def tension_pair(**kw):
+    """Two nodes one above the other, on the bottom and top platens, one bond with a horizontal face (normal +y):
+    opening the platens pulls it (width x thickness = area, so platen stress = -sigma)."""
+    return network([[0.0, 0.0], [0.0, 1e-3]], [[0, 1]], [[0.0, 1.0]], top=[1], bottom=[0], **kw)
