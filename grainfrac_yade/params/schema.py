@@ -114,7 +114,8 @@ class ResolutionParams:
 class NumericsParams:
     """DEM integration knobs, and the engine that computes the scene."""
     engine: str = _spec("", "choice", "mechanical engine of the scene (grainfrac_yade.engines): yade = YADE's "
-                        "explicit DEM with dynamic relaxation", ("yade",))
+                        "explicit DEM with dynamic relaxation; static = static equilibrium between bond failures (grainfrac_yade.static: "
+                        "no inertia, no loading rate)", ("yade", "static"))
     damping: float = _spec("1", "unit_interval_open", "Cundall non-viscous damping")
     timestep_safety: float = _spec("1", "unit_interval_open", "fraction of the critical time step")
     density_scale: float = _spec("1", "positive", "mass scaling factor for quasi-static runs")

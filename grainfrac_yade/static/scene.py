@@ -1,0 +1,442 @@
+"""The static engine's scene: :class:`grainfrac_yade.engines.Scene` on the quasi-static core (pure numpy/scipy).
+
+The test protocols (:mod:`grainfrac_yade.protocols`) drive it unchanged; their calls map onto the core so:
+
+* **platens** (:class:`StaticPlatens`): displacement control of the platen closure d (top -d/2, bottom +d/2,
+  smooth platens: lateral motion free, :mod:`.network`).  ``set_axial_velocity(v)`` sets the closing speed of
+  the load parameter; the closure is v x the load parameter (:attr:`StaticScene.time`).
+* **run(n)**: n increments of the load parameter, each of :attr:`StaticScene.dt`: the closure advances by
+  v x dt along the sequentially linear path of :class:`.cascade.Path` (to each bond crossing, the most
+  overstressed bond broken alone, equilibrium restored at that closure, then every bond at its strength, one at
+  a time), so that after each increment no intact bond is beyond its strength (paper Eq. 4-5).
+* **equilibrate**: one solve at the current closure, and the cascade of what is then at its strength.
+* **steps** counts equilibria solved (:class:`.solver.Counters`); **time** is the load parameter [s]: the time a
+  machine closing at the protocol's speed would take to this closure (a UCS history's ``time_s`` therefore
+  reads as YADE's DEM time at the same strain).
+* **confine(sigma_3)**: a constant lateral traction on the side nodes (a dead load, :meth:`.network.StaticNetwork.
+  confinement_force`); the isotropic stage is the path to an axial stress sigma_3 (:func:`consolidate`).
+* **save / restore**: an ``.npz`` of the core's state (displacements, contact statuses, shear references, forces,
+  strengths, counters): the run goes on bit for bit.
+* **export_state / scene_from_state**: :class:`grainfrac_yade.engines.SceneState`; the static engine keeps each
+  broken contact's shear reference s_p (its plastic slip) in ``bond_slip`` and the closure in the platens' dict.
+
+Where no set of contact statuses settles (frictional contacts with a non-associated slip rule need not have a
+unique quasi-static equilibrium) the core raises :class:`~grainfrac_yade.errors.NumericalFailure`: the protocols
+end the run as a numerical failure with that reason.  Rough platens and the Brazilian jaws are not in the core
+yet: refused with one line.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..engines import SceneState
+from ..errors import GrainfracError, NumericalFailure
+from ..grains import layout_for
+from . import contacts as cl
+from .cascade import Path
+from .failure import FailureRule
+from .network import build_static_network
+from .solver import Equilibrium, State
+
+#: Fields of the core's converged state that a save keeps (arrays over bonds in canonical order, or scalars).
+STATE_FIELDS = ("closure", "u", "broken", "status", "sign", "s_p", "fn", "fs", "stress", "break_mode", "held",
+                "iterations")
+#: Name the static engine's parts carry in :meth:`StaticScene.engine_names`.
+EQUILIBRIUM_NAME = "StaticEquilibrium"
+
+
+def load_increment(params) -> float:
+    """The load parameter's increment of one solved step [s]: ``ucs.record_strain_increment / ucs.strain_rate``,
+    so that a UCS history row is one increment of the path (the path itself finds every bond crossing inside it;
+    the increment only sets where rows are written)."""
+    return params.ucs.record_strain_increment / params.ucs.strain_rate
+
+
+class StaticPlatens:
+    """The platens of a static scene (:class:`grainfrac_yade.engines.PlatenDrive`): the closure d is the core's
+    control; strains and the platen stress are read off its converged state."""
+
+    name = "Platens"
+
+    def __init__(self, scene: "StaticScene"):
+        net = scene.net
+        self.scene = scene
+        self.width, self.height = net.width, net.height
+        self.velocity = 0.0
+        # reference positions (what a checkpoint keeps of YADE's platens): the closure is measured from them
+        self.y0_top, self.y0_bottom, self.x0_gap = net.height, 0.0, net.width
+
+    def set_axial_velocity(self, closing_speed: float) -> None:
+        """The platens approach each other at ``closing_speed`` [m/s of the load parameter]."""
+        self.velocity = float(closing_speed)
+
+    def shift(self, closing: float) -> None:
+        """Close the platens by ``closing`` [m] in one jump, solved along the path (breaks and cascades)."""
+        self.scene.move_to(self.scene.state.closure + float(closing))
+
+    def axial_strain(self) -> float:
+        return self.scene.state.closure / self.height
+
+    def lateral_strain(self) -> float:
+        """Change of the side nodes' mean distance over the width (compression positive) [1]."""
+        net, u = self.scene.net, self.scene.state.u
+        ux = np.where(net.dofs[:, 0] >= 0, u[np.maximum(net.dofs[:, 0], 0)], 0.0)
+        gap = (ux[net.right].mean() if net.right.any() else 0.0) - (ux[net.left].mean() if net.left.any() else 0.0)
+        return -gap / self.width
+
+    def axial_stress(self) -> float:
+        return float(self.scene.state.stress)
+
+    def state_dict(self) -> dict:
+        return {"velocity": self.velocity, "y0_top": float(self.y0_top), "y0_bottom": float(self.y0_bottom),
+                "x0_gap": float(self.x0_gap), "reaction_pa": self.axial_stress(),
+                "closure": float(self.scene.state.closure)}
+
+    def rebind(self, reaction: float) -> None:
+        """After a restore: nothing to fetch (the stress is the restored state's)."""
+
+
+class StaticConfinement:
+    """Constant lateral traction sigma_3 on the side nodes (a dead load of the equilibrium)."""
+
+    name = "Confinement"
+
+    def __init__(self, scene: "StaticScene", stress: float):
+        self.scene, self.stress = scene, float(stress)
+        self.apply()
+
+    def apply(self):
+        """Make the scene's equilibrium carry the traction (again after a restore)."""
+        self.scene.set_confinement(self.stress)
+
+    def total_force(self) -> float:
+        """Sum of the inward forces on both sides [N] (2 x sigma_3 x height x thickness)."""
+        return float(np.abs(self.scene.net.confinement_force(self.stress)).sum())
+
+
+class StaticScene:
+    """A specimen's static scene (module doc); bond arrays of the interface in the layout's order."""
+
+    def __init__(self, specimen, params, layout=None):
+        self.specimen, self.params = specimen, params
+        self.layout = layout or layout_for(specimen, params)
+        self.net = build_static_network(specimen, params, self.layout)
+        m = self.net.n_bonds
+        #: canonical number of each layout bond (the network keeps bonds in a numbering-free order)
+        self.canon = np.empty(m, np.int64)
+        self.canon[self.net.order] = np.arange(m)
+        self.confinement_stress = 0.0
+        self.eq = Equilibrium(self.net)
+        self.path = Path(self.eq)
+        self.drivers = []
+        self._dt = load_increment(params)
+        self._time = 0.0
+        self._steps_offset = 0
+        self.broken = np.zeros(m, bool)
+        self.break_mode = np.zeros(m, np.int8)
+        self.break_step = np.full(m, -1, np.int64)
+        self.state = self.eq.initial(0.0)
+
+    # ------------------------------------------------------------------ counters
+    @property
+    def steps(self) -> int:
+        """Equilibria solved so far (bracketing and cascades included)."""
+        return self._steps_offset + self.eq.counters.equilibria
+
+    @property
+    def time(self) -> float:
+        """The load parameter [s] (module doc)."""
+        return self._time
+
+    @property
+    def dt(self) -> float:
+        return self._dt
+
+    @property
+    def n_bonds(self) -> int:
+        return self.net.n_bonds
+
+    # ------------------------------------------------------------------ advancing
+    def _platens(self):
+        return next((d for d in self.drivers if isinstance(d, StaticPlatens)), None)
+
+    def run(self, n_steps: int) -> None:
+        """``n_steps`` increments of the load parameter, the closure following the platens' speed."""
+        pl = self._platens()
+        speed = pl.velocity if pl is not None else 0.0
+        for _ in range(int(n_steps)):
+            self._time += self._dt
+            self.move_to(self.state.closure + speed * self._dt)
+
+    def move_to(self, closure: float) -> None:
+        """Follow the path to ``closure`` [m] (breaks at their crossings, cascades); the bookkeeping synced.  A
+        closure behind the current one (opening platens) is solved directly, with the cascade there."""
+        if closure >= self.state.closure:
+            state = self.path.run_closure(self.state, closure)
+        else:
+            state = self.path.cascade(self.eq.solve(closure, self.state))
+        self._take(state)
+
+    def equilibrate(self, balanced, check_steps: int, max_steps: int):
+        """One solve at the current closure and loads, and the cascade of what is at its strength: 1 step."""
+        before = self.steps
+        self._take(self.path.cascade(self.eq.solve(self.state.closure, self.state)))
+        return max(1, self.steps - before)
+
+    def _take(self, state: State) -> None:
+        if not (math.isfinite(state.stress) and np.all(np.isfinite(state.fn)) and np.all(np.isfinite(state.fs))):
+            raise NumericalFailure(f"static equilibrium: a force is NaN or infinite at closure {state.closure:.6g} m")
+        new = state.broken & ~self.state.broken
+        self.state = state
+        if new.any():
+            lay = self.net.order[np.flatnonzero(new)]
+            self.broken[lay] = True
+            self.break_mode[lay] = state.break_mode[np.flatnonzero(new)]
+            self.break_step[lay] = self.steps
+
+    # ------------------------------------------------------------------ bonds
+    def _idx(self, indices):
+        return self.canon if indices is None else self.canon[np.atleast_1d(np.asarray(indices, np.int64))]
+
+    def bond_forces(self, indices=None):
+        c = self._idx(indices)
+        return self.state.fn[c].copy(), np.abs(self.state.fs[c])
+
+    def bond_stresses(self, indices=None):
+        c = self._idx(indices)
+        area = self.net.area[c]
+        return self.state.fn[c] / area, np.abs(self.state.fs[c]) / area
+
+    def bond_strengths(self, indices=None):
+        c = self._idx(indices)
+        intact = ~self.state.broken[c]
+        return np.where(intact, self.path.jt[c], 0.0), np.where(intact, self.path.jc[c], 0.0)
+
+    def write_bond_strengths(self, indices, tensile, cohesion) -> None:
+        c = self._idx(indices)
+        self.path.jt[c] = np.broadcast_to(np.asarray(tensile, float), c.shape)
+        self.path.jc[c] = np.broadcast_to(np.asarray(cohesion, float), c.shape)
+
+    def break_bonds(self, indices, mode: int) -> None:
+        """Break bonds ``indices`` in ``mode``, one at a time in canonical order, equilibrium restored after each
+        (JCFpm's broken contact: compression only, residual friction)."""
+        state = self.state
+        for c in np.sort(self._idx(indices)):
+            if not state.broken[c]:
+                state = self.path.break_bond(state, int(c), int(mode))
+        self._take(state)
+
+    def bond_separated(self, indices) -> np.ndarray:
+        c = self._idx(indices)
+        return (self.net.cn[c] @ self.state.u) > 0
+
+    def sliding_erasures(self) -> int:
+        """None: a static contact is never erased by sliding."""
+        return 0
+
+    # ------------------------------------------------------------------ cells, platens, confinement
+    def node_positions(self) -> np.ndarray:
+        """(n_nodes, 2) current node positions [m] (the network's nodes, cell by cell)."""
+        net, u = self.net, self.state.u
+        d = np.zeros((len(net.node_pos), 2))
+        for col in range(2):
+            ok = net.dofs[:, col] >= 0
+            d[ok, col] = u[net.dofs[ok, col]]
+        return net.node_pos[:, :2] + d
+
+    def cell_positions(self, cells=None) -> np.ndarray:
+        """(n, 3) mean position of each cell's nodes [m] (z: the specimen's mid-plane)."""
+        pos, cell = self.node_positions(), self.net.node_cell
+        n_cells = self.specimen.n_cells
+        sums = np.zeros((n_cells, 2))
+        np.add.at(sums, cell, pos)
+        mean = sums / np.maximum(np.bincount(cell, minlength=n_cells), 1)[:, None]
+        out = np.column_stack([mean, np.full(n_cells, 0.5 * self.specimen.thickness)])
+        return out if cells is None else out[np.asarray(cells, np.int64)]
+
+    def attach_platens(self, lateral: str = "free") -> StaticPlatens:
+        if lateral != "free":
+            raise GrainfracError(f"static engine: platen_lateral = {lateral!r} (rough platens) is not in the static "
+                                 "core, whose platens are smooth; fix: platen_lateral = \"free\" or the YADE engine")
+        pl = self._platens() or StaticPlatens(self)
+        if pl not in self.drivers:
+            self.drivers.append(pl)
+        return pl
+
+    def attach_jaws(self, loading_arc: float, lateral: str = "fixed"):
+        raise GrainfracError("static engine: the Brazilian test's jaws are not in the static core yet; fix: "
+                             "--engine yade (numerics.engine = \"yade\")")
+
+    def confine(self, stress: float) -> StaticConfinement:
+        conf = StaticConfinement(self, stress)
+        self.drivers.append(conf)
+        return conf
+
+    def set_confinement(self, stress: float) -> None:
+        """Rebuild the equilibrium with a constant lateral traction ``stress`` [Pa] and re-solve where the scene is."""
+        self.confinement_stress = float(stress)
+        counters = self.eq.counters
+        self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
+        self.eq.counters = counters
+        jt, jc = self.path.jt, self.path.jc
+        self.path = Path(self.eq)
+        self.path.jt, self.path.jc = jt, jc
+        self.state = self.eq.solve(self.state.closure, self.state)
+
+    def engine_names(self) -> list:
+        return [EQUILIBRIUM_NAME] + [d.name for d in self.drivers]
+
+    def counts(self) -> dict:
+        """Nodes, closed contacts (intact bonds and closed broken ones) and bonds."""
+        return {"n_bodies": int(len(self.net.node_pos)), "n_interactions": int(np.count_nonzero(self.state.status
+                                                                                                  != cl.OPEN)),
+                "n_bonds": self.n_bonds}
+
+    # ------------------------------------------------------------------ state
+    def _arrays(self) -> dict:
+        out = {"state_" + k: np.asarray(getattr(self.state, k)) for k in STATE_FIELDS}
+        out.update(jt=self.path.jt, jc=self.path.jc, broken=self.broken, break_mode=self.break_mode,
+                   break_step=self.break_step, time=np.float64(self._time), steps=np.int64(self.steps),
+                   confinement=np.float64(self.confinement_stress), n_bonds=np.int64(self.n_bonds))
+        return out
+
+    def save(self, path) -> None:
+        """An ``.npz`` of the core's state, strengths, bookkeeping and counters (exact doubles)."""
+        with open(path, "wb") as fh:
+            np.savez(fh, **self._arrays())
+
+    def restore(self, path) -> None:
+        """Replace this scene's state by the one :meth:`save` wrote (same specimen and parameters)."""
+        with np.load(path) as data:
+            a = {k: data[k] for k in data.files}
+        if int(a["n_bonds"]) != self.n_bonds:
+            raise GrainfracError(f"{path}: a static scene of {int(a['n_bonds'])} bonds, not {self.n_bonds}; fix: "
+                                 "start the run again with --overwrite")
+        if float(a["confinement"]) != self.confinement_stress:
+            self.set_confinement(float(a["confinement"]))
+        values = {k: a["state_" + k] for k in STATE_FIELDS}
+        for k in ("closure", "stress"):
+            values[k] = float(values[k])
+        for k in ("held", "iterations"):
+            values[k] = int(values[k])
+        self.state = State(**values)
+        self.path.jt, self.path.jc = a["jt"].copy(), a["jc"].copy()
+        self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()
+        self._time = float(a["time"])
+        self._steps_offset = int(a["steps"]) - self.eq.counters.equilibria
+
+    def checkpoint_state(self) -> dict:
+        return {"n_bodies": int(len(self.net.node_pos)), "n_bonds": self.n_bonds, "engine": "static"}
+
+    def restore_checkpoint(self, where, scene_file, saved: dict, arrays: dict, confinement=None) -> None:
+        if saved.get("engine") != "static" or saved["n_bonds"] != self.n_bonds:
+            raise GrainfracError(f"{where}: checkpoint of another scene (engine {saved.get('engine', 'yade')!r}, "
+                                 f"{saved['n_bonds']} bonds; rebuilt: static, {self.n_bonds}); fix: resume it with the "
+                                 "engine that wrote it, or start the run again with --overwrite")
+        try:
+            self.restore(scene_file)
+        except (OSError, ValueError, KeyError, EOFError) as exc:
+            raise GrainfracError(f"{scene_file}: the checkpoint's static scene is unreadable ({type(exc).__name__}: "
+                                 f"{exc}); fix: start the run again with --overwrite") from None
+        if confinement is not None and confinement.stress != self.confinement_stress:
+            confinement.apply()
+        self.broken, self.break_mode, self.break_step = (np.array(arrays[k]) for k in ("broken", "break_mode",
+                                                                                        "break_step"))
+
+    def _bond_frame(self):
+        """(normal, tangent) unit vectors of every layout bond in 3D: the face normal, pointing from the bond's first
+        sphere to its second, and its in-plane perpendicular (z x n)."""
+        lay = self.layout
+        n = self.specimen.tessellation.face_normal[lay.bond_face][:, :2].astype(float)
+        a, b = lay.sphere_center[lay.bond_spheres[:, 0], :2], lay.sphere_center[lay.bond_spheres[:, 1], :2]
+        n = np.where((((b - a) * n).sum(1) < 0)[:, None], -n, n)
+        z = np.zeros((len(n), 1))
+        return np.hstack([n, z]), np.hstack([-n[:, 1:2], n[:, 0:1], z])
+
+    def export_state(self, platens=None) -> SceneState:
+        """The scene's state, engine-neutral; static extras: ``bond_slip`` holds each contact's shear reference s_p
+        [m], the platens' dict the closure [m] (what :func:`scene_from_state` re-solves from)."""
+        net, st, inv = self.net, self.state, self.canon
+        nodes = len(net.node_pos)
+        disp = np.zeros((nodes, 3))
+        disp[:, :2] = self.node_positions() - net.node_pos[:, :2]
+        rot = np.where(net.dofs[:, 2] >= 0, st.u[np.maximum(net.dofs[:, 2], 0)], 0.0)
+        pos = np.column_stack([net.node_pos[:, :2], np.full(nodes, 0.5 * self.specimen.thickness)]) + disp
+        normal, tangent = self._bond_frame()
+        fn, fs = st.fn[inv], st.fs[inv]
+        intact = ~st.broken[inv]
+        area = net.area[inv]
+        return SceneState(
+            steps=int(self.steps), time=float(self._time), node_cell=net.node_cell.copy(), node_position=pos,
+            node_displacement=disp, node_velocity=np.zeros((nodes, 3)), node_rotation=rot,
+            node_angular_velocity=np.zeros(nodes), bond_broken=self.broken.copy(), bond_mode=self.break_mode.copy(),
+            bond_break_step=self.break_step.copy(),
+            bond_tensile_capacity=np.where(intact, self.path.jt[inv] * area, 0.0),
+            bond_cohesive_capacity=np.where(intact, self.path.jc[inv] * area, 0.0),
+            bond_normal_stiffness=net.kn[inv].copy(), bond_shear_stiffness=net.ks[inv].copy(),
+            bond_tan_friction=np.where(intact, net.tan_friction[inv], net.tan_residual[inv]),
+            bond_normal_force=fn[:, None] * normal, bond_shear_force=fs[:, None] * tangent,
+            bond_reference_gap=np.zeros(self.n_bonds), bond_slip=st.s_p[inv].copy(),
+            bond_plane_normal=np.zeros((self.n_bonds, 3)),
+            platens=None if platens is None else platens.state_dict())
+
+    def apply_state(self, state: SceneState) -> None:
+        """Put ``state`` into this freshly built scene and solve the equilibrium there: displacements, broken set,
+        strengths, shear references; the statuses follow from the return mapping and the solve (module doc)."""
+        net = self.net
+        if len(state.node_position) != len(net.node_pos) or len(state.bond_broken) != self.n_bonds:
+            raise GrainfracError(f"a state of {len(state.node_position)} nodes and {len(state.bond_broken)} bonds does "
+                                 f"not fit this static scene ({len(net.node_pos)} nodes, {self.n_bonds} bonds); fix: "
+                                 "build the scene from the specimen, layout and parameters the state was made with")
+        u = np.zeros(net.ndof)
+        for col in range(2):
+            ok = net.dofs[:, col] >= 0
+            u[net.dofs[ok, col]] = state.node_displacement[ok, col]
+        ok = net.dofs[:, 2] >= 0
+        u[net.dofs[ok, 2]] = state.node_rotation[ok]
+        order = net.order
+        broken = np.asarray(state.bond_broken, bool)[order]
+        area = net.area
+        self.path.jt = np.where(broken, net.tensile_strength, np.asarray(state.bond_tensile_capacity)[order] / area)
+        self.path.jc = np.where(broken, net.cohesion, np.asarray(state.bond_cohesive_capacity)[order] / area)
+        s_p = np.asarray(state.bond_slip, float)[order]
+        closure = (float(state.platens["closure"]) if state.platens and "closure" in state.platens
+                   else float(np.mean(state.node_displacement[net.bottom, 1])
+                              - np.mean(state.node_displacement[net.top, 1])))
+        dn, ds = net.cn @ u, net.ct @ u
+        status, sign, _ = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual)
+        m = self.n_bonds
+        base = State(closure, u, broken, status, sign, s_p, np.zeros(m), np.zeros(m), 0.0,
+                     np.asarray(state.bond_mode, int)[order].copy())
+        self.state = self.eq.solve(closure, base)
+        self.broken = np.array(state.bond_broken, bool)
+        self.break_mode = np.array(state.bond_mode, np.int8)
+        self.break_step = np.array(state.bond_break_step, np.int64)
+        self._time = float(state.time)
+        self._steps_offset = int(state.steps) - self.eq.counters.equilibria
+
+
+def build_scene(specimen, params, layout=None) -> StaticScene:
+    """The static scene of ``specimen`` (rigid or fem cells, as ``resolution.grain_model`` builds its layout)."""
+    return StaticScene(specimen, params, layout)
+
+
+def scene_from_state(specimen, params, state: SceneState, layout=None) -> StaticScene:
+    """A static scene of ``specimen`` in ``state`` (:meth:`StaticScene.export_state` of this or another engine),
+    equilibrium solved there."""
+    scene = StaticScene(specimen, params, layout)
+    scene.apply_state(state)
+    return scene
+
+
+def consolidate(scene: StaticScene, platens, stress: float, params) -> dict:
+    """The isotropic stage of a confined test: the path under the lateral traction ``stress`` [Pa] until the axial
+    stress equals it (sigma_1 = sigma_3).  The protocol's keys: steps it took, whether it was reached, the axial
+    stress there."""
+    before = scene.steps
+    state, reason = scene.path.hold(scene.state, stress, FailureRule(0.0))
+    scene._take(state)
+    return {"consolidation_steps": scene.steps - before, "consolidated": not reason,
+            "consolidation_axial_stress_pa": float(state.stress)}
