@@ -33,6 +33,8 @@ DEBUG_FLAG = "--debug"
 #: Folder of the traceback logs of unexpected errors (relative to the working folder; the temporary folder if
 #: that is not writable).
 ERROR_LOG_DIR = "results/logs"
+#: Commands that take ``--engine NAME`` (a shortcut for ``--set numerics.engine=NAME``).
+ENGINE_COMMANDS = ("ucs", "creep", "brazilian")
 #: A negative number with an exponent (-10e-3): argparse takes it for an option ("expected one argument").
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
@@ -96,6 +98,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_specimen, with_params=True)
     register_all(sub, _common)
     animate.register(sub, _common)
+    for name in ENGINE_COMMANDS:
+        if name in sub.choices:
+            sub.choices[name].add_argument("--engine", metavar="NAME",
+                                           help="mechanical engine: yade (the default: explicit DEM) or static "
+                                                "(static equilibrium between bond failures); numerics.engine")
     return parser
 
 

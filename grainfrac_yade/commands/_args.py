@@ -4,6 +4,7 @@ command modules never import ``cli.py`` (it loads them)."""
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ..params import FlagOverride, load_parameters, override_origin
 from ..geometry.specimen import MAX_SEED, check_cell_count
@@ -41,7 +42,8 @@ def overrides_from_args(args) -> list:
     if extra is not None:
         out += list(extra(args))
     for opt, key in (("width", "specimen.width"), ("height", "specimen.height"),
-                     ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell")):
+                     ("grain_size", "specimen.grain_size"), ("spheres_per_cell", "resolution.spheres_per_cell"),
+                   ("engine", "numerics.engine")):
         value = getattr(args, opt, None)
         if value is not None:
             out.append(FlagOverride(key, value, "--" + opt.replace("_", "-")))
@@ -58,4 +60,24 @@ def load_params_from_args(args):
                       if override_origin(o) != "--set" and o[0].startswith("specimen."))
     check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
                      sp.grain_size, flags)
+    check_engine(getattr(args, "command", ""), params, args.resolved_overrides)
     return params
+
+
+def check_engine(command: str, params, overrides=()) -> None:
+    """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
+    without dynamics, a test the engine does not have yet), and warn once per line of a dynamic-only setting
+    given in ``overrides`` to an engine without dynamics.  Nothing for a dynamic engine (YADE)."""
+    from ..engines.registry import engine_for, require_dynamic
+    from ..errors import GrainfracError
+    module = engine_for(params)
+    if getattr(module, "DYNAMIC", False):
+        return
+    if command == "creep" and params.stress_corrosion.clock == "paper":
+        require_dynamic(params, "the paper clock (its unbalanced force, Eq. 8)")
+    refusal = getattr(module, "UNSUPPORTED", {}).get(command)
+    if refusal:
+        raise GrainfracError(refusal)
+    for line in getattr(module, "warn_dynamic_only", lambda o: [])([o for o in overrides
+                                                                     if override_origin(o) == "--set"]):
+        print(line, file=sys.stderr)
