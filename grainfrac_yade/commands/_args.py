@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..engines.registry import engine_for, require_dynamic
+from ..errors import GrainfracError
 from ..params import FlagOverride, load_parameters, override_origin
 from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
@@ -68,8 +70,6 @@ def check_engine(command: str, params, overrides=()) -> None:
     """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
     without dynamics, a test the engine does not have yet), and warn once per line of a dynamic-only setting
     given in ``overrides`` to an engine without dynamics.  Nothing for a dynamic engine (YADE)."""
-    from ..engines.registry import engine_for, require_dynamic
-    from ..errors import GrainfracError
     module = engine_for(params)
     if getattr(module, "DYNAMIC", False):
         return

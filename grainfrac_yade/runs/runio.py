@@ -72,20 +72,12 @@ def code_version() -> str:
     return __version__
 
 
-#: The engine of every run before ``numerics.engine`` existed: its summaries carry no engine keys.
-DEFAULT_ENGINE = "yade"
-
-
 def summary_header(params, seed) -> dict:
     """summary.json keys shared by UCS and creep runs: seed, code version, all parameters, and at the
     top level how the cells are realised (``spheres_per_cell``, ``grain_model``, ``nodes_per_face``)."""
     r = params.resolution
-    out = {"seed": seed, "code_version": code_version(), "params": params.to_dict(),
-           "spheres_per_cell": r.spheres_per_cell, "grain_model": r.grain_model, "nodes_per_face": r.nodes_per_face}
-    if params.numerics.engine != DEFAULT_ENGINE:   # the engine and the settings it did not use (YADE's keys as before)
-        from ..engines.registry import engine_for
-        out.update(getattr(engine_for(params), "summary_keys", lambda p: {"engine": p.numerics.engine})(params))
-    return out
+    return {"seed": seed, "code_version": code_version(), "params": params.to_dict(),
+            "spheres_per_cell": r.spheres_per_cell, "grain_model": r.grain_model, "nodes_per_face": r.nodes_per_face}
 
 
 def _clean(value):

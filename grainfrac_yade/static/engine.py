@@ -13,8 +13,8 @@ own, not written against the scene interface), the Brazilian jaws and levers, VT
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
-one-line warning (:func:`warn_dynamic_only`), and every run's summary records them as not used
-(:func:`summary_keys`).
+one-line warning (:func:`.settings.warn_dynamic_only`), and every run's summary records them as not used
+(:func:`.settings.summary_keys`).
 """
 from __future__ import annotations
 
@@ -22,21 +22,12 @@ import importlib.metadata
 
 from ..errors import GrainfracError
 from .scene import StaticScene, build_scene, consolidate, scene_from_state  # noqa: F401
+from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
-#: The value of ``numerics.engine`` that selects this engine.
-NAME = "static"
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
 DYNAMIC = False
 #: Names of the strain a VTK series is timed by (as the YADE engine's; VTK output is refused here).
 AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
-
-#: Parameters that only a dynamic engine reads: explicit integration (damping, time step, mass scaling), the
-#: collider, the creep servo and the dynamic relaxation budgets (steps and elastic wave crossings).
-DYNAMIC_ONLY = ("numerics.damping", "numerics.timestep_safety", "numerics.density_scale",
-                "numerics.step_floor_quantile", "numerics.verlet_fraction", "numerics.verlet_radius_quantile",
-                "creep.servo_response_steps", "creep.servo_max_strain_rate", "creep.servo_response_crossings",
-                "creep.check_period", "creep.max_relaxation_steps", "creep.max_relaxation_crossings",
-                "creep.relaxation_damping")
 
 #: Commands the static engine cannot run yet -> the one line that says so and the fix.
 UNSUPPORTED = {
@@ -50,28 +41,6 @@ UNSUPPORTED = {
 def version() -> str:
     """The versions of the libraries the static engine computes with (numpy, scipy)."""
     return "numpy " + importlib.metadata.version("numpy") + ", scipy " + importlib.metadata.version("scipy")
-
-
-def _value(params, key: str):
-    section, name = key.split(".")
-    return getattr(getattr(params, section), name)
-
-
-def summary_keys(params) -> dict:
-    """What a run's summary.json records of the engine: its name, and the dynamic-only settings (with their
-    values) that it did not use."""
-    return {"engine": NAME, "settings_not_used": {k: _value(params, k) for k in DYNAMIC_ONLY}}
-
-
-def warn_dynamic_only(overrides) -> list:
-    """One warning line per dynamic-only setting among ``overrides`` (``(key, value)`` pairs or
-    ``section.key=value`` strings as ``--set`` gives them)."""
-    out = []
-    for item in overrides:
-        key = item.split("=", 1)[0].strip() if isinstance(item, str) else item[0]
-        if key in DYNAMIC_ONLY:
-            out.append(f"warning: --set {key}: the static engine has no dynamics and does not use it")
-    return out
 
 
 def _refuse(what: str):

@@ -38,6 +38,7 @@ from . import contacts as cl
 from .cascade import Path
 from .failure import FailureRule
 from .network import build_static_network
+from .settings import summary_keys
 from .solver import Equilibrium, State
 
 #: Fields of the core's converged state that a save keeps (arrays over bonds in canonical order, or scalars).
@@ -284,6 +285,10 @@ class StaticScene:
         self.path = Path(self.eq)
         self.path.jt, self.path.jc = jt, jc
         self.state = self.eq.solve(self.state.closure, self.state)
+
+    def summary_keys(self) -> dict:
+        """What a run's summary records of the engine: its name and the dynamic-only settings it did not use."""
+        return summary_keys(self.params)
 
     def engine_names(self) -> list:
         return [EQUILIBRIUM_NAME] + [d.name for d in self.drivers]

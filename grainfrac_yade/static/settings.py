@@ -1,0 +1,40 @@
+"""The static engine's name and the settings it does not read (pure: parameters only).
+
+A static equilibrium has no time integration: damping, the DEM step, mass scaling, the collider and the creep
+servo's and relaxation's budgets (steps, elastic wave crossings) mean nothing to it.  A run on the static engine
+records them as not used; one given with ``--set`` gets a one-line warning.
+"""
+from __future__ import annotations
+
+#: The value of ``numerics.engine`` that selects this engine.
+NAME = "static"
+
+#: Parameters that only a dynamic engine reads: explicit integration (damping, time step, mass scaling), the
+#: collider, the creep servo and the dynamic relaxation budgets (steps and elastic wave crossings).
+DYNAMIC_ONLY = ("numerics.damping", "numerics.timestep_safety", "numerics.density_scale",
+                "numerics.step_floor_quantile", "numerics.verlet_fraction", "numerics.verlet_radius_quantile",
+                "creep.servo_response_steps", "creep.servo_max_strain_rate", "creep.servo_response_crossings",
+                "creep.check_period", "creep.max_relaxation_steps", "creep.max_relaxation_crossings",
+                "creep.relaxation_damping")
+
+
+def _value(params, key: str):
+    section, name = key.split(".")
+    return getattr(getattr(params, section), name)
+
+
+def summary_keys(params) -> dict:
+    """What a run's summary.json records of the engine: its name, and the dynamic-only settings (with their
+    values) that it did not use."""
+    return {"engine": NAME, "settings_not_used": {k: _value(params, k) for k in DYNAMIC_ONLY}}
+
+
+def warn_dynamic_only(overrides) -> list:
+    """One warning line per dynamic-only setting among ``overrides`` (``(key, value)`` pairs or
+    ``section.key=value`` strings as ``--set`` gives them)."""
+    out = []
+    for item in overrides:
+        key = item.split("=", 1)[0].strip() if isinstance(item, str) else item[0]
+        if key in DYNAMIC_ONLY:
+            out.append(f"warning: --set {key}: the static engine has no dynamics and does not use it")
+    return out

@@ -1,0 +1,176 @@
+"""The static engine through the scene interface: the UCS protocol drives it unchanged (pure, tiny specimens)."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from grainfrac_yade.engines import Scene
+from grainfrac_yade.engines.registry import engine, engine_for
+from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.params import load_parameters
+
+TINY = ["specimen.width=3e-3", "specimen.height=6e-3", "numerics.engine=static"]
+#: summary.json keys that measure the machine, not the run
+MACHINE_KEYS = ("wall_s", "cpu_s")
+
+
+def _params(*extra):
+    return load_parameters(overrides=[*TINY, *extra])
+
+
+def test_static_engine_module_and_scene_interface():
+    """The registry's "static" module: no dynamics, a scene that implements the protocol's Scene."""
+    p = _params()
+    module = engine_for(p)
+    assert module is engine("static") and module.NAME == "static" and module.DYNAMIC is False
+    assert "scipy" in module.version()
+    scene = module.build_scene(build_specimen(p, 1), p)
+    assert isinstance(scene, Scene)
+    assert scene.steps >= 1 and scene.time == 0.0 and scene.dt > 0
+    assert scene.counts()["n_bonds"] == scene.n_bonds == len(scene.broken)
+    fn, fs = scene.bond_forces()
+    assert fn.shape == fs.shape == (scene.n_bonds,) and np.all(fn == 0)
+
+
+def test_run_breaks_bonds_and_keeps_them_within_strength():
+    """run(n): the closure follows the platens' speed; after each increment no intact bond is beyond its
+    strength (paper Eq. 4-5), and the bookkeeping is in the layout's order."""
+    from grainfrac_yade.law import failed_now
+    p = _params()
+    scene = engine_for(p).build_scene(build_specimen(p, 1), p)
+    pl = scene.attach_platens("free")
+    pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
+    scene.run(250)     # 0.5 % axial strain
+    assert pl.axial_strain() == pytest.approx(250 * p.ucs.record_strain_increment)
+    assert scene.broken.sum() > 0 and np.all(scene.break_step[scene.broken] > 0)
+    assert np.all(scene.break_step[~scene.broken] == -1)
+    sigma, tau = scene.bond_stresses()
+    jt, jc = scene.bond_strengths()
+    tan_phi = scene.net.tan_friction[scene.canon]
+    ten, sh = failed_now(jt, jc, sigma, tau, tan_phi)
+    intact = ~scene.broken
+    assert not np.any((ten | sh) & intact)
+    assert pl.axial_stress() > 0 and math.isfinite(pl.lateral_strain())
+
+
+def test_save_restore_goes_on_bit_for_bit(tmp_path):
+    """A scene restored from save() computes what the uninterrupted one does, to the last bit."""
+    p = _params()
+    specimen = build_specimen(p, 1)
+    a = engine_for(p).build_scene(specimen, p)
+    pa = a.attach_platens("free")
+    pa.set_axial_velocity(p.ucs.strain_rate * pa.height)
+    a.run(150)
+    a.save(tmp_path / "scene.npz")
+    a.run(100)
+    b = engine_for(p).build_scene(specimen, p)
+    pb = b.attach_platens("free")
+    pb.set_axial_velocity(pa.velocity)
+    b.restore(tmp_path / "scene.npz")
+    b.run(100)
+    assert b.steps == a.steps and b.time == a.time
+    assert np.array_equal(a.state.u, b.state.u) and np.array_equal(a.broken, b.broken)
+    assert np.array_equal(a.break_step, b.break_step) and pa.axial_stress() == pb.axial_stress()
+
+
+def test_state_round_trip():
+    """export_state -> scene_from_state: the same broken set, strengths and forces (re-solved there)."""
+    p = _params()
+    specimen = build_specimen(p, 1)
+    module = engine_for(p)
+    a = module.build_scene(specimen, p)
+    pl = a.attach_platens("free")
+    pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
+    a.run(200)
+    state = a.export_state(pl)
+    b = module.scene_from_state(specimen, p, state)
+    assert np.array_equal(b.broken, a.broken) and b.steps == a.steps and b.time == a.time
+    fa, fb = a.bond_forces(), b.bond_forces()
+    scale = np.abs(fa[0]).max()
+    assert np.allclose(fa[0], fb[0], rtol=0, atol=1e-9 * scale) and np.allclose(fa[1], fb[1], rtol=0, atol=1e-9 * scale)
+    assert np.array_equal(b.export_state(pl).bond_tensile_capacity, state.bond_tensile_capacity)
+
+
+def _ucs_folder(tmp_path, name, *extra):
+    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    p = _params(*extra)
+    out = tmp_path / name
+    return run_ucs_to_folder(p, 1, out), out
+
+
+def test_ucs_through_the_protocol_writes_a_run_folder(tmp_path):
+    """protocols/ucs.py on the static engine: the usual run folder, finite values, the engine recorded."""
+    summary, out = _ucs_folder(tmp_path, "a")
+    for name in ("summary.json", "history.csv", "cracks.csv", "params.json", "stress_strain.png",
+                 "crack_map_peak.png"):
+        assert (out / name).exists(), name
+    assert summary["numerical_failure"] is False and summary["peak_reached"] is True
+    assert summary["ucs_pa"] > 0 and summary["engine"] == "static"
+    assert "numerics.damping" in summary["settings_not_used"]
+    assert json.loads((out / "params.json").read_text())["numerics"]["engine"] == "static"
+    text = (out / "history.csv").read_text() + (out / "summary.json").read_text() + (out / "cracks.csv").read_text()
+    assert "nan" not in text.lower() and "infinity" not in text.lower()
+    hist = np.genfromtxt(out / "history.csv", delimiter=",", names=True)
+    assert np.all(np.isfinite(hist["axial_stress_pa"])) and len(hist) > 10
+
+
+def test_ucs_row_twice_is_identical(tmp_path):
+    """Determinism: the same row twice gives the same summary.json (but the machine's times) and cracks.csv."""
+    s1, o1 = _ucs_folder(tmp_path, "one")
+    s2, o2 = _ucs_folder(tmp_path, "two")
+    for s in (s1, s2):
+        for k in MACHINE_KEYS:
+            s.pop(k, None)
+    assert json.dumps(s1, sort_keys=True, default=str) == json.dumps(s2, sort_keys=True, default=str)
+    assert (o1 / "cracks.csv").read_bytes() == (o2 / "cracks.csv").read_bytes()
+    assert (o1 / "history.csv").read_bytes() == (o2 / "history.csv").read_bytes()
+
+
+def test_confined_ucs_on_the_static_engine():
+    """Confinement as a constant lateral traction: the isotropic stage reaches sigma_1 = sigma_3, then the
+    deviator's peak."""
+    from grainfrac_yade.protocols.ucs import run_ucs
+    p = _params("confinement.stress=20e6")
+    cols, result, scene, _ = run_ucs(build_specimen(p, 1), p)
+    assert result["consolidated"] is True
+    assert result["consolidation_axial_stress_pa"] == pytest.approx(20e6, rel=1e-6)
+    assert result["numerical_failure"] is False and max(cols["axial_stress_pa"]) > 20e6
+
+
+def _cli(capsys, *argv):
+    from grainfrac_yade.cli import main
+    rc = main(list(argv))
+    return rc, capsys.readouterr()
+
+
+def test_misspelt_engine_flag_is_one_line(capsys, tmp_path):
+    rc, out = _cli(capsys, "ucs", "--engine", "statc", "--width", "3e-3", "--height", "6e-3",
+                   "--out", str(tmp_path / "x"))
+    assert rc == 2 and out.err.count("\n") == 1 and "--engine" in out.err and "'static'" in out.err
+    assert not (tmp_path / "x").exists()
+
+
+def test_paper_clock_and_creep_refused_in_one_line(capsys, tmp_path):
+    """The paper clock needs dynamics; the static creep hold is not on the scene interface yet."""
+    common = ["--engine", "static", "--width", "3e-3", "--height", "6e-3", "--stress", "100e6",
+              "--out", str(tmp_path / "x")]
+    rc, out = _cli(capsys, "creep", *common, "--set", "stress_corrosion.clock=paper")
+    assert rc == 2 and out.err.count("\n") == 1 and "paper clock" in out.err and "fix:" in out.err
+    rc, out = _cli(capsys, "creep", *common)
+    assert rc == 2 and out.err.count("\n") == 1 and "creep" in out.err and "fix:" in out.err
+    assert not (tmp_path / "x").exists()
+
+
+def test_dynamic_only_setting_warns_once():
+    from grainfrac_yade.static.engine import warn_dynamic_only
+    lines = warn_dynamic_only(["numerics.damping=0.5", "specimen.width=3e-3", ("creep.servo_response_steps", 5)])
+    assert len(lines) == 2 and all("\n" not in s and s.startswith("warning:") for s in lines)
+
+
+def test_engine_flag_is_the_parameter():
+    """--engine NAME is --set numerics.engine=NAME (recorded in params.json like any parameter)."""
+    from grainfrac_yade.cli import build_parser
+    from grainfrac_yade.commands._args import overrides_from_args
+    args = build_parser().parse_args(["ucs", "--engine", "static"])
+    assert ("numerics.engine", "static") in [tuple(o) for o in overrides_from_args(args) if not isinstance(o, str)]
