@@ -174,3 +174,17 @@ def test_engine_flag_is_the_parameter():
     from grainfrac_yade.commands._args import overrides_from_args
     args = build_parser().parse_args(["ucs", "--engine", "static"])
     assert ("numerics.engine", "static") in [tuple(o) for o in overrides_from_args(args) if not isinstance(o, str)]
+
+
+def test_ucs_resumed_from_a_checkpoint_is_bit_identical(tmp_path):
+    """A checkpoint before every history row (the static scene saved as an .npz): resuming from the last one
+    gives the uninterrupted test's history and result."""
+    from grainfrac_yade.protocols.ucs import resume_ucs, run_ucs
+    p = _params("numerics.checkpoint_interval=1e-9")
+    specimen = build_specimen(p, 1)
+    cols, result, _, _ = run_ucs(specimen, p, checkpoint_folder=tmp_path, run_values={"seed": 1})
+    assert (tmp_path / "checkpoint").is_dir()
+    cols2, result2, _, _ = resume_ucs(specimen, p, tmp_path)
+    assert cols2 == cols
+    for k in ("steps", "broken_total", "end_reason", "peak_reached"):
+        assert result2[k] == result[k], k
