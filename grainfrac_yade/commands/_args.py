@@ -62,14 +62,15 @@ def load_params_from_args(args):
                       if override_origin(o) != "--set" and o[0].startswith("specimen."))
     check_cell_count(n_cells_for(box, sp.grain_size), f"the {' x '.join(f'{b * 1e3:g}' for b in box)} mm specimen",
                      sp.grain_size, flags)
-    check_engine(getattr(args, "command", ""), params, args.resolved_overrides)
+    check_engine(getattr(args, "command", ""), params, args.resolved_overrides, bool(getattr(args, "vtk_every", None)))
     return params
 
 
-def check_engine(command: str, params, overrides=()) -> None:
+def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
     """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
-    without dynamics, a test the engine does not have yet), and warn once per line of a dynamic-only setting
-    given in ``overrides`` to an engine without dynamics.  Nothing for a dynamic engine (YADE)."""
+    without dynamics, a test the engine does not have yet, a VTK series ``vtk`` it does not write), and warn
+    once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  Nothing for
+    a dynamic engine (YADE)."""
     module = engine_for(params)
     if getattr(module, "DYNAMIC", False):
         return
@@ -78,6 +79,8 @@ def check_engine(command: str, params, overrides=()) -> None:
     refusal = getattr(module, "UNSUPPORTED", {}).get(command)
     if refusal:
         raise GrainfracError(refusal)
+    if vtk and getattr(module, "VTK_REFUSED", ""):
+        raise GrainfracError(module.VTK_REFUSED)
     for line in getattr(module, "warn_dynamic_only", lambda o: [])([o for o in overrides
                                                                      if override_origin(o) == "--set"]):
         print(line, file=sys.stderr)

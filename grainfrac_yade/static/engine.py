@@ -33,6 +33,8 @@ AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
 UNSUPPORTED = {
     "creep": ("the static engine's creep hold needs the creep protocol written against the scene interface (the "
               "creep runner is still YADE's own); fix: --engine yade (numerics.engine = \"yade\")"),
+    "bench": ("the static engine has no DEM steps to time (bench measures YADE's stepping and creep runs); fix: "
+              "bench with numerics.engine = \"yade\""),
     "brazilian": ("the static engine's Brazilian test needs the disc's jaws in the static core (not built yet); "
                   "fix: --engine yade (numerics.engine = \"yade\")"),
 }
@@ -62,9 +64,12 @@ def apply_levers(*args, **kwargs):
     _refuse("brazilian")
 
 
+#: The one line that refuses a VTK series (``--vtk-every``) on the static engine.
+VTK_REFUSED = "static engine: VTK series (--vtk-every) are not written yet; fix: leave out --vtk-every, or --engine yade"
+
+
 class StrainSeries:
     """VTK series: not written by the static engine yet (refused with one line)."""
 
     def __init__(self, *args, **kwargs):
-        raise GrainfracError("static engine: VTK series (--vtk-every) are not written yet; fix: leave out --vtk-every, "
-                             "or --engine yade")
+        raise GrainfracError(VTK_REFUSED)
