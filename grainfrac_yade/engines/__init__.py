@@ -1,9 +1,11 @@
 """Mechanical engines: what computes a scene's motion and bond forces (pure; the engines load lazily).
 
-One engine today, selected by ``numerics.engine``:
+Two engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep``, ``brazilian``):
 
 * ``"yade"`` (the default): YADE's explicit DEM with dynamic relaxation
-  (:mod:`grainfrac_yade.yade_adapter.engine`, which alone imports YADE).
+  (:mod:`grainfrac_yade.yade_adapter.engine`, which alone imports YADE);
+* ``"static"``: static equilibrium between bond failures, bonds broken one at a time
+  (:mod:`grainfrac_yade.static.engine`, pure numpy and scipy; the UCS so far).
 
 Every engine module offers ``NAME``, ``build_scene(specimen, params, layout=None)`` and
 ``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements
