@@ -44,6 +44,9 @@ from .solver import Equilibrium, State
 #: Fields of the core's converged state that a save keeps (arrays over bonds in canonical order, or scalars).
 STATE_FIELDS = ("closure", "u", "broken", "status", "sign", "s_p", "fn", "fs", "stress", "break_mode", "held",
                 "iterations")
+#: Grain models whose bonds act on their face's plane (fem cells: a node sphere on each side of the face), whose
+#: reference gap is the spheres' distance along the face normal and whose plane normal a state carries.
+BONDS_ON_FACES = ("fem",)
 #: Name the static engine's parts carry in :meth:`StaticScene.engine_names`.
 EQUILIBRIUM_NAME = "StaticEquilibrium"
 
@@ -360,9 +363,21 @@ class StaticScene:
         z = np.zeros((len(n), 1))
         return np.hstack([n, z]), np.hstack([-n[:, 1:2], n[:, 0:1], z])
 
+    def _reference_gap(self, normal) -> np.ndarray:
+        """Each bond's stress-free normal gap as the layout made it [m]: the spheres' overlap r_a + r_b - |c_b - c_a|
+        for bonds between spheres, and their distance along the face normal for bonds on their face's plane
+        (:data:`BONDS_ON_FACES`), as a dynamic engine measures it."""
+        lay = self.layout
+        a, b = lay.bond_spheres[:, 0], lay.bond_spheres[:, 1]
+        d = lay.sphere_center[b] - lay.sphere_center[a]
+        if lay.model in BONDS_ON_FACES:
+            return np.abs((d * normal).sum(1))
+        return lay.sphere_radius[a] + lay.sphere_radius[b] - np.linalg.norm(d, axis=1)
+
     def export_state(self, platens=None) -> SceneState:
         """The scene's state, engine-neutral; static extras: ``bond_slip`` holds each contact's shear reference s_p
-        [m], the platens' dict the closure [m] (what :func:`scene_from_state` re-solves from)."""
+        [m], the platens' dict the closure [m] (what :func:`scene_from_state` re-solves from).  Node velocities are
+        zero (a relaxed state)."""
         net, st, inv = self.net, self.state, self.canon
         nodes = len(net.node_pos)
         disp = np.zeros((nodes, 3))
@@ -383,8 +398,8 @@ class StaticScene:
             bond_normal_stiffness=net.kn[inv].copy(), bond_shear_stiffness=net.ks[inv].copy(),
             bond_tan_friction=np.where(intact, net.tan_friction[inv], net.tan_residual[inv]),
             bond_normal_force=fn[:, None] * normal, bond_shear_force=fs[:, None] * tangent,
-            bond_reference_gap=np.zeros(self.n_bonds), bond_slip=st.s_p[inv].copy(),
-            bond_plane_normal=np.zeros((self.n_bonds, 3)),
+            bond_reference_gap=self._reference_gap(normal), bond_slip=st.s_p[inv].copy(),
+            bond_plane_normal=normal if self.layout.model in BONDS_ON_FACES else np.zeros((self.n_bonds, 3)),
             platens=None if platens is None else platens.state_dict())
 
     def apply_state(self, state: SceneState) -> None:
