@@ -171,8 +171,8 @@ class StaticScene:
         pl = self._platens()
         speed = pl.velocity if pl is not None else 0.0
         for _ in range(int(n_steps)):
-            self._time += self._dt
             self.move_to(self.state.closure + speed * self._dt)
+            self._time += self._dt     # only once the increment is solved (a NumericalFailure leaves the last one)
 
     def move_to(self, closure: float) -> None:
         """Follow the path to ``closure`` [m] (breaks at their crossings, cascades); the bookkeeping synced.  A
