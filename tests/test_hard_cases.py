@@ -78,7 +78,7 @@ def no_negative_strength(scene, corr=None):
 def captured(monkeypatch):
     """The scene (and corrosion engine) of the next UCS or creep run made through the run-folder functions."""
     from grainfrac_yade.protocols import ucs as ucs_test
-    from grainfrac_yade.yade_adapter import engine   # what the commands call (engines.engine_for)
+    from grainfrac_yade.protocols import creep as creep_test
     got = {}
 
     def keep(module, name, pick):
@@ -89,7 +89,7 @@ def captured(monkeypatch):
             got["scene"], got["corr"] = pick(result)
             return result
         monkeypatch.setattr(module, name, wrapper)
-    keep(engine, "run_creep", lambda run: (run.scene, run.corr))
+    keep(creep_test, "run_creep", lambda run: (run.scene, run.corr))
     keep(ucs_test, "run_ucs", lambda result: (result[2], None))
     return got
 
@@ -126,7 +126,7 @@ def outcome_in_analysis(folder) -> list:
 def step_ten_times_critical(monkeypatch):
     """Scenes built for UCS and creep runs step at 10 x their critical DEM step (timestep_safety <= 1
     cannot ask for it: the step is set after the scene is built)."""
-    from grainfrac_yade.yade_adapter import creep_protocol, engine
+    from grainfrac_yade.yade_adapter import engine
 
     def stepping_up(build):
         def build_then_step_up(*args, **kwargs):
@@ -134,8 +134,7 @@ def step_ten_times_critical(monkeypatch):
             scene.O.dt = 10 * scene.dt_critical
             return scene
         return build_then_step_up
-    for module in (creep_protocol, engine):   # the creep runner's own build, the engine's for the UCS test
-        monkeypatch.setattr(module, "build_scene", stepping_up(module.build_scene))
+    monkeypatch.setattr(engine, "build_scene", stepping_up(engine.build_scene))   # what every test protocol builds with
 
 
 @needs_yade

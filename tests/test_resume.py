@@ -475,6 +475,6 @@ def test_a_brazilian_test_killed_mid_loading_resumes_to_the_uninterrupted_result
 
 
 def test_only_finite_element_cells_are_flagged_as_resuming_inexactly():
-    from grainfrac_yade.yade_adapter.checkpoint import inexact_note
+    from grainfrac_yade.protocols.checkpoints import inexact_note
     assert inexact_note(load_parameters()) == ""
     assert "memory address" in inexact_note(load_parameters(overrides=["resolution.grain_model=fem"]))

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..engines.registry import engine_for, require_dynamic
 from ..errors import GrainfracError
+from ..protocols import creep as creep_test
 from ..protocols.cracks import bond_segments, broken_counts, crack_table
 
 
@@ -389,14 +390,13 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         vtk_fractions = (state.get("run_values") or {}).get("vtk_fractions")
         if vtk_fractions:
             run_values["vtk_fractions"] = vtk_fractions   # kept in the checkpoints written from here on
-        run = engine_for(params).resume_creep(specimen, params, stress, out, progress=progress, **outputs)
+        run = creep_test.resume_creep(specimen, params, stress, out, progress=progress, **outputs)
         t0 -= state.get("wall_s", 0.0)   # wall time of the run up to its checkpoint
         c0 -= state.get("cpu_s", 0.0)    # CPU time of this process up to it (checkpoints older than the key: 0)
     else:
         if vtk_times is not None or vtk_every:
             outputs.update(vtk_folder=out / "vtk", vtk_times=vtk_times or (), vtk_every=vtk_every or 0)
-        run = engine_for(params).run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out,
-                                           **outputs)
+        run = creep_test.run_creep(specimen, params, stress, progress=progress, checkpoint_folder=out, **outputs)
     numerical = bool(run.numerical_failure)
     no_test = numerical or run.failed_before_test   # no creep result: neither a lifetime nor a survival
     if ucs_source is None:   # a resumed run, or a caller that did not say: the calibrated value or one given
