@@ -145,8 +145,8 @@ def fake_scene(specimen, layout):
 
 
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):
-    from grainfrac_yade.commands.creep import run_creep_to_folder
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     from grainfrac_yade.protocols import ucs as ucs_test
     from grainfrac_yade.protocols import creep as creep_test
     params, specimen, lay = fem

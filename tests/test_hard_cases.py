@@ -95,7 +95,7 @@ def captured(monkeypatch):
 
 
 def ucs_folder(params, out, captured, nullable=("crack_initiation_pa",)) -> dict:
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     run_ucs_to_folder(params, 1, out)
     s = clean_folder(out, nullable)
     no_negative_strength(captured["scene"])
@@ -109,7 +109,7 @@ NO_HOLD = ("wave_crossing_steps", "servo_response_steps_used", "max_relaxation_s
 
 
 def creep_folder(params, out, stress, ucs, captured, nullable=NO_LIFETIME) -> dict:
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     run_creep_to_folder(params, 1, out, stress, stress / ucs, ucs)
     s = clean_folder(out, nullable)
     no_negative_strength(captured["scene"], captured["corr"])
@@ -158,7 +158,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
     """Before: 'UCS 0 MPa', E and Poisson NaN, every bond broken.  Now: no result, and analyze-ucs lists
     the run apart (1 s)."""
     from grainfrac_yade.commands.analyze_ucs import cmd_analyze_ucs
-    from grainfrac_yade.commands.ucs import MEASURES
+    from grainfrac_yade.protocols.ucs_output import MEASURES
     s = ucs_folder(load_parameters(overrides=TINY), tmp_path / "run", captured, MEASURES)
     assert s["numerical_failure"] is True and s["ucs_pa"] is None and s["steps"] == 0
     assert s["end_reason"].startswith("numerical failure: DEM step ")

@@ -253,7 +253,7 @@ def _no_nan(path):
 
 
 def _creep_folder(tmp_path, monkeypatch, tiny, run):
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     from grainfrac_yade.protocols import creep as creep_test
     monkeypatch.setattr(creep_test, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     out = tmp_path / "run"
@@ -507,7 +507,7 @@ def test_yade_nan_ends_the_run_as_a_numerical_failure(tmp_path, monkeypatch, pha
     """A NaN velocity spreads through the scene: during the ramp (it used to end 'failed on loading' once
     the platen strain passed the cap) or at the first relaxation of the creep phase (it used to end
     'no equilibrium', i.e. a lifetime)."""
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     _inject_nan(monkeypatch, method, after)
     params = load_parameters(overrides=TINY)
     s = run_creep_to_folder(params, 1, tmp_path / "run", 0.7 * 300e6, 0.7, 300e6)
