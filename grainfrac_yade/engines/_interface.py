@@ -137,7 +137,8 @@ class PlatenDrive(Protocol):
 class Scene(Protocol):
     """A built scene of one engine: what the test protocols read and drive.
 
-    Attributes every scene has: ``specimen``, ``layout``, ``params``, ``n_bonds``, and the per-bond
+    Attributes every scene has: ``specimen``, ``layout``, ``params``, ``props`` (the bonds' intact properties,
+    :func:`grainfrac_yade.layout.bond_properties`), ``n_bonds``, and the per-bond
     bookkeeping ``broken`` (bool), ``break_mode`` (law's mode codes) and ``break_step`` (the
     :attr:`steps` count at the break, -1 if intact).
     """
@@ -209,6 +210,13 @@ class Scene(Protocol):
     # ------------------------------------------------------------------ cells, platens, confinement
     def cell_positions(self, cells=None) -> np.ndarray:
         """(n, 3) current positions of cells [m]."""
+
+    def cell_motion(self) -> tuple:
+        """((n, 2+) positions [m], (n,) rotations about z [rad]): each cell's rigid motion (a deformable cell's
+        least-squares fit), what a picture of the moved cells draws (:mod:`grainfrac_yade.protocols.snapshots`)."""
+
+    def bond_shift(self, positions) -> np.ndarray:
+        """(b, 2) displacement [m] drawn for each bond (``positions``: those of :meth:`cell_motion`)."""
 
     def attach_platens(self, lateral: str) -> PlatenDrive:
         """Rigid platens on the end cells (``lateral``: "free" smooth or "fixed" rough), listed among the

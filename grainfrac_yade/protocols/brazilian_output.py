@@ -10,13 +10,13 @@ import numpy as np
 
 from ..analysis.brazilian_analysis import (CENTRAL_BAND_HALF_WIDTH, brazilian_summary, central_band_area_fraction,
                                            crack_location, hondros_centre_factor, in_central_band)
-from ..engines.registry import engine_for
 from ..geometry.specimen import build_disc_specimen
 from ..params import require_plane
 from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
 from . import brazilian as brazilian_test
 from .cracks import bond_segments, crack_table
 from .levers import Levers, new_breaks
+from .snapshots import DIAMETRAL_STRAIN, StrainSeries
 
 
 #: summary.json keys measured from the load curve: null when a numerical failure ended the run.
@@ -50,8 +50,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
     else:
         out = prepare_run_dir(out, "brazilian", params, seed, overwrite=overwrite)
         levers = levers or Levers()
-        engine = engine_for(params)
-        snapshot = engine.StrainSeries(out / "vtk", vtk_every, engine.DIAMETRAL_STRAIN) if vtk_every else None
+        snapshot = StrainSeries(out / "vtk", vtk_every, DIAMETRAL_STRAIN) if vtk_every else None
         history, result, scene, (broken_peak, mode_peak) = brazilian_test.run_brazilian(
             specimen, params, progress=progress, levers=levers, checkpoint_folder=out,
             run_values={"seed": seed, "levers": levers.to_dict()}, snapshot=snapshot)

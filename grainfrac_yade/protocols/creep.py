@@ -60,6 +60,7 @@ from .confinement import broken_apart_reason
 from .cracks import bond_is_inter, broken_counts
 from .creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
 from .loading import check_value, held_at_equilibrium
+from .snapshots import Series, write_creep_snapshot
 
 #: History rows between writes of the partial history (an interrupted run keeps what it measured).
 HISTORY_FLUSH_ROWS = 50
@@ -334,7 +335,7 @@ class CreepRun:
         """Snapshot of the current state, unless the last one was taken at this same history row
         (only reads the scene)."""
         if self.corr is not None and self._vtk_rows != len(self.rows):
-            self.engine.write_creep_snapshot(self.engine.Series(self.vtk_folder, times=self.vtk_written), self, creep_time)
+            write_creep_snapshot(Series(self.vtk_folder, times=self.vtk_written), self, creep_time)
             self.vtk_written.append(creep_time)
             self._vtk_rows = len(self.rows)
 

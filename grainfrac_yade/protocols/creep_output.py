@@ -13,7 +13,7 @@ import numpy as np
 
 from ..analysis.creep_analysis import CreepStages, damage_index, resolve_creep_stages
 from ..analysis.runparams import load_run_parameters
-from ..engines.registry import engine_for, require_dynamic
+from ..engines.registry import require_dynamic
 from ..errors import GrainfracError
 from ..geometry.specimen import build_specimen
 from ..params import load_parameters, require_plane
@@ -23,6 +23,7 @@ from ..runs.runio import (CHECKPOINT, SUMMARY, check_files, checkpoint_folder, c
 from ..wave import budget_fields
 from . import creep as creep_test
 from .cracks import bond_segments, broken_counts, crack_table
+from .snapshots import write_life_series
 
 
 #: Where a ratio's reference strength can come from (summary.json ``ucs_source``).
@@ -184,7 +185,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         run_strain_time_figure(hist, summary, out / "strain_time.png")
     t_ref = lifetime if lifetime else t_end
     if vtk_fractions:
-        engine_for(params).write_life_series(run, out / "vtk", [f * t_ref for f in vtk_fractions], vtk_fractions)
+        write_life_series(run, out / "vtk", [f * t_ref for f in vtk_fractions], vtk_fractions)
         summary["vtk_life_fractions"] = [float(f) for f in vtk_fractions]
     for frac in MAP_FRACTIONS:
         t = frac * t_ref

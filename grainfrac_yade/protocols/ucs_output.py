@@ -8,12 +8,12 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.ucs_analysis import ucs_summary
-from ..engines.registry import engine_for
 from ..geometry.specimen import build_specimen
 from ..params import require_plane
 from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
 from . import ucs as ucs_test
 from .cracks import bond_segments, crack_table
+from .snapshots import AXIAL_STRAIN, StrainSeries
 
 
 #: summary.json keys measured from the stress-strain curve: null when a numerical failure ended the run.
@@ -34,11 +34,10 @@ def run_ucs_to_folder(params, seed, out, overwrite=False, progress=None, resume=
     out = Path(out) if resume else prepare_run_dir(out, "ucs", params, seed, overwrite=overwrite)
     specimen = build_specimen(params, seed)
     outputs = {"checkpoint_folder": out, "run_values": {"seed": seed}}
-    engine = engine_for(params)
     if resume:
         history, result, scene, (broken_peak, mode_peak) = ucs_test.resume_ucs(specimen, params, out, progress=progress)
     else:
-        snapshot = engine.StrainSeries(out / "vtk", vtk_every, engine.AXIAL_STRAIN) if vtk_every else None
+        snapshot = StrainSeries(out / "vtk", vtk_every, AXIAL_STRAIN) if vtk_every else None
         history, result, scene, (broken_peak, mode_peak) = ucs_test.run_ucs(specimen, params, progress=progress,
                                                                             snapshot=snapshot, **outputs)
     # a numerical failure has no result: the curve before it is kept in history.csv, measured nothing

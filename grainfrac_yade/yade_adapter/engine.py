@@ -8,8 +8,7 @@ module does not import YADE: :func:`.load_yade` does, when the first scene is bu
 The isotropic stage of a confined test (``consolidate``: a stress servo and dynamic relaxation), the
 Brazilian levers applied to a scene (``apply_levers``), the stress-corrosion bond writer of a creep test
 (``stress_corrosion(scene, sc_params, saved=None)``: reads the bond forces, writes what the degradation law
-says they can carry; the law's state is :class:`grainfrac_yade.protocols.corrosion.BondCorrosion`), the VTK
-series, yade-batch rows and the timings of ``bench`` are this engine's, listed here so that the test
+says they can carry; the law's state is :class:`grainfrac_yade.protocols.corrosion.BondCorrosion`), yade-batch rows and the timings of ``bench`` are this engine's, listed here so that the test
 protocols (:mod:`grainfrac_yade.protocols`) and the commands reach them through the engine registry and
 never import this package.
 """
@@ -22,7 +21,6 @@ from .confinement import consolidate  # noqa: F401
 from .corrosion_engine import stress_corrosion  # noqa: F401
 from .levers import Levers, apply_levers, new_breaks  # noqa: F401
 from .scene import GrainScene, build_scene, scene_from_state  # noqa: F401
-from .vtk_output import AXIAL_STRAIN, DIAMETRAL_STRAIN, Series, StrainSeries, write_creep_snapshot, write_life_series  # noqa: F401
 
 #: The value of ``numerics.engine`` that selects this engine.
 NAME = "yade"

@@ -121,6 +121,17 @@ class GrainScene:
         """(n_bonds, 2) mineral indices of the two cells."""
         return self.specimen.face_minerals[self.layout.bond_face]
 
+    def cell_motion(self) -> tuple:
+        """(n, 2+) positions [m] of the cell centroids and (n,) rotation angles about z [rad]: the cell bodies'
+        (rigid cells), or the least-squares rigid motion of each cell's spheres weighted by their lumped areas
+        (fem cells)."""
+        return self.cells.cell_motion(self)
+
+    def bond_shift(self, positions) -> np.ndarray:
+        """(b, 2) displacement [m] drawn for each bond: the mean of its two cells' (rigid) or two spheres' (fem)
+        displacements; ``positions``: the cell positions of :meth:`cell_motion`."""
+        return self.cells.bond_shift(self, positions)
+
     def bodies_of(self, cells) -> np.ndarray:
         """All body ids of ``cells``, cell by cell in the given order (one per rigid cell)."""
         return self.cells.bodies_of(self, np.atleast_1d(np.asarray(cells, dtype=np.int64)))
