@@ -9,7 +9,8 @@ import sys
 from pathlib import Path
 
 
-from grainfrac_yade.commands.brazilian import run_brazilian_to_folder, tensile_scale_overrides
+from grainfrac_yade.commands.brazilian import tensile_scale_overrides
+from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json
 from grainfrac_yade.geometry.specimen import build_specimen

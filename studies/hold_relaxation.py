@@ -50,9 +50,9 @@ def main(argv=None) -> int:
     params = load_parameters(extra_files=a.params, overrides=[*a.overrides, "stress_corrosion.enabled=false"])
     from grainfrac_yade.runs.runio import code_version
     from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.yade_adapter.creep_protocol import CreepRun
+    from grainfrac_yade.protocols.creep import CreepRun
     from grainfrac_yade.wave import scene_density
-    from grainfrac_yade.yade_adapter.scene import mean_bond_force
+    from grainfrac_yade.protocols.loading import mean_bond_force
     import numpy as np
     out.mkdir(parents=True)
     c0 = time.process_time()

@@ -103,8 +103,8 @@ def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, 
     (``disc_diameter`` [m]) into ``prefix``_brazilian with ``overrides``: their two rows of
     :data:`LEVER_FIELDS` (without the setting's name; the UCS row also has ``crack_initiation_volumetric_pa``, the Brazilian
     row ``broken_total``)."""
-    from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     rows, prefix = [], Path(prefix)
     w, h = ucs_size
     p = load_parameters(extra_files=extra_files, overrides=[f"specimen.width={w}", f"specimen.height={h}", *overrides])

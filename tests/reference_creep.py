@@ -47,7 +47,7 @@ def run(name, out, extra=WITHOUT_COLLAPSE):
     import pandas as pd
 
     sys.path.insert(0, str(ROOT))
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     from grainfrac_yade.params import load_parameters
     seed, width, height, ratio, _ = RUNS[name]
     p = load_parameters(overrides=[("specimen.width", width), ("specimen.height", height),

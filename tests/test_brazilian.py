@@ -176,7 +176,7 @@ def test_a_disc_with_weak_contacts_is_split_past_the_start_transient(tmp_path):
     """Fem disc of 6 mm, seed 1, weak contact tails: by default it stops in the start transient (a bond
     broke, the load rang down below half its first peak, 1.6 MPa); with ``brazilian.stop_min_strain`` 2e-4
     it goes on to its split, past that strain and several times stronger."""
-    from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
+    from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
     fem = [str(ROOT / "params" / "presets" / "fem.toml")]
     out = {}
     for name, extra in (("default", []), ("waits", ["brazilian.stop_min_strain=2e-4"])):

@@ -200,7 +200,7 @@ def test_a_tiny_specimen_ends_by_collapse_early_with_the_lifetime_of_the_criteri
     ``max_relaxation_steps``; with the criterion off the same run waits for the backstop.  Everything
     before the final relaxation is the same, so the lifetime is the same to the last bit."""
     from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.yade_adapter.creep_protocol import run_creep
+    from grainfrac_yade.protocols.creep import run_creep
     base = ["specimen.width=3e-3", "specimen.height=6e-3", "stress_corrosion.creep_time_limit=1e13",
             "numerics.checkpoint_interval=0"]
     runs = {}

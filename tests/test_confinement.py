@@ -103,7 +103,7 @@ def test_a_negative_confinement_is_one_line(capsys):
 @needs_yade
 @pytest.mark.yade
 def test_confinement_forces_consolidation_and_a_higher_peak(tmp_path):
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.yade_adapter.confinement import Confinement
     from grainfrac_yade.yade_adapter.scene import build_scene

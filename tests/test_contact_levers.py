@@ -272,13 +272,13 @@ def test_levers_reach_yades_bonds(fem):
 
 
 def _ucs(tmp_path, name, *overrides, size=TINY):
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     p = load_parameters(overrides=[*size, *overrides])
     return run_ucs_to_folder(p, 1, tmp_path / name, overwrite=True)
 
 
 def _sigma_t(tmp_path, name, diameter, *overrides):
-    from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
+    from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
     p = load_parameters(overrides=[f"brazilian.diameter={diameter}", *overrides])
     return run_brazilian_to_folder(p, 1, tmp_path / name, overwrite=True)["tensile_strength_pa"]
 
@@ -338,7 +338,7 @@ def test_weibull_scatter_lowers_brazilian_strength(tmp_path):
 @pytest.mark.slow
 def test_brazilian_runs_with_fem_cells(tmp_path):
     """A tiny disc of fem cells (5 mm, 25 cells) loads to a split, as rigid cells do."""
-    from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
+    from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
     p = load_parameters(extra_files=[FEM_PRESET], overrides=["brazilian.diameter=5e-3"])
     s = run_brazilian_to_folder(p, 1, tmp_path / "fem", overwrite=True)
     assert s["split_found"] and s["tensile_strength_pa"] > 0

@@ -27,7 +27,7 @@ def small_ucs():
 
 
 def _creep(ratio, ucs, extra=()):
-    from grainfrac_yade.yade_adapter.creep_protocol import run_creep
+    from grainfrac_yade.protocols.creep import run_creep
     p = load_parameters(overrides=SMALL + list(extra))
     return run_creep(build_specimen(p, 1), p, ratio * ucs)
 
@@ -98,7 +98,7 @@ def test_small_specimen_creep_curve_has_three_stages():
     creep in steps (16 events here), so this checks the stage detector on a real staircase; the
     paper-size specimen gives smooth three-stage curves (README)."""
     from grainfrac_yade.analysis.creep_analysis import STAGE_RATE_FACTOR, STAGE_WINDOW, creep_stages, local_rates
-    from grainfrac_yade.yade_adapter.creep_protocol import run_creep
+    from grainfrac_yade.protocols.creep import run_creep
     p = load_parameters(overrides=["specimen.width=10e-3", "specimen.height=20e-3",
                                    "stress_corrosion.creep_time_limit=1e30"])
     run = run_creep(build_specimen(p, 1), p, 0.6 * 258e6)

@@ -28,7 +28,7 @@ def test_unbalanced_engine_period_must_be_a_positive_whole_number():
 
 def _run(extra):
     from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.yade_adapter.creep_protocol import run_creep
+    from grainfrac_yade.protocols.creep import run_creep
     p = load_parameters(overrides=TINY + extra)
     return run_creep(build_specimen(p, 1), p, LOAD)
 

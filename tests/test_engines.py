@@ -100,7 +100,7 @@ def test_the_paper_clock_needs_a_dynamic_engine(monkeypatch, tmp_path):
     folder is made; YADE's is dynamic."""
     import sys
     from types import SimpleNamespace
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     from grainfrac_yade.engines import registry
     import dataclasses
     assert registry.require_dynamic(load_parameters(), "the paper clock").NAME == "yade"

@@ -145,10 +145,10 @@ def fake_scene(specimen, layout):
 
 
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):
-    from grainfrac_yade.commands.creep import run_creep_to_folder
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     from grainfrac_yade.protocols import ucs as ucs_test
-    from grainfrac_yade.yade_adapter import engine
+    from grainfrac_yade.protocols import creep as creep_test
     params, specimen, lay = fem
     scene = fake_scene(specimen, lay)
     strain = np.linspace(0.0, 5e-3, 26)
@@ -167,7 +167,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
                           failed_before_test=False,
                           numerical_failure=False, n_events=2, scene=scene, vtk_written=[], initial_bond_stresses=None,
                           break_time=np.full(lay.n_bonds, np.nan), macro_time=np.full(lay.n_bonds, np.nan), vtk_folder=None, vtk_times=[], vtk_merged=[])
-    monkeypatch.setattr(engine, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
+    monkeypatch.setattr(creep_test, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     run_ucs_to_folder(params, SEED, tmp_path / "ucs")
     run_creep_to_folder(params, SEED, tmp_path / "creep", 200e6, 0.7, 285e6)
     for name in ("ucs", "creep"):

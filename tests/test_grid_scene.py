@@ -28,7 +28,6 @@ def grid_specimen(params, nx, ny, mineral="quartz"):
 
 
 def test_vtk_cell_motion_follows_a_rotated_cell(params):
-    from grainfrac_yade.yade_adapter.vtk_output import cell_motion
     from grainfrac_yade.yade_adapter.scene import build_scene
     fem = load_parameters(overrides=["resolution.grain_model=fem"])
     s = grid_specimen(fem, 2, 1)
@@ -41,7 +40,7 @@ def test_vtk_cell_motion_follows_a_rotated_cell(params):
     for m in members:
         p = (lay.sphere_center[m, :2] - c) @ rot.T + c + shift
         sc.O.bodies[int(sc.sphere_body[m])].state.pos = (p[0], p[1], lay.sphere_center[m, 2])
-    pos, ang = cell_motion(sc)
+    pos, ang = sc.cell_motion()
     np.testing.assert_allclose(ang, [0.0, angle], atol=1e-12)
     np.testing.assert_allclose(pos[:, :2], sc.specimen.tessellation.cell_centroid + [[0, 0], shift], atol=1e-15)
 

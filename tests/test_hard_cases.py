@@ -78,7 +78,7 @@ def no_negative_strength(scene, corr=None):
 def captured(monkeypatch):
     """The scene (and corrosion engine) of the next UCS or creep run made through the run-folder functions."""
     from grainfrac_yade.protocols import ucs as ucs_test
-    from grainfrac_yade.yade_adapter import engine   # what the commands call (engines.engine_for)
+    from grainfrac_yade.protocols import creep as creep_test
     got = {}
 
     def keep(module, name, pick):
@@ -89,13 +89,13 @@ def captured(monkeypatch):
             got["scene"], got["corr"] = pick(result)
             return result
         monkeypatch.setattr(module, name, wrapper)
-    keep(engine, "run_creep", lambda run: (run.scene, run.corr))
+    keep(creep_test, "run_creep", lambda run: (run.scene, run.corr))
     keep(ucs_test, "run_ucs", lambda result: (result[2], None))
     return got
 
 
 def ucs_folder(params, out, captured, nullable=("crack_initiation_pa",)) -> dict:
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     run_ucs_to_folder(params, 1, out)
     s = clean_folder(out, nullable)
     no_negative_strength(captured["scene"])
@@ -109,7 +109,7 @@ NO_HOLD = ("wave_crossing_steps", "servo_response_steps_used", "max_relaxation_s
 
 
 def creep_folder(params, out, stress, ucs, captured, nullable=NO_LIFETIME) -> dict:
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     run_creep_to_folder(params, 1, out, stress, stress / ucs, ucs)
     s = clean_folder(out, nullable)
     no_negative_strength(captured["scene"], captured["corr"])
@@ -126,7 +126,7 @@ def outcome_in_analysis(folder) -> list:
 def step_ten_times_critical(monkeypatch):
     """Scenes built for UCS and creep runs step at 10 x their critical DEM step (timestep_safety <= 1
     cannot ask for it: the step is set after the scene is built)."""
-    from grainfrac_yade.yade_adapter import creep_protocol, engine
+    from grainfrac_yade.yade_adapter import engine
 
     def stepping_up(build):
         def build_then_step_up(*args, **kwargs):
@@ -134,8 +134,7 @@ def step_ten_times_critical(monkeypatch):
             scene.O.dt = 10 * scene.dt_critical
             return scene
         return build_then_step_up
-    for module in (creep_protocol, engine):   # the creep runner's own build, the engine's for the UCS test
-        monkeypatch.setattr(module, "build_scene", stepping_up(module.build_scene))
+    monkeypatch.setattr(engine, "build_scene", stepping_up(engine.build_scene))   # what every test protocol builds with
 
 
 @needs_yade
@@ -159,7 +158,7 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
     """Before: 'UCS 0 MPa', E and Poisson NaN, every bond broken.  Now: no result, and analyze-ucs lists
     the run apart (1 s)."""
     from grainfrac_yade.commands.analyze_ucs import cmd_analyze_ucs
-    from grainfrac_yade.commands.ucs import MEASURES
+    from grainfrac_yade.protocols.ucs_output import MEASURES
     s = ucs_folder(load_parameters(overrides=TINY), tmp_path / "run", captured, MEASURES)
     assert s["numerical_failure"] is True and s["ucs_pa"] is None and s["steps"] == 0
     assert s["end_reason"].startswith("numerical failure: DEM step ")

@@ -86,7 +86,7 @@ def test_a_checkpoint_keeps_the_erasure_count():
     """The synced count is scene state: a resumed run reports what the uninterrupted one would."""
     import time
     from types import SimpleNamespace
-    from grainfrac_yade.yade_adapter.checkpoint import base_state
+    from grainfrac_yade.protocols.checkpoints import base_state
     sc, *_ = _sheared_bond(keep=False)
     sc.erased_by_sliding = 3
     run = SimpleNamespace(scene=sc, t0=time.time(), c0=time.process_time())

@@ -81,7 +81,7 @@ def test_cli_stresses_are_mpa_and_batch_stresses_pa():
 def test_a_specimen_broken_apart_in_the_isotropic_stage_is_a_failure_not_a_ucs_of_zero(tmp_path):
     """1e6 times the intended 20 MPa (a unit slip, Pa given for MPa; the CLI refuses it, the adapter is called
     directly): every bond breaks in the isotropic stage; the run must say so and measure nothing."""
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     params = load_parameters(overrides=TINY + [("confinement.stress", 20e12)])
     s = run_ucs_to_folder(params, 1, tmp_path / "run")
     assert s["failed_before_test"] is True and s["ucs_pa"] is None
@@ -354,7 +354,7 @@ def test_truncated_and_garbage_checkpoints_are_one_line(tmp_path):
 
 # ------------------------------------------------------------------ ratios keep their meaning; crack phases
 def test_the_calibrated_reference_lists_what_differs_from_its_calibration():
-    from grainfrac_yade.commands.creep import UCS_FROM_CALIBRATION, reference_differences, ucs_reference
+    from grainfrac_yade.protocols.creep_output import UCS_FROM_CALIBRATION, reference_differences, ucs_reference
     assert reference_differences(load_parameters()) == []
     edited = load_parameters(overrides=["contacts.quartz/quartz.tensile_strength=1e6", "specimen.width=3e-3",
                                         "stress_corrosion.beta1=2e-3"])   # beta1 changes no UCS: not listed

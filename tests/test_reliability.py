@@ -253,9 +253,9 @@ def _no_nan(path):
 
 
 def _creep_folder(tmp_path, monkeypatch, tiny, run):
-    from grainfrac_yade.commands.creep import run_creep_to_folder
-    from grainfrac_yade.yade_adapter import engine
-    monkeypatch.setattr(engine, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
+    from grainfrac_yade.protocols import creep as creep_test
+    monkeypatch.setattr(creep_test, "run_creep", lambda specimen, params, stress, progress=None, **outputs: run)
     out = tmp_path / "run"
     run_creep_to_folder(tiny[0], 1, out, 200e6, 0.7, 285e6)
     return out
@@ -481,12 +481,12 @@ def test_the_specimen_command_still_builds_3d(tmp_path):
 # ------------------------------------------------------------------ in YADE: a real NaN
 def _inject_nan(monkeypatch, method, after):
     """Before or ``after`` CreepRun.<method>, give one free body a NaN velocity: the DEM steps spread it."""
-    from grainfrac_yade.yade_adapter import creep_protocol
+    from grainfrac_yade.protocols import creep as creep_protocol
     original = getattr(creep_protocol.CreepRun, method)
 
     def poison(run):
         from yade import Vector3
-        run.scene.O.bodies[run._free_ids[0]].state.vel = Vector3(math.nan, math.nan, 0.0)
+        run.scene.O.bodies[run.scene.free_bodies()[0]].state.vel = Vector3(math.nan, math.nan, 0.0)
 
     def poisoned(self, *args, **kwargs):
         if not after:
@@ -507,7 +507,7 @@ def test_yade_nan_ends_the_run_as_a_numerical_failure(tmp_path, monkeypatch, pha
     """A NaN velocity spreads through the scene: during the ramp (it used to end 'failed on loading' once
     the platen strain passed the cap) or at the first relaxation of the creep phase (it used to end
     'no equilibrium', i.e. a lifetime)."""
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     _inject_nan(monkeypatch, method, after)
     params = load_parameters(overrides=TINY)
     s = run_creep_to_folder(params, 1, tmp_path / "run", 0.7 * 300e6, 0.7, 300e6)
@@ -577,12 +577,12 @@ class _RampPlatens:
 
 
 def _ramp(stresses, target):
-    from grainfrac_yade.yade_adapter.creep_protocol import CreepRun
+    from grainfrac_yade.protocols.creep import CreepRun
     run = CreepRun.__new__(CreepRun)
     platens = _RampPlatens(stresses)
     run.platens, run.target = platens, target
     run.params = SimpleNamespace(creep=SimpleNamespace(ramp_strain_rate=0.5, failure_strain=0.02))
-    run.scene = SimpleNamespace(O=SimpleNamespace(dt=1e-7, iter=0), broken=np.zeros(3, dtype=bool),
+    run.scene = SimpleNamespace(dt=1e-7, steps=0, broken=np.zeros(3, dtype=bool),
                                 run=lambda n: setattr(platens, "checks", platens.checks + 1))
     run.break_time = np.full(3, np.nan)
     run.failed, run.failed_on_loading, run.failure_reason = False, False, ""

@@ -84,7 +84,7 @@ def _start_and_kill(spec, out, ready, timeout=120, extra=(), every_safe_point=Tr
 
 def _reference(spec, out):
     """The uninterrupted run (this process, one thread; the shipped checkpoint interval)."""
-    from grainfrac_yade.commands.creep import run_creep_to_folder
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     p = load_parameters(overrides=[("specimen.width", spec["width"]), ("specimen.height", spec["height"]),
                                    "stress_corrosion.creep_time_limit=1e30"])
     s = run_creep_to_folder(p, spec["seed"], out, spec["ratio"] * spec["ucs"], spec["ratio"], spec["ucs"])
@@ -363,7 +363,7 @@ def _assert_same_loading_test(a, b):
 
 
 def _ucs_reference(out, spec=UCS_TINY):
-    from grainfrac_yade.commands.ucs import run_ucs_to_folder
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     p = load_parameters(overrides=[("specimen.width", spec["width"]), ("specimen.height", spec["height"])])
     s = run_ucs_to_folder(p, spec["seed"], out)
     assert not (out / "checkpoint").exists() and "resumed_from" not in s
@@ -461,7 +461,7 @@ def test_a_yade_batch_rerun_resumes_an_unfinished_ucs_row(tmp_path):
 def test_a_brazilian_test_killed_mid_loading_resumes_to_the_uninterrupted_result(tmp_path):
     """6 mm disc, seed 1: 100,947 DEM steps, 41 broken bonds; about 9 s alone, 45 s with a checkpoint
     before every row."""
-    from grainfrac_yade.commands.brazilian import run_brazilian_to_folder
+    from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
     ref = tmp_path / "uninterrupted"
     run_brazilian_to_folder(load_parameters(overrides=["brazilian.diameter=6e-3"]), 1, ref)
     killed = tmp_path / "killed"
@@ -475,6 +475,6 @@ def test_a_brazilian_test_killed_mid_loading_resumes_to_the_uninterrupted_result
 
 
 def test_only_finite_element_cells_are_flagged_as_resuming_inexactly():
-    from grainfrac_yade.yade_adapter.checkpoint import inexact_note
+    from grainfrac_yade.protocols.checkpoints import inexact_note
     assert inexact_note(load_parameters()) == ""
     assert "memory address" in inexact_note(load_parameters(overrides=["resolution.grain_model=fem"]))

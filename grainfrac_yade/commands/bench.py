@@ -43,6 +43,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ..engines.registry import ENGINE_NAMES, engine, engine_for
+from ..protocols.timed_creep import TimedCreepRun
 
 #: Where the full bench writes by default.
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
@@ -194,9 +195,9 @@ def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
     engine = engine_for(params)
     stress = ratio * params.calibration.reference_ucs
     specimen = build_specimen(params, seed)
-    run = engine.TimedCreepRun(specimen, params, stress, max_events=settings.events,
-                               at_hold=lambda r: {**engine.time_stepping(r, settings.window_s, settings.repeats),
-                                                  **engine.time_bond_io(r.corr, settings.repeats)})
+    run = TimedCreepRun(specimen, params, stress, max_events=settings.events,
+                        at_hold=lambda r: {**engine.time_stepping(r, settings.window_s, settings.repeats),
+                                           **engine.time_bond_io(r.corr, settings.repeats)})
     run.run()
     if run.measured is None:
         raise GrainfracError(f"bench: the scene ({params.resolution.grain_model} cells, "
@@ -226,7 +227,7 @@ def clocks_to_failure(params_for_clock, seed, ratio, progress=None) -> dict:
         params = params_for_clock(clock)
         stress = out["stress_pa"] = ratio * params.calibration.reference_ucs
         t0, c0 = time.perf_counter(), time.process_time()
-        run = engine_for(params).TimedCreepRun(build_specimen(params, seed), params, stress)
+        run = TimedCreepRun(build_specimen(params, seed), params, stress)
         run.run()
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         first, last = run.rows[0], run.rows[-1]
@@ -311,7 +312,7 @@ def paper_creep_to_failure(extra_files, overrides, stress, progress) -> dict:
     params = scene_params(extra_files, (FEM_PRESET,), [f"specimen.width={width}", f"specimen.height={height}",
                                                       *overrides], ("stress_corrosion.clock=event",))
     t0, c0 = time.perf_counter(), time.process_time()
-    run = engine_for(params).TimedCreepRun(build_specimen(params, FEM_SEEDS[0]), params, stress)
+    run = TimedCreepRun(build_specimen(params, FEM_SEEDS[0]), params, stress)
     run.run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     last = run.rows[-1]

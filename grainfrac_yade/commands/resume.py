@@ -1,5 +1,5 @@
 """``--resume DIR`` of the loading tests (``ucs``, ``brazilian``): the option, its conflicts, and the run
-folder's parameters and checkpoint (``creep --resume`` has its own, :func:`.creep.resume_creep_folder`)."""
+folder's parameters and checkpoint (``creep --resume`` has its own, :func:`grainfrac_yade.protocols.creep_output.resume_creep_folder`)."""
 from __future__ import annotations
 
 import json

@@ -9,8 +9,9 @@ Two engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep``
 
 Every engine module offers ``NAME``, ``build_scene(specimen, params, layout=None)`` and
 ``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements
-:class:`Scene` (``_interface.py``), and the test runners and their writers' helpers that the commands
-call.  :func:`.registry.engine_for` finds the engine of a run's
+:class:`Scene` (``_interface.py``), and the hooks the test protocols (:mod:`grainfrac_yade.protocols`)
+and the commands call on it by name (``consolidate``, ``apply_levers``, ``stress_corrosion``, the VTK
+series, the timings of ``bench``; listed in the interface's docstring).  :func:`.registry.engine_for` finds the engine of a run's
 parameters; a command never imports an engine's package itself.  Adding an engine: a module
 implementing the interface, its name in :data:`.registry.ENGINE_MODULES` and among the choices of
 ``numerics.engine`` (docs/maintainers.md).  This ``__init__`` imports no engine (the registry does,

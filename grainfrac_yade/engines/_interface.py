@@ -11,6 +11,16 @@ loaded by platens.  Two kinds are meant to implement it:
 * a quasi-static engine: :meth:`Scene.run` applies load increments, each solved, and
   :meth:`Scene.equilibrate` is one solve.
 
+Engines that integrate motion in time (``DYNAMIC`` in the engine module) have an unbalanced force
+(:meth:`Scene.unbalanced`), which the paper clock (Eq. 8) needs; a creep test's hold is force control by
+the platens (:meth:`PlatenDrive.hold_stress`).  Besides the scene, an engine module offers what the
+protocols call on it by name: ``build_scene``, ``scene_from_state``, ``consolidate`` (a confined test's
+isotropic stage), ``apply_levers`` (Brazilian levers) and ``stress_corrosion(scene, sc_params, saved=None)``,
+the bond writer of a creep test: a :class:`grainfrac_yade.protocols.corrosion.BondCorrosion` (the
+degradation law's state, engine-neutral) that also reads the bond stresses (``stresses``, ``intact``)
+and writes what the law says they carry (``write``, ``degrade``, ``hand_over_failures``), listed among
+the scene's engines (``saved``: its state from a checkpoint).
+
 Counters: :attr:`Scene.steps` counts DEM steps (dynamic) or solves (static); :attr:`Scene.time` is
 the engine's own time (DEM time; a static engine's load parameter), both written to the histories
 as ``step`` and ``time_s``.  Creep time is separate from both (the clocks of :mod:`grainfrac_yade.clocks`).
@@ -111,12 +121,24 @@ class PlatenDrive(Protocol):
     def axial_stress(self) -> float:
         """Mean reaction of the two platens over the cross-section (compression positive) [Pa]."""
 
+    def hold_stress(self, target: float, young: float, response_steps: int, max_speed: float) -> object:
+        """Force control from here on: a stress servo that moves the platens so as to hold the axial stress
+        at ``target`` [Pa], removing an error in about ``response_steps`` steps on a specimen of axial modulus
+        ``young`` [Pa], at closing speeds within +-``max_speed`` [m/s].  The servo has ``target``, ``gain``
+        [m/Pa], ``max_speed``, ``stress`` (the last measured axial stress [Pa]), ``clipped`` (+1/-1: the last
+        command was clipped closing/opening, 0 not) and ``closing_clipped_steps`` (steps in a row clipped
+        closing: a collapse the platens cannot hold)."""
+
+    def resume_hold(self, saved: dict) -> object:
+        """:meth:`hold_stress` as a checkpoint saved it (``saved``: the servo's attributes by name)."""
+
 
 @runtime_checkable
 class Scene(Protocol):
     """A built scene of one engine: what the test protocols read and drive.
 
-    Attributes every scene has: ``specimen``, ``layout``, ``params``, ``n_bonds``, and the per-bond
+    Attributes every scene has: ``specimen``, ``layout``, ``params``, ``props`` (the bonds' intact properties,
+    :func:`grainfrac_yade.layout.bond_properties`), ``n_bonds``, and the per-bond
     bookkeeping ``broken`` (bool), ``break_mode`` (law's mode codes) and ``break_step`` (the
     :attr:`steps` count at the break, -1 if intact).
     """
@@ -153,6 +175,16 @@ class Scene(Protocol):
         ``balanced()`` did not hold within ``max_steps`` (dynamic relaxation, checked every
         ``check_steps``; a static engine solves once)."""
 
+    def unbalanced(self, reference: float) -> tuple:
+        """(largest resultant force on a body the platens do not drive [N], mean resultant force on those
+        bodies / ``reference``, inf if ``reference`` <= 0): how far the scene is from equilibrium after the
+        last step (0 for a static engine's solved state); ``reference`` is a mean bond force
+        (:func:`grainfrac_yade.protocols.loading.mean_bond_force`).  NumericalFailure if a force is not finite."""
+
+    def relaxation_damping(self, damping: float) -> None:
+        """The numerical damping of relaxation from here on (YADE: Cundall's non-viscous damping coefficient);
+        an engine that solves for equilibrium ignores it."""
+
     # ------------------------------------------------------------------ bonds
     def bond_forces(self, indices=None) -> tuple:
         """(normal force, tension positive; shear force magnitude) [N] of bonds ``indices`` (all: None)."""
@@ -178,6 +210,13 @@ class Scene(Protocol):
     # ------------------------------------------------------------------ cells, platens, confinement
     def cell_positions(self, cells=None) -> np.ndarray:
         """(n, 3) current positions of cells [m]."""
+
+    def cell_motion(self) -> tuple:
+        """((n, 2+) positions [m], (n,) rotations about z [rad]): each cell's rigid motion (a deformable cell's
+        least-squares fit), what a picture of the moved cells draws (:mod:`grainfrac_yade.protocols.snapshots`)."""
+
+    def bond_shift(self, positions) -> np.ndarray:
+        """(b, 2) displacement [m] drawn for each bond (``positions``: those of :meth:`cell_motion`)."""
 
     def attach_platens(self, lateral: str) -> PlatenDrive:
         """Rigid platens on the end cells (``lateral``: "free" smooth or "fixed" rough), listed among the

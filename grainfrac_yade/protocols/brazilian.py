@@ -173,7 +173,7 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None, chec
     load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
     Broken counts and the snapshot leave out slits.  ``checkpoint_folder``: the run folder,
     checkpoints go to its ``checkpoint/`` (None: none); ``run_values``: stored with them (seed, levers).
-    ``snapshot``: a :class:`.vtk_output.StrainSeries` (VTK files, timestep the diametral strain; it only
+    ``snapshot``: a :class:`.snapshots.StrainSeries` (VTK files, timestep the diametral strain; it only
     reads the scene), None: no VTK output.
     """
     run = BrazilianRun(specimen, params, progress, scene, levers, checkpoint_folder, run_values)

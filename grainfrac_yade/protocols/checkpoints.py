@@ -93,7 +93,7 @@ class LoadingCheckpoints:
             checkpoint_folder, params.numerics.checkpoint_interval, run_values or {}, progress, capture=capture)
         #: the checkpoints this run went on from (DEM step, phase, when written)
         self.resumes = []
-        #: a VTK series (the engine's ``StrainSeries``) told of each row and of the end (it only reads the scene); None: no VTK
+        #: a VTK series (:class:`.snapshots.StrainSeries`) told of each row and of the end (it only reads the scene); None: no VTK
         self.snapshot = None
 
     def safe_point(self):

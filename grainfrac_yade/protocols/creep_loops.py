@@ -1,12 +1,12 @@
 """The two creep clocks' loops over a held specimen (pure numpy; no YADE).
 
-A *holder* is the creep run the loops drive (:class:`grainfrac_yade.yade_adapter.creep_protocol.CreepRun`
-in YADE): ``relax(creep_time, safe_point=None, resume=None) -> bool`` (DEM steps to equilibrium at the
-held load; ``safe_point(counters)`` is called between its checks, ``resume`` goes on from such counters), ``record_now``,
+A *holder* is the creep run the loops drive (:class:`grainfrac_yade.protocols.creep.CreepRun`):
+``relax(creep_time, safe_point=None, resume=None) -> bool`` (steps to equilibrium at the held load; ``safe_point(counters)`` is called between its checks, ``resume`` goes on from such counters), ``record_now``,
 ``mark_breaks``, ``check_failure``, ``unbalanced(mean_bond_force) -> (largest, relative)``,
 ``progress``, ``safe_point(phase, counters)`` (a checkpoint if one is due), ``platens``, ``servo``
 (None without a stress servo), ``failed``, ``failure_reason`` and ``last_relaxation_steps``.  The
-bonds are a stress-corrosion engine (:class:`grainfrac_yade.yade_adapter.corrosion_engine.StressCorrosion`):
+bonds are an engine's stress-corrosion bond writer (its ``stress_corrosion`` hook; YADE's
+:class:`grainfrac_yade.yade_adapter.corrosion_engine.StressCorrosion`, a :class:`.corrosion.BondCorrosion`):
 its law, state, stresses and writes; its ``scene`` is an engine's :class:`grainfrac_yade.engines.Scene`
 (``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
 (event clock) and the law's ``degrade`` (paper clock, through the engine).  The paper clock's

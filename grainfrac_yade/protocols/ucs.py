@@ -145,7 +145,7 @@ def run_ucs(specimen, params, progress=None, scene=None, checkpoint_folder=None,
     The history holds only finite rows (a row with a NaN or infinite value ends the run as a
     numerical failure instead).  ``checkpoint_folder``: the run folder, checkpoints go to its
     ``checkpoint/`` (None: none); ``run_values``: stored with them (seed).  ``snapshot``: a
-    :class:`.vtk_output.StrainSeries` (VTK files, timestep the axial strain), None: no VTK output.
+    :class:`.snapshots.StrainSeries` (VTK files, timestep the axial strain), None: no VTK output.
     """
     run = UcsRun(specimen, params, progress, scene, checkpoint_folder, run_values)
     run.snapshot = snapshot

@@ -8,8 +8,8 @@ imports YADE.
 
 What the protocols reach through an engine module: ``build_scene``, ``scene_from_state``, ``consolidate`` (the
 isotropic stage of a confined test).  Not in the static engine yet, each refused with one line naming the fix
-(:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the creep runner (still YADE's
-own, not written against the scene interface), the Brazilian jaws and levers, VTK series.
+(:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the creep hold (a held platen
+stress in the static scene), the Brazilian jaws and levers, VTK series.
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
@@ -21,7 +21,7 @@ from __future__ import annotations
 import importlib.metadata
 
 from ..errors import GrainfracError
-from .scene import StaticScene, build_scene, consolidate, scene_from_state  # noqa: F401
+from .scene import VTK_REFUSED, StaticScene, build_scene, consolidate, scene_from_state  # noqa: F401
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
@@ -31,8 +31,8 @@ AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
 
 #: Commands the static engine cannot run yet -> the one line that says so and the fix.
 UNSUPPORTED = {
-    "creep": ("the static engine's creep hold needs the creep protocol written against the scene interface (the "
-              "creep runner is still YADE's own); fix: --engine yade (numerics.engine = \"yade\")"),
+    "creep": ("the static engine's creep hold needs a held platen stress in the static scene (the creep protocol "
+              "drives a stress servo; not built yet); fix: --engine yade (numerics.engine = \"yade\")"),
     "bench": ("the static engine has no DEM steps to time (bench measures YADE's stepping and creep runs); fix: "
               "bench with numerics.engine = \"yade\""),
     "brazilian": ("the static engine's Brazilian test needs the disc's jaws in the static core (not built yet); "
@@ -64,8 +64,6 @@ def apply_levers(*args, **kwargs):
     _refuse("brazilian")
 
 
-#: The one line that refuses a VTK series (``--vtk-every``) on the static engine.
-VTK_REFUSED = "static engine: VTK series (--vtk-every) are not written yet; fix: leave out --vtk-every, or --engine yade"
 
 
 class StrainSeries:

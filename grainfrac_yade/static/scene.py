@@ -58,6 +58,13 @@ def load_increment(params) -> float:
     return params.ucs.record_strain_increment / params.ucs.strain_rate
 
 
+#: The one line that refuses a held platen stress (the creep hold) on the static engine.
+HOLD_REFUSED = ("static engine: a held platen stress (the creep hold of protocols/creep.py) is not in the static "
+                "scene yet; fix: --engine yade (numerics.engine = \"yade\")")
+#: The one line that refuses a VTK series on the static engine.
+VTK_REFUSED = "static engine: VTK series (--vtk-every) are not written yet; fix: leave out --vtk-every, or --engine yade"
+
+
 class StaticPlatens:
     """The platens of a static scene (:class:`grainfrac_yade.engines.PlatenDrive`): the closure d is the core's
     control; strains and the platen stress are read off its converged state."""
@@ -71,6 +78,14 @@ class StaticPlatens:
         self.velocity = 0.0
         # reference positions (what a checkpoint keeps of YADE's platens): the closure is measured from them
         self.y0_top, self.y0_bottom, self.x0_gap = net.height, 0.0, net.width
+
+    def hold_stress(self, target: float, young: float, response_steps: int, max_speed: float):
+        """Refused: a held stress on the static platens (the creep hold) is not built yet (one line)."""
+        raise GrainfracError(HOLD_REFUSED)
+
+    def resume_hold(self, saved: dict):
+        """Refused, as :meth:`hold_stress`."""
+        raise GrainfracError(HOLD_REFUSED)
 
     def set_axial_velocity(self, closing_speed: float) -> None:
         """The platens approach each other at ``closing_speed`` [m/s of the load parameter]."""
@@ -183,6 +198,13 @@ class StaticScene:
             state = self.path.cascade(self.eq.solve(closure, self.state))
         self._take(state)
 
+    def unbalanced(self, reference: float) -> tuple:
+        """(0, 0): a solved static state is in equilibrium (the active-set solution is exact to round-off)."""
+        return 0.0, 0.0
+
+    def relaxation_damping(self, damping: float) -> None:
+        """Ignored: equilibrium is solved, not relaxed (numerics.damping is a dynamic-only setting)."""
+
     def equilibrate(self, balanced, check_steps: int, max_steps: int):
         """One solve at the current closure and loads, and the cascade of what is at its strength: 1 step."""
         before = self.steps
@@ -259,6 +281,14 @@ class StaticScene:
         mean = sums / np.maximum(np.bincount(cell, minlength=n_cells), 1)[:, None]
         out = np.column_stack([mean, np.full(n_cells, 0.5 * self.specimen.thickness)])
         return out if cells is None else out[np.asarray(cells, np.int64)]
+
+    def cell_motion(self) -> tuple:
+        """Refused: the VTK series are not written for the static engine yet (one line)."""
+        raise GrainfracError(VTK_REFUSED)
+
+    def bond_shift(self, positions) -> np.ndarray:
+        """Refused, as :meth:`cell_motion`."""
+        raise GrainfracError(VTK_REFUSED)
 
     def attach_platens(self, lateral: str = "free") -> StaticPlatens:
         if lateral != "free":

@@ -17,7 +17,8 @@ import numpy as np
 from ..geometry.tessellation import SIDES
 from ..wave import hold_budget, scene_density
 from ..protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
-from .platens import StressServo, free_bodies, held_at_equilibrium
+from ..protocols.loading import held_at_equilibrium
+from .platens import StressServo
 
 
 #: Walls that carry the confining stress and the inward direction (x) of their force.
@@ -72,7 +73,7 @@ def consolidate(scene, platens, stress: float, params) -> dict:
     """Isotropic stage: with the confining forces on, a servo brings the axial stress to ``stress``
     [Pa] and holds it until equilibrium (mean resultant on free bodies / mean bond force below
     ``creep.equilibrium_tolerance`` and the axial stress within ``creep.stress_tolerance``), at most
-    ``creep.max_relaxation_steps`` DEM steps (:func:`.platens.held_at_equilibrium`, as a creep run's
+    ``creep.max_relaxation_steps`` DEM steps (:func:`grainfrac_yade.protocols.loading.held_at_equilibrium`, as a creep run's
     hold).  The servo's gain uses :func:`young_estimate` of ``params``; with it and the scene's density
     (:func:`~grainfrac_yade.wave.scene_density`) the servo's response and the stage's step budget follow the
     creep hold's (:func:`~grainfrac_yade.wave.hold_budget`).
@@ -83,13 +84,12 @@ def consolidate(scene, platens, stress: float, params) -> dict:
     budget = hold_budget(cp, platens.height, young, scene_density(params), scene.O.dt)
     servo = StressServo(platens, stress, young, budget.servo_response_steps, cp.servo_max_strain_rate * platens.height)
     scene.drivers.append(servo)
-    free = free_bodies(scene, platens)
     done, balanced = 0, False
     try:
         while done < budget.max_relaxation_steps:
             scene.run(cp.check_period)
             done += cp.check_period
-            if held_at_equilibrium(scene, servo, free, np.flatnonzero(~scene.broken), cp):
+            if held_at_equilibrium(scene, servo, np.flatnonzero(~scene.broken), cp):
                 balanced = True
                 break
     finally:

@@ -166,3 +166,16 @@ def add_stiffness_restorer(scene, corr):
     """For a law that changes stiffness: broken bonds get their contact stiffness back before the next step."""
     if not corr.law.exact_jump:
         scene.drivers.append(ContactStiffnessRestorer(corr))
+
+
+def stress_corrosion(scene, sc_params, saved: dict | None = None) -> StressCorrosion:
+    """The stress-corrosion bond writer of ``scene`` (``[stress_corrosion]`` parameters ``sc_params``), listed among
+    its engines, with the contact-stiffness restorer of a law that changes stiffness.  ``saved``: the law's state
+    from a checkpoint (:meth:`StressCorrosion.state_dict`), loaded without writing to the bonds, which came back
+    with the scene."""
+    corr = StressCorrosion(scene, sc_params)
+    if saved is not None:
+        corr.load_state(saved, write=False)
+    scene.extras.append(corr)
+    add_stiffness_restorer(scene, corr)
+    return corr

@@ -6,22 +6,21 @@ steps, and equilibrium is reached by relaxing until the project's criterion hold
 module does not import YADE: :func:`.load_yade` does, when the first scene is built.
 
 The isotropic stage of a confined test (``consolidate``: a stress servo and dynamic relaxation), the
-Brazilian levers applied to a scene (``apply_levers``), the creep runner written for YADE so far (the UCS
-and Brazilian tests are :mod:`grainfrac_yade.protocols.ucs` and :mod:`~grainfrac_yade.protocols.brazilian`),
-the VTK series, yade-batch rows and
-the timings of ``bench`` are this engine's, listed here so that the commands reach them through the
-engine registry and never import this package.
+Brazilian levers applied to a scene (``apply_levers``), the stress-corrosion bond writer of a creep test
+(``stress_corrosion(scene, sc_params, saved=None)``: reads the bond forces, writes what the degradation law
+says they can carry; the law's state is :class:`grainfrac_yade.protocols.corrosion.BondCorrosion`), yade-batch rows and the timings of ``bench`` are this engine's, listed here so that the test
+protocols (:mod:`grainfrac_yade.protocols`) and the commands reach them through the engine registry and
+never import this package.
 """
 from __future__ import annotations
 
 from . import load_yade, use_default_threads  # noqa: F401
 from .batch import read_table, row_errors, row_plan, run_folder_name  # noqa: F401
-from .bench_timing import TimedCreepRun, loading_step_cost, time_bond_io, time_stepping  # noqa: F401
+from .bench_timing import loading_step_cost, time_bond_io, time_stepping  # noqa: F401
 from .confinement import consolidate  # noqa: F401
-from .creep_protocol import resume_creep, run_creep  # noqa: F401
+from .corrosion_engine import stress_corrosion  # noqa: F401
 from .levers import Levers, apply_levers, new_breaks  # noqa: F401
 from .scene import GrainScene, build_scene, scene_from_state  # noqa: F401
-from .vtk_output import AXIAL_STRAIN, DIAMETRAL_STRAIN, StrainSeries, write_life_series  # noqa: F401
 
 #: The value of ``numerics.engine`` that selects this engine.
 NAME = "yade"

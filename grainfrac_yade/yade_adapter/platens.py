@@ -12,11 +12,8 @@ means over the side cells' spheres.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from .measures import check_value, mean_bond_force, resultant_forces
 
 #: DOFs blocked on platen cells: y prescribed, z and all rotations blocked (pseudo-2D, flat platen).
 PLATEN_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -129,23 +126,27 @@ class Platens:
         bottom = sum(f(i)[1] for i in self._bottom_ids)
         return 0.5 * (top - bottom) / self.cross_section
 
+    def hold_stress(self, target: float, young: float, response_steps: int, max_speed: float) -> "StressServo":
+        """Force control from here on: a :class:`StressServo` holding the axial stress at ``target`` [Pa], added
+        to the scene's drivers (its gain from the specimen's axial modulus ``young`` [Pa] and ``response_steps``,
+        its speed within +-``max_speed`` [m/s])."""
+        servo = StressServo(self, target, young, response_steps, max_speed)
+        self.scene.drivers.append(servo)
+        return servo
+
+    def resume_hold(self, saved: dict) -> "StressServo":
+        """:meth:`hold_stress` as a checkpoint saved it (``saved``: the servo's ``target``, ``gain``, ``max_speed``,
+        ``stress``, and ``clipped``, ``closing_clipped_steps``, counted from 0 if the checkpoint has none)."""
+        servo = StressServo.restored(self, saved["target"], saved["gain"], saved["max_speed"], saved["stress"],
+                                     saved.get("clipped", 0), saved.get("closing_clipped_steps", 0))
+        self.scene.drivers.append(servo)
+        return servo
+
 
 def free_bodies(scene, platens) -> list:
     """Body ids of the cells that are not platen cells (their resultant forces measure balance)."""
     free = np.setdiff1d(np.arange(scene.specimen.n_cells), np.union1d(platens.top, platens.bottom))
     return [int(b) for b in scene.bodies_of(free)]
-
-
-def held_at_equilibrium(scene, servo, free_ids, bonds, creep_params) -> bool:
-    """The servo holds its target at equilibrium: mean resultant force on ``free_ids`` / mean force of
-    ``bonds`` below ``creep.equilibrium_tolerance``, and the held stress within
-    ``creep.stress_tolerance`` x the target.  NumericalFailure if a force or the stress is not finite."""
-    reference = mean_bond_force(scene, bonds)
-    _, mean_resultant = resultant_forces(scene, free_ids)
-    rel = mean_resultant / reference if reference > 0 else math.inf
-    check_value("held axial stress", servo.stress, scene.O.iter)
-    return rel < creep_params.equilibrium_tolerance and \
-        abs(servo.stress - servo.target) < creep_params.stress_tolerance * servo.target
 
 
 class StressServo:

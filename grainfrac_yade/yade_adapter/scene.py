@@ -40,7 +40,7 @@ from . import fem_cells, load_yade, rigid_cells
 from .confinement import Confinement
 from .jaws import DiscJaws
 from .joints import IntactJointGuard
-from .platens import Platens
+from .platens import Platens, free_bodies
 from .measures import BOND_FORCE_SAMPLE, check_value, mean_bond_force, resultant_forces  # noqa: F401
 
 #: Bond break modes: the degradation laws' codes (:mod:`grainfrac_yade.law`), which are YADE's JCFpm crack file's.
@@ -120,6 +120,17 @@ class GrainScene:
     def bond_mineral_pair(self) -> np.ndarray:
         """(n_bonds, 2) mineral indices of the two cells."""
         return self.specimen.face_minerals[self.layout.bond_face]
+
+    def cell_motion(self) -> tuple:
+        """(n, 2+) positions [m] of the cell centroids and (n,) rotation angles about z [rad]: the cell bodies'
+        (rigid cells), or the least-squares rigid motion of each cell's spheres weighted by their lumped areas
+        (fem cells)."""
+        return self.cells.cell_motion(self)
+
+    def bond_shift(self, positions) -> np.ndarray:
+        """(b, 2) displacement [m] drawn for each bond: the mean of its two cells' (rigid) or two spheres' (fem)
+        displacements; ``positions``: the cell positions of :meth:`cell_motion`."""
+        return self.cells.bond_shift(self, positions)
 
     def bodies_of(self, cells) -> np.ndarray:
         """All body ids of ``cells``, cell by cell in the given order (one per rigid cell)."""
@@ -300,7 +311,27 @@ class GrainScene:
         """Rigid platens on the end cells (:class:`.platens.Platens`), listed among the scene's engines."""
         platens = Platens(self, lateral)
         self.extras.append(platens)
+        self._platens, self._free_ids = platens, None
         return platens
+
+    def free_bodies(self) -> list:
+        """Body ids of the cells the platens do not drive (all cells' without platens), found once."""
+        if getattr(self, "_free_ids", None) is None:
+            platens = getattr(self, "_platens", None)
+            self._free_ids = (free_bodies(self, platens) if platens is not None
+                              else [int(b) for b in self.bodies_of(np.arange(self.specimen.n_cells))])
+        return self._free_ids
+
+    def unbalanced(self, reference: float) -> tuple:
+        """(largest resultant force on a free body [N], mean resultant / ``reference``; inf if ``reference`` <= 0)
+        from the last DEM step (free: not driven by the platens; bodies: cells, or the spheres of fem cells).
+        NumericalFailure if a force is NaN or infinite."""
+        largest, mean = resultant_forces(self, self.free_bodies())
+        return largest, (mean / reference if reference > 0 else math.inf)
+
+    def relaxation_damping(self, damping: float):
+        """Cundall's non-viscous damping of the integrator from here on (``NewtonIntegrator.damping``)."""
+        self.newton.damping = damping
 
     def confine(self, stress: float) -> Confinement:
         """Confining stress sigma_3 [Pa] on the side walls (:class:`.confinement.Confinement`: permanent forces)."""

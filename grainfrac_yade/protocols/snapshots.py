@@ -1,6 +1,8 @@
 """VTK time series of a run for ParaView: cells (moved polygons) and bonds (state, strengths, stresses).
 
-This module only reads the scene and collects arrays; :mod:`grainfrac_yade.vtkio` writes them as
+Any engine: this module only reads the scene through the scene interface
+(:class:`grainfrac_yade.engines.Scene`: ``cell_motion``, ``bond_shift``, ``bond_forces`` and the bonds'
+bookkeeping) and collects arrays; :mod:`grainfrac_yade.vtkio` writes them as
 XML ``.vtp`` files and ``.pvd`` collections with VTK's writer (not YADE's VTKRecorder, which
 crashed on its second write here: shared/yade_notes.md, Output).  Reads each cell body once
 (position, orientation) and each bond's forces once: about 2-3 us per bond, so a paper-size
@@ -17,27 +19,12 @@ import numpy as np
 
 from ..vtkio import (BOND_KIND_NAMES, BOND_STATE_NAMES, rigid_motion, series_file,
                      time_field, write_polygons, write_pvd, write_segments)
-from ..protocols.cracks import bond_segments
+from .cracks import bond_is_inter, bond_segments
 
 #: The time of each kind of run: (field-data name, unit) of the .pvd timestep.
 CREEP_TIME = ("creep_time", "s")
 AXIAL_STRAIN = ("axial_strain", "1")
 DIAMETRAL_STRAIN = ("diametral_strain", "1")
-
-
-def cell_motion(scene):
-    """(n, 2+) positions [m] of the cell centroids and (n,) rotation angles about z [rad].
-
-    Rigid cells: the cell bodies' positions and rotations.  Fem cells: the least-squares rigid motion
-    (translation + rotation) of each cell's spheres, weighted by their lumped areas.
-    """
-    return scene.cells.cell_motion(scene)
-
-
-def bond_shift(scene, pos) -> np.ndarray:
-    """(b, 2) displacement [m] drawn for each bond: the mean of its two cells' (rigid) or two spheres'
-    (fem) displacements; ``pos``: the cell positions of :func:`cell_motion`."""
-    return scene.cells.bond_shift(scene, pos)
 
 
 def code_tables(specimen) -> dict:
@@ -57,8 +44,9 @@ def bond_base_arrays(scene, broken, mode, break_time, break_time_name) -> dict:
     """Per-bond data every series has: id, state (0 intact, 1 tensile, 2 shear crack), its name, kind
     (1 inter-granular), the two cells and the break time (NaN: intact)."""
     state = np.where(broken, mode, 0).astype(int)
+    cells = scene.specimen.tessellation.face_cells[scene.layout.bond_face]
     return {"bond_id": np.arange(scene.n_bonds), "state": state, "state_name": np.array(BOND_STATE_NAMES)[state],
-            "inter": scene.bond_is_inter.astype(int), "cell_a": scene.bond_cells[:, 0], "cell_b": scene.bond_cells[:, 1],
+            "inter": bond_is_inter(scene).astype(int), "cell_a": cells[:, 0], "cell_b": cells[:, 1],
             break_time_name: np.where(broken, break_time, np.nan)}
 
 
@@ -93,9 +81,9 @@ class Series:
         """The scene's current state at ``time``: moved polygons, bonds with stresses per intact area
         and ``extra_bonds`` arrays; break time: ``break_time`` (default the DEM step of each break)."""
         spec, tess = scene.specimen, scene.specimen.tessellation
-        pos, angle = cell_motion(scene)
+        pos, angle = scene.cell_motion()
         polygons = rigid_motion(tess.cell_vertices, tess.cell_centroid, pos, angle)
-        segments = bond_segments(scene, np.arange(scene.n_bonds)) + bond_shift(scene, pos)[:, None, :]
+        segments = bond_segments(scene, np.arange(scene.n_bonds)) + scene.bond_shift(pos)[:, None, :]
         fn, fs = scene.bond_forces()
         area = scene.layout.bond_area
         if break_time is None:
@@ -108,7 +96,8 @@ class Series:
 
 
 def initial_strengths(scene) -> dict:
-    """Tensile strength and cohesion [Pa] of a test without stress corrosion: the initial ones, 0 once broken."""
+    """Tensile strength and cohesion [Pa] of a test without stress corrosion: the initial ones (the scene's
+    ``props``), 0 once broken."""
     props = scene.props
     return {"tensile_strength_pa": np.where(scene.broken, 0.0, props.tensile_strength),
             "cohesion_pa": np.where(scene.broken, 0.0, props.cohesion)}

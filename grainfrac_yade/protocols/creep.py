@@ -1,18 +1,22 @@
 """Constant-load creep test to failure with stress corrosion (paper section 4.1).
 
 0. Confined tests (``confinement.stress`` sigma_3 > 0): side-wall forces, then the isotropic
-   stage to sigma_1 = sigma_3 at equilibrium (:mod:`.confinement`).  A specimen that breaks apart in
+   stage to sigma_1 = sigma_3 at equilibrium (the engine's ``consolidate``).  A specimen that breaks apart in
    it (:func:`.confinement.broken_apart_reason`) ends the run there with ``failed_before_test`` set
    and the reason in ``failure_reason``: no ramp, no creep, neither a lifetime nor a survival.
 1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
    stress reaches the target; bonds broken during the ramp are counted apart.
-2. Hold: a servo keeps the axial stress at the target (:class:`StressServo`).
+2. Hold: a servo keeps the axial stress at the target (the platens' ``hold_stress``,
+   :class:`grainfrac_yade.engines.PlatenDrive`); the creep phase's damping (``creep.relaxation_damping``)
+   is the scene's ``relaxation_damping`` (an engine without damping ignores it).
 3. Creep: the degradation law (:mod:`grainfrac_yade.law`) acts as creep time
    passes, with the ``event`` clock (at equilibrium, one pure
    :func:`~grainfrac_yade.law.creep_step` to the next failure, ours) or the
    ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is below
-   the threshold, applied every ``engine_period`` DEM steps).  This module reads
-   forces and writes strengths (:mod:`.corrosion_engine`); the law is not here.
+   the threshold, applied every ``engine_period`` DEM steps; a dynamic engine only,
+   :func:`grainfrac_yade.engines.registry.require_dynamic`).  The engine's ``stress_corrosion`` hook
+   reads the bond forces and writes the strengths (the law's state: :class:`.corrosion.BondCorrosion`);
+   the law is not here.
 
 Failure: the platens cannot hold the load.  Collapse (:class:`CollapseWatch`): the
 servo closes the platens at its speed limit on every DEM step while the axial strain
@@ -30,30 +34,33 @@ break no bond, end the run with ``numerical_failure`` set and the reason in
 Checkpoints (given a run folder): every ``numerics.checkpoint_interval`` s of wall time
 in the ramp, always at its end, then every interval again at a safe point of the clock loops
 (:meth:`CreepRun.safe_point`); :func:`resume_creep` goes on from the last one and
-computes what the uninterrupted run would have (:mod:`.checkpoint`).
+computes what the uninterrupted run would have (:mod:`.checkpoints`; :func:`capture` and :func:`restore`
+here: the run's own state beside the engine's scene).
+
+Written against the scene interface (:class:`grainfrac_yade.engines.Scene`): any engine runs it.
 """
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 
 import numpy as np
 
 from ..clocks import EventClock, PaperClock
+from ..engines.registry import engine_for, require_dynamic
 from ..errors import NumericalFailure
-from ..protocols.creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
 from ..law import shear_strength
 from ..params import unbalanced_threshold
 from ..vtkio import due_times, merged_frame_note
-from ..wave import hold_budget, scene_density
-from .checkpoint import Checkpointer, capture, inexact_note, read, restore
-from .confinement import Confinement, broken_apart_reason, consolidate
-from .corrosion_engine import StressCorrosion, add_stiffness_restorer
-from .platens import Platens, StressServo, free_bodies, held_at_equilibrium
-from ..protocols.cracks import broken_counts
-from .scene import build_scene, check_value, resultant_forces
-from .vtk_output import Series, write_creep_snapshot
+from ..wave import HoldBudget, hold_budget, scene_density
+from .checkpoints import Checkpointer, START_TABLE, base_state, inexact_note, platen_state, read, restore_platens, \
+    restore_scene, scene_arrays
+from .columns import history_as_today
+from .confinement import broken_apart_reason
+from .cracks import bond_is_inter, broken_counts
+from .creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
+from .loading import check_value, held_at_equilibrium
+from .snapshots import Series, write_creep_snapshot
 
 #: History rows between writes of the partial history (an interrupted run keeps what it measured).
 HISTORY_FLUSH_ROWS = 50
@@ -101,17 +108,16 @@ class CreepRun:
         self.history_sink = history_sink
         self.progress = progress or (lambda msg: None)
         self.t0, self.c0 = time.time(), time.process_time()   # wall and CPU time of the run's start
-        self.scene = build_scene(specimen, params)
-        self.platens = Platens(self.scene, params.ucs.platen_lateral)
-        self.scene.extras.append(self.platens)
+        #: the engine of ``params`` (``numerics.engine``): builds the scene, the isotropic stage, the bond writer
+        self.engine = engine_for(params)
+        self.scene = self.engine.build_scene(specimen, params)
+        self.platens = self.scene.attach_platens(params.ucs.platen_lateral)
         #: side-wall forces of a confined test (``confinement.stress`` > 0), else None
         self.confinement = None
-        #: the isotropic stage of a confined test (:func:`.confinement.consolidate`): steps, equilibrium
+        #: the isotropic stage of a confined test (the engine's ``consolidate``): steps, equilibrium
         self.consolidation = {}
         if params.confinement.stress > 0:
-            self.confinement = Confinement(self.scene, params.confinement.stress)
-            self.scene.extras.append(self.confinement)
-        self._free_ids = free_bodies(self.scene, self.platens)
+            self.confinement = self.scene.confine(params.confinement.stress)
         self.rows, self.ramp_broken = [], 0
         self.failed, self.failure_reason = False, ""
         self.failed_on_loading = False   # failed during the ramp: lifetime 0, no creep phase
@@ -146,13 +152,11 @@ class CreepRun:
     def unbalanced(self, mean_bond_force):
         """Largest resultant force on a free body [N], and mean / mean_bond_force (bodies: cells, or the
         spheres of fem cells)."""
-        largest, mean = resultant_forces(self.scene, self._free_ids)
-        rel = mean / mean_bond_force if mean_bond_force > 0 else math.inf
-        return largest, rel
+        return self.scene.unbalanced(mean_bond_force)
 
     def at_equilibrium(self, servo):
         bonds = self.corr.intact() if self.corr is not None else np.flatnonzero(~self.scene.broken)
-        return held_at_equilibrium(self.scene, servo, self._free_ids, bonds, self.params.creep)
+        return held_at_equilibrium(self.scene, servo, bonds, self.params.creep)
 
     def record(self, creep_time, stress=None):
         """Append a history row; NumericalFailure (and no row) if a value is NaN or infinite."""
@@ -196,14 +200,14 @@ class CreepRun:
         cp = self.params.creep
         if resume is None:
             self.platens.set_axial_velocity(cp.ramp_strain_rate * self.platens.height)
-        steps = max(1, int(round(RAMP_CHECK_STRAIN / (cp.ramp_strain_rate * self.scene.O.dt))))
+        steps = max(1, int(round(RAMP_CHECK_STRAIN / (cp.ramp_strain_rate * self.scene.dt))))
         peak = 0.0 if resume is None else float(resume["peak"])
         while True:
-            if self.scene.O.iter > 0:   # not before the first step: the bonds' reference state is set by it
+            if self.scene.steps > 0:   # not before the first step: the bonds' reference state is set by it
                 self.safe_point("loading", {"peak": peak})
             self.scene.run(steps)
             s = self.platens.axial_stress()
-            check_value("axial stress during the ramp", s, self.scene.O.iter)
+            check_value("axial stress during the ramp", s, self.scene.steps)
             peak = max(peak, s)
             if s >= self.target:
                 break
@@ -225,12 +229,11 @@ class CreepRun:
         (``creep.relaxation_damping``, if set) replaces the ramp's."""
         cp = self.params.creep
         if cp.relaxation_damping > 0:
-            self.scene.newton.damping = cp.relaxation_damping
+            self.scene.relaxation_damping(cp.relaxation_damping)
         young = max(self.target / max(self.platens.axial_strain(), SERVO_STRAIN_FLOOR), SERVO_MODULUS_FLOOR)
-        self.hold_budget = hold_budget(cp, self.platens.height, young, scene_density(self.params), self.scene.O.dt)
-        self.servo = StressServo(self.platens, self.target, young, self.hold_budget.servo_response_steps,
-                                 cp.servo_max_strain_rate * self.platens.height)
-        self.scene.drivers.append(self.servo)
+        self.hold_budget = hold_budget(cp, self.platens.height, young, scene_density(self.params), self.scene.dt)
+        self.servo = self.platens.hold_stress(self.target, young, self.hold_budget.servo_response_steps,
+                                              cp.servo_max_strain_rate * self.platens.height)
 
     def relax(self, creep_time, safe_point=None, resume=None):
         """Run DEM steps until equilibrium at the held load; False (and failed) at collapse
@@ -277,7 +280,7 @@ class CreepRun:
         limit = shear_strength(jc, sigma, corr.tan_phi[idx])
         return {"bond": idx, "normal_stress_pa": sigma, "shear_stress_pa": tau,
                 "tensile_utilisation": sigma / jt, "shear_utilisation": np.where(limit > 0, tau / limit, np.inf),
-                "inter": self.scene.bond_is_inter[idx]}
+                "inter": bond_is_inter(self.scene)[idx]}
 
     def run_event_clock(self, resume=None):
         """Event clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it)."""
@@ -287,7 +290,9 @@ class CreepRun:
         self.n_events = event_clock_loop(self, self.corr, self.clock, resume)
 
     def run_paper_clock(self, resume=None):
-        """Paper clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it)."""
+        """Paper clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it).
+        Needs a dynamic engine (Eq. 8 measures the unbalanced force)."""
+        require_dynamic(self.params, "the paper clock (its unbalanced force, Eq. 8)")
         sc = self.params.stress_corrosion
         if resume is None:
             self.clock = PaperClock(sc.dt_min, sc.dt_max, unbalanced_threshold(sc))
@@ -348,7 +353,7 @@ class CreepRun:
         phase, loop = self.resumed or (None, None)
         if phase in (None, "loading"):
             if phase is None and self.confinement is not None:
-                self.consolidation = consolidate(self.scene, self.platens, self.confinement.stress, self.params)
+                self.consolidation = self.engine.consolidate(self.scene, self.platens, self.confinement.stress, self.params)
                 self.failure_reason = broken_apart_reason(self.scene, self.confinement.stress, "no creep test")
                 if self.failure_reason:   # no specimen left to load: neither a lifetime nor a survival
                     self.failed_before_test = True
@@ -370,9 +375,7 @@ class CreepRun:
                     self.check_failure()
                 self.record(0.0, self.servo.stress)
                 return self
-            self.corr = StressCorrosion(self.scene, self.params.stress_corrosion)
-            self.scene.extras.append(self.corr)
-            add_stiffness_restorer(self.scene, self.corr)
+            self.corr = self.engine.stress_corrosion(self.scene, self.params.stress_corrosion)
             if self.relax(0.0):
                 self.initial_bond_stresses = self.bond_stress_table()
             loop = None
@@ -384,6 +387,87 @@ class CreepRun:
         if self.vtk_folder is not None:
             self.write_vtk(self.rows[-1]["creep_time_s"])
         return self
+
+
+# ------------------------------------------------------------------ checkpoints
+def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") -> tuple:
+    """(state dict for state.json, arrays for arrays.npz) of creep run ``run`` at a safe point."""
+    sc, pl = run.scene, run.platens
+    state = {
+        **base_state("creep", run, phase, loop, run_values, version),
+        "creep_time_s": run.rows[-1]["creep_time_s"] if run.rows else 0.0,
+        "run": {"rows": run.rows, "ramp_broken": run.ramp_broken, "failed": run.failed,
+                "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
+                "n_events": run.n_events, "vtk_times": run.vtk_times, "vtk_written": run.vtk_written,
+                "vtk_merged": run.vtk_merged,
+                "vtk_rows": run._vtk_rows, "vtk": run.vtk_folder is not None, "vtk_every": run.vtk_every,
+                "last_relaxation_steps": run.last_relaxation_steps, "resumes": run.resumes,
+                "consolidation": run.consolidation},
+        "platens": platen_state(pl),
+        "servo": None, "clock": None, "corrosion": None, "start_table_columns": None,
+    }
+    arrays = {**scene_arrays(sc), "break_time": run.break_time, "macro_time": run.macro_time}
+    servo = run.servo
+    if servo is not None:
+        state["servo"] = {"target": servo.target, "gain": servo.gain, "max_speed": servo.max_speed,
+                          "stress": float(servo.stress), "hold_budget": run.hold_budget.as_dict(),
+                          "clipped": int(servo.clipped), "closing_clipped_steps": int(servo.closing_clipped_steps)}
+    if run.corr is not None:
+        corr = run.corr.state_dict()
+        state["corrosion"] = {"creep_time": corr["creep_time"], "law": corr["law"], "restored": corr["restored"]}
+        arrays.update(tensile_strength_pa=np.asarray(corr["tensile_strength_pa"]),
+                      cohesion_pa=np.asarray(corr["cohesion_pa"]), area_fraction=np.asarray(corr["area_fraction"]))
+    clock = run.clock
+    if clock is not None:
+        state["clock"] = clock.state_dict()
+    if run.initial_bond_stresses is not None:
+        state["start_table_columns"] = list(run.initial_bond_stresses)
+        arrays.update({START_TABLE + k: np.asarray(v) for k, v in run.initial_bond_stresses.items()})
+    return state, arrays
+
+
+def restore(run, where, state: dict, arrays: dict):
+    """Load the checkpoint ``where`` into creep run ``run``, freshly built from the same specimen and
+    parameters.
+
+    Returns (phase, loop counters) for the driver to go on from.
+    """
+    sc, pl = run.scene, run.platens
+    restore_scene(sc, where, state, arrays, run.confinement)
+    restore_platens(pl, state["platens"])
+    r = state["run"]
+    run.rows = [history_as_today(row) for row in r["rows"]]   # rows of older checkpoints: dem_steps
+    run.ramp_broken, run.failed, run.failure_reason = r["ramp_broken"], r["failed"], r["failure_reason"]
+    run.failed_on_loading, run.n_events = r["failed_on_loading"], r["n_events"]
+    run.vtk_times, run.vtk_written, run._vtk_rows = r["vtk_times"], r["vtk_written"], r["vtk_rows"]
+    run.vtk_every = int(r.get("vtk_every", 0))   # older checkpoints: times only
+    run.vtk_merged = r.get("vtk_merged", [])   # older checkpoints: none recorded
+    run.last_relaxation_steps = r["last_relaxation_steps"]
+    run.consolidation = r.get("consolidation", {})
+    run.resumes = r["resumes"] + [{"dem_steps": state["dem_steps"], "creep_time_s": state["creep_time_s"],
+                                   "phase": state["phase"], "checkpoint_written": state["written"]}]
+    run.break_time, run.macro_time = np.array(arrays["break_time"]), np.array(arrays["macro_time"])
+    run.t0 = time.time() - state["wall_s"]
+    run.c0 = time.process_time() - state.get("cpu_s", 0.0)
+    if state["servo"] is not None:
+        s = state["servo"]
+        # checkpoints written before the clip count was kept: counted from 0 again
+        servo = pl.resume_hold(s)
+        run.servo = servo
+        # checkpoints written before the hold budget had wave crossings held the fixed step counts
+        run.hold_budget = (HoldBudget.from_dict(s["hold_budget"]) if "hold_budget" in s
+                           else HoldBudget.fixed(run.params.creep))
+    if state["corrosion"] is not None:
+        run.corr = run.engine.stress_corrosion(
+            sc, run.params.stress_corrosion,
+            {"creep_time": state["corrosion"]["creep_time"], "restored": state["corrosion"].get("restored", []),
+             **{k: arrays[k] for k in ("tensile_strength_pa", "cohesion_pa", "area_fraction")}})
+    if state["clock"] is not None:
+        kind = state["clock"].get("kind")
+        run.clock = (EventClock if kind == EventClock.KIND else PaperClock).from_state(state["clock"])
+    columns = state["start_table_columns"]
+    run.initial_bond_stresses = None if columns is None else {k: arrays[START_TABLE + k] for k in columns}
+    return state["phase"], state["loop"]
 
 
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:
@@ -400,8 +484,8 @@ def resume_creep(specimen, params, target_stress, run_folder, progress=None, **o
     """Go on with the creep run whose checkpoint is in ``run_folder`` (same specimen, parameters and
     load as the run that wrote it) and return the finished run; it writes further checkpoints there.
 
-    The scene is built as for a new run, then replaced by the checkpoint's (``O.load``) and the
-    driver's state is restored (:func:`.checkpoint.restore`).  GrainfracError if the folder holds
+    The scene is built as for a new run, then replaced by the checkpoint's (the engine's
+    ``restore_checkpoint``) and the driver's state is restored (:func:`restore`).  GrainfracError if the folder holds
     no usable checkpoint.
     """
     where, state, arrays = read(run_folder)
