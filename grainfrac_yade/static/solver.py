@@ -68,6 +68,8 @@ CYCLE_ACCEPT_REL = 1e-6
 
 #: Sets of fixed dofs (per set of closed contacts) kept [1]: a path meets a few; the cache is only emptied when full.
 FIXED_CACHE = 256
+#: Broken sets whose force rows are kept [1]: a break meets two (before and after it), a cascade a few more.
+ROWS_CACHE = 4
 
 
 class _PlainOp:
@@ -170,14 +172,25 @@ class Equilibrium:
         self._order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
         self.reuse_factor, self.max_low_rank_contacts = bool(reuse_factor), int(max_low_rank_contacts)
         self._pattern = TangentPattern(net) if self.reuse_factor else None
-        self._lr, self._op, self._fixed_cache = None, None, {}
+        self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
 
     # ------------------------------------------------------------------ assembly
+    def force_rows(self, broken):
+        """The network's force rows at this broken set (:meth:`.network.StaticNetwork.force_rows`), kept for the
+        last few broken sets (the same matrices, so nothing changes but the work)."""
+        key = broken.tobytes()
+        hit = self._rows_cache.get(key)
+        if hit is None:
+            if len(self._rows_cache) >= ROWS_CACHE:
+                self._rows_cache.pop(next(iter(self._rows_cache)))
+            hit = self._rows_cache[key] = self.net.force_rows(broken)
+        return hit
+
     def tangent(self, status, sign, s_p, ground=False):
         """Tangent stiffness (ndof x ndof) of the affine law at these statuses."""
         n = self.net
         a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
-        gn, gt = n.force_rows(status != cl.INTACT)
+        gn, gt = self.force_rows(status != cl.INTACT)
         k = n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)
         if self._ground is None:      # each dof's own intact stiffness, once (its kind's median where it has none)
             d = np.abs(k.diagonal())
@@ -296,7 +309,7 @@ class Equilibrium:
         self._grounded = ground
         if ground:
             self.counters.grounded += 1
-        self._gn, self._gt = self.net.force_rows(status != cl.INTACT)
+        self._gn, self._gt = self.force_rows(status != cl.INTACT)
         free = ~fixed
         kff = k[free][:, free].tocsc()
         t0 = time.process_time()
@@ -390,7 +403,7 @@ class Equilibrium:
     def platen_stress(self, u, fn, fs, broken, constant=True):
         """Platen stress [Pa, compression positive] of the internal forces (as ``elastic.solve_uniaxial``)."""
         n = self.net
-        gn, gt = n.force_rows(broken)
+        gn, gt = self.force_rows(broken)
         r = n.k_grain @ u + gn.T @ fn + gt.T @ fs
         if constant:
             r = r - self.f_ext
@@ -427,8 +440,8 @@ class Equilibrium:
         new = broken_now.broken & ~state.broken
         dn, ds = n.cn @ state.u, n.ct @ state.u
         fn_b, fs_b = cl.forces(dn, ds, broken_now.status, broken_now.sign, broken_now.s_p, n.kn, n.ks, n.tan_residual)
-        gn, gt = n.force_rows(state.broken)
-        gnb, gtb = n.force_rows(broken_now.broken)
+        gn, gt = self.force_rows(state.broken)
+        gnb, gtb = self.force_rows(broken_now.broken)
         w = new.astype(float)
         return -(gn.T @ (w * state.fn) + gt.T @ (w * state.fs) - gnb.T @ (w * fn_b) - gtb.T @ (w * fs_b))
 

@@ -148,19 +148,23 @@ class LowRankSolver:
         self.net, self.lu, self.coef, self.free, self.max_contacts = net, lu, coef, free, max_contacts
         self._z = {}            # (contact, coefficients) -> (U columns, K^-1 U columns), free dofs
         self.back_substitutions = 0
+        cols = np.flatnonzero(free)
+        m = net.n_bonds
+        # rows restricted to the free dofs, once per reference: 0..m-1 c_n, m..2m-1 c_t, then g_n, g_t
+        self._rows = sp.vstack([net.cn, net.ct, net.gn, net.gt]).tocsc()[:, cols].tocsr()
+        self._m = m
 
     def _columns(self, i, new):
         key = (int(i),) + tuple(float(x) for x in new[:3]) + (bool(new[3]),)
         hit = self._z.get(key)
         if hit is not None:
             return hit
-        net, f = self.net, self.free
         old = tuple(c[i] for c in self.coef)
+        m = self._m
+        dense = self._rows[[i, m + i, 2 * m + i, 3 * m + i]].toarray()
 
         def rows(broken):
-            gn = (net.cn if broken else net.gn)[i]
-            gt = (net.ct if broken else net.gt)[i]
-            return gn.toarray().ravel()[f], gt.toarray().ravel()[f]
+            return (dense[0], dense[1]) if broken else (dense[2], dense[3])
         gn1, gt1 = rows(new[3])
         gn0, gt0 = rows(old[3])
         wn = new[0] * gn1 + new[1] * gt1 - old[0] * gn0 - old[1] * gt0
@@ -182,13 +186,11 @@ class LowRankSolver:
             return _Woodbury(self, None, None, None)
         zs = [self._columns(i, (a_nn[i], a_sn[i], a_ss[i], b[i])) for i in changed]
         z = np.concatenate([q[1] for q in zs], axis=1)
-        f = self.free
-        vt = sp.vstack([self.net.cn[changed], self.net.ct[changed]]).tocsr()[:, np.flatnonzero(f)]
-        # V's columns per contact are (c_n, c_t): interleave to match U's (w_n, w_t) per contact
+        # V's columns per contact are (c_n, c_t), interleaved to match U's (w_n, w_t) per contact
         r = len(changed)
         order = np.empty(2 * r, int)
-        order[0::2], order[1::2] = np.arange(r), r + np.arange(r)
-        vt = vt[order]
+        order[0::2], order[1::2] = changed, self._m + changed
+        vt = self._rows[order]
         cap = np.eye(2 * r) + vt @ z
         try:
             lu_cap = sla.lu_factor(cap, check_finite=True)
