@@ -18,6 +18,7 @@ import math
 import time
 
 from grainfrac_yade.clocks import EventClock
+from grainfrac_yade.errors import NumericalFailure
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.law import build_law
 from grainfrac_yade.params import load_parameters
@@ -29,12 +30,14 @@ from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 
 
-def counters(eq, cpu, breaks):
+def counters(eq, cpu, records, bonds):
+    """The solver's counters and the CPU per equilibrium, per break (a record: a crossing and its cascade, as the
+    study page counts them) and per bond broken."""
     c = eq.counters
     d = {k: getattr(c, k) for k in vars(c)}
     d.update(cpu_s=cpu, cpu_per_equilibrium_s=cpu / max(c.equilibria, 1),
-             equilibria_per_break=c.equilibria / max(breaks, 1), cpu_per_break_s=cpu / max(breaks, 1),
-             iterations_per_equilibrium=c.iterations / max(c.equilibria, 1))
+             equilibria_per_break=c.equilibria / max(records, 1), cpu_per_break_s=cpu / max(records, 1),
+             cpu_per_bond_s=cpu / max(bonds, 1), iterations_per_equilibrium=c.iterations / max(c.equilibria, 1))
     return d
 
 
@@ -61,6 +64,7 @@ def main(argv=None):
     ap.add_argument("--events", type=int, default=5)
     ap.add_argument("--time-limit", type=float, default=1e13)
     ap.add_argument("--direct", action="store_true")
+    ap.add_argument("--max-low-rank", type=int, help="changed contacts from a kept factor (solver default if unset)")
     ap.add_argument("--set", action="append", default=[])
     ap.add_argument("--dump", help="write the break sequences (path and creep) to this JSON file")
     a = ap.parse_args(argv)
@@ -70,6 +74,8 @@ def main(argv=None):
     s = build_specimen(p, a.seed)
     net = build_static_network(s, p, layout_for(s, p))
     settings = {"reuse_factor": False} if a.direct else {}
+    if a.max_low_rank is not None and not a.direct:
+        settings["max_low_rank_contacts"] = a.max_low_rank
     out = {"seed": a.seed, "width": a.width, "height": a.height, "bonds": net.n_bonds, "dofs": net.ndof,
            "direct": a.direct, "build_cpu_s": time.process_time() - t0}
     eq = Equilibrium(net, **settings)
@@ -79,12 +85,16 @@ def main(argv=None):
     if a.breaks > 0:
         path = Path(eq)
         t2 = time.process_time()
-        st = path.run_closure(st, a.max_strain * net.height, stop=lambda s_, rec: len(rec) >= a.breaks)
+        end = "max strain or break count"
+        try:
+            st = path.run_closure(st, a.max_strain * net.height, stop=lambda s_, rec: len(rec) >= a.breaks)
+        except NumericalFailure as exc:        # reported with the path so far, as the probe does
+            st, end = getattr(path, "last_state", st), f"numerical failure: {exc}"[:300]
         cpu = time.process_time() - t2
         nb = sum(len(r.bonds) for r in path.records)
         h, n = sequence_hash(path.records)
         out["path"] = {"breaks": nb, "records": len(path.records), "strain": st.closure / net.height,
-                       "stress_mpa": st.stress / 1e6, "sequence_hash": h, **counters(eq, cpu, nb)}
+                       "stress_mpa": st.stress / 1e6, "end": end, "sequence_hash": h, **counters(eq, cpu, len(path.records), nb)}
     if a.creep_stress:
         eq2 = Equilibrium(net, **settings)
         path2 = Path(eq2)
@@ -114,7 +124,7 @@ def main(argv=None):
                         "cpu_per_event_s": ev_cpu / max(res.events, 1),
                         "equilibria_per_event": ev_eq / max(res.events, 1),
                         "cpu_per_event_equilibrium_s": ev_cpu / max(ev_eq, 1), "sequence_hash": h,
-                        "times": res.times[:5], **{"counters": counters(eq2, cpu, n)}}
+                        "times": res.times[:5], "counters": counters(eq2, cpu, len(path2.records), n)}
     if a.dump:
         with open(a.dump, "w") as fh:
             json.dump({"path": sequence(path.records) if a.breaks > 0 else [],

@@ -17,6 +17,8 @@ reference factor: the caller falls back to the direct factorisation, which also 
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -193,7 +195,9 @@ class LowRankSolver:
         vt = self._rows[order]
         cap = np.eye(2 * r) + vt @ z
         try:
-            lu_cap = sla.lu_factor(cap, check_finite=True)
+            with warnings.catch_warnings():     # a singular capacitance (a mechanism) is refused just below
+                warnings.simplefilter("ignore", sla.LinAlgWarning)
+                lu_cap = sla.lu_factor(cap, check_finite=True)
         except (ValueError, np.linalg.LinAlgError):
             return None
         if not np.all(np.isfinite(lu_cap[0])) or np.abs(np.diag(lu_cap[0])).min() == 0.0:
