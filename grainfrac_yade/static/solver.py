@@ -92,7 +92,7 @@ class _FastOp:
 
     def solve(self, kff, rhs):
         if self.op.z is None:
-            return self.op.apply(rhs)
+            return self.op.direct(kff, rhs)
         return self.op.solve(kff, rhs)
 
 
