@@ -15,6 +15,7 @@ import argparse
 import hashlib
 import json
 import math
+import sys
 import time
 
 from grainfrac_yade.clocks import EventClock
@@ -109,7 +110,12 @@ def main(argv=None):
             if not ramp:
                 ramp.update(cpu_s=time.process_time() - t, equilibria=eq2.counters.equilibria,
                             broken=int(r[0].broken.sum()), strain=r[0].closure / net.height)
+            calls[0] += 1
+            print(json.dumps({"event": calls[0] - 1, "cpu_s": time.process_time() - t3, "creep_time_s": clock.creep_time,
+                              "broken": int(r[0].broken.sum()), "strain": r[0].closure / net.height,
+                              "equilibria": eq2.counters.equilibria}), file=sys.stderr, flush=True)
             return r
+        calls = [0]
         path2.hold = hold
         t3 = time.process_time()
         res = creep_hold(eq2, law, clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),
