@@ -160,3 +160,20 @@ def test_fast_path_breaks_the_same_bonds_as_the_direct_path(model):
         c = pf.eq.counters
         assert c.low_rank > 0 and c.factorisations < c.tangents
     assert pd.eq.counters.low_rank == 0 and pd.eq.counters.factorisations >= pd.eq.counters.iterations // 2
+
+
+def test_forget_factor_goes_on_as_a_fresh_equilibrium():
+    """The fast path's answers depend on the kept factor at round-off; after forget_factor() a path goes on bit for
+    bit as a new Equilibrium started from the same state does (what a saved and restored run needs)."""
+    s, p, lay = _tiny("fem")
+    net = build_static_network(s, p, lay)
+    eq = Equilibrium(net)
+    path = Path(eq)
+    state = path.run_closure(eq.initial(0.0), 0.02 * net.height, stop=lambda st, rec: len(rec) >= BREAKS // 2)
+    eq.forget_factor()
+    a = path.run_closure(state, 0.02 * net.height, stop=lambda st, rec: len(rec) >= BREAKS)
+    fresh = Path(Equilibrium(net))
+    b = fresh.run_closure(state, 0.02 * net.height, stop=lambda st, rec: len(rec) >= BREAKS // 2)
+    assert [k for r in path.records[BREAKS // 2:] for k in r.bonds] == [k for r in fresh.records for k in r.bonds]
+    assert [r.stress_before for r in path.records[BREAKS // 2:]] == [r.stress_before for r in fresh.records]
+    assert np.array_equal(a.u, b.u) and a.closure == b.closure

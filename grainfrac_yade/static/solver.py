@@ -174,6 +174,13 @@ class Equilibrium:
         self._pattern = TangentPattern(net) if self.reuse_factor else None
         self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
 
+    def forget_factor(self):
+        """Drop the kept factor (and with it the low-rank history): the next solve factorises afresh, as a new
+        ``Equilibrium`` on the same network would.  The fast path's answers depend on which factor is kept at
+        round-off (1e-12 relative); a caller that saves and restores a run calls this at every save, in the saved
+        and in the uninterrupted run alike, so that both go on bit for bit."""
+        self._key, self._lr, self._op, self._lu, self._k = None, None, None, None, None
+
     # ------------------------------------------------------------------ assembly
     def force_rows(self, broken):
         """The network's force rows at this broken set (:meth:`.network.StaticNetwork.force_rows`), kept for the
