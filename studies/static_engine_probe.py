@@ -62,6 +62,7 @@ def main(argv=None):
     ap.add_argument("--changes-per-iteration", type=int, default=STATUS_CHANGES_PER_ITERATION)
     ap.add_argument("--max-iterations", type=int, default=MAX_ACTIVE_SET_ITERATIONS)
     ap.add_argument("--max-events", type=int, default=2000)
+    ap.add_argument("--direct", action="store_true", help="the plain direct path (every tangent factorised)")
     a = ap.parse_args(argv)
     size = [f"specimen.width={a.width}", f"specimen.height={a.height}"]
     p = load_parameters(extra_files=a.params, overrides=size + a.set)
@@ -69,7 +70,8 @@ def main(argv=None):
     s = build_specimen(p, a.seed)
     lay = layout_for(s, p)
     net = build_static_network(s, p, lay)
-    settings = {"changes_per_iteration": a.changes_per_iteration, "max_iterations": a.max_iterations}
+    settings = {"changes_per_iteration": a.changes_per_iteration, "max_iterations": a.max_iterations,
+                "reuse_factor": not a.direct}
     eq = Equilibrium(net, **settings)
     out = {"grain_model": lay.model, "seed": a.seed, "bonds": net.n_bonds, "dofs": net.ndof,
            "build_cpu_s": time.process_time() - t0}

@@ -134,3 +134,46 @@ def test_confinement_is_a_constant_lateral_traction():
     eq = Equilibrium(net, confinement=20e6)
     state, reason = Path(eq).hold(eq.initial(0.0), 20e6, FailureRule(0.0))
     assert reason is None and state.stress == pytest.approx(20e6, rel=1e-9)   # the bracketing tolerance
+
+
+#: Changed contacts allowed from a kept factor in the small-rank run of the fast-path test [1]: small enough that
+#: the tiny paths pass the switch from low-rank updates to a new factor many times.
+SMALL_RANK = 3
+
+
+@pytest.mark.parametrize("model", ["rigid", "fem"])
+def test_fast_path_breaks_the_same_bonds_as_the_direct_path(model):
+    """The cached assembly with low-rank updates of a kept factor (default, and with at most SMALL_RANK changed
+    contacts so that it refactorises often) against the plain direct path (every tangent assembled by sparse
+    products and factorised): the same bonds break in the same order, at stresses equal within 1e-9 relative
+    (the bracketing tolerance; the solves agree to a relative residual of 1e-14, tangent.FAST_RESIDUAL), and the fast path really
+    updated (low-rank solves counted, fewer factorisations than tangents)."""
+    s, p, lay = _tiny(model)
+    net = build_static_network(s, p, lay)
+    pd, sd = _path(net, reuse_factor=False)
+    for rank in (None, SMALL_RANK):
+        pf, sf = _path(net, **({} if rank is None else {"max_low_rank_contacts": rank}))
+        assert len(pd.records) >= BREAKS // 2
+        assert [k for r in pf.records for k in r.bonds] == [k for r in pd.records for k in r.bonds]
+        assert np.allclose([r.stress_before for r in pf.records], [r.stress_before for r in pd.records], rtol=1e-9)
+        assert np.allclose([r.stress_after for r in pf.records], [r.stress_after for r in pd.records], rtol=1e-9)
+        c = pf.eq.counters
+        assert c.low_rank > 0 and c.factorisations < c.tangents
+    assert pd.eq.counters.low_rank == 0 and pd.eq.counters.factorisations >= pd.eq.counters.iterations // 2
+
+
+def test_forget_factor_goes_on_as_a_fresh_equilibrium():
+    """The fast path's answers depend on the kept factor at round-off; after forget_factor() a path goes on bit for
+    bit as a new Equilibrium started from the same state does (what a saved and restored run needs)."""
+    s, p, lay = _tiny("fem")
+    net = build_static_network(s, p, lay)
+    eq = Equilibrium(net)
+    path = Path(eq)
+    state = path.run_closure(eq.initial(0.0), 0.02 * net.height, stop=lambda st, rec: len(rec) >= BREAKS // 2)
+    eq.forget_factor()
+    a = path.run_closure(state, 0.02 * net.height, stop=lambda st, rec: len(rec) >= BREAKS)
+    fresh = Path(Equilibrium(net))
+    b = fresh.run_closure(state, 0.02 * net.height, stop=lambda st, rec: len(rec) >= BREAKS // 2)
+    assert [k for r in path.records[BREAKS // 2:] for k in r.bonds] == [k for r in fresh.records for k in r.bonds]
+    assert [r.stress_before for r in path.records[BREAKS // 2:]] == [r.stress_before for r in fresh.records]
+    assert np.array_equal(a.u, b.u) and a.closure == b.closure

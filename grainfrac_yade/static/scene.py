@@ -341,9 +341,12 @@ class StaticScene:
         return out
 
     def save(self, path) -> None:
-        """An ``.npz`` of the core's state, strengths, bookkeeping and counters (exact doubles)."""
+        """An ``.npz`` of the core's state, strengths, bookkeeping and counters (exact doubles).  The kept factor is
+        dropped here (the solver's answers depend on it at round-off), so that the run that saves and the run that
+        restores go on from the same solver state, bit for bit."""
         with open(path, "wb") as fh:
             np.savez(fh, **self._arrays())
+        self.eq.forget_factor()
 
     def restore(self, path) -> None:
         """Replace this scene's state by the one :meth:`save` wrote (same specimen and parameters)."""
@@ -360,6 +363,7 @@ class StaticScene:
         for k in ("held", "iterations"):
             values[k] = int(values[k])
         self.state = State(**values)
+        self.eq.forget_factor()
         self.path.jt, self.path.jc = a["jt"].copy(), a["jc"].copy()
         self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()
         self._time = float(a["time"])

@@ -32,6 +32,7 @@ from scipy.sparse.csgraph import connected_components
 from ..errors import NumericalFailure
 from . import contacts as cl
 from .network import StaticNetwork
+from .tangent import MAX_LOW_RANK_CONTACTS, LowRankSolver, TangentPattern
 
 #: Active-set iterations per equilibrium before giving up [1]: each is one factorisation; a consistent set is
 #: normally found in a handful (measured on 10 x 20 mm, docs/studies/static_engine.md).
@@ -63,6 +64,36 @@ MAX_SPLIT_DEPTH = 12
 #: largest contact normal force [1]: contacts hovering at their open/close or stick/slip point within round-off
 #: of a path's sub-step (measured: 8e-4 N against forces of kN on 10 x 20 mm rigid cells).
 CYCLE_ACCEPT_REL = 1e-6
+
+
+#: Sets of fixed dofs (per set of closed contacts) kept [1]: a path meets a few; the cache is only emptied when full.
+FIXED_CACHE = 256
+#: Broken sets whose force rows are kept [1]: a break meets two (before and after it), a cascade a few more.
+ROWS_CACHE = 4
+
+
+class _PlainOp:
+    """A SuperLU factor of the tangent itself (the direct path)."""
+    fast = False
+
+    def __init__(self, lu):
+        self.lu = lu
+
+    def solve(self, kff, rhs):
+        return self.lu.solve(rhs)
+
+
+class _FastOp:
+    """The fast path's solve: the kept factor itself, or a low-rank update of it refined to FAST_RESIDUAL."""
+    fast = True
+
+    def __init__(self, op):
+        self.op = op
+
+    def solve(self, kff, rhs):
+        if self.op.z is None:
+            return self.op.direct(kff, rhs)
+        return self.op.solve(kff, rhs)
 
 
 class _Cycling(Exception):
@@ -102,6 +133,11 @@ class Counters:
     solve_seconds: float = 0.0      # CPU
     splits: int = 0                 # steps split in two because the active set cycled
     grounded: int = 0               # factorisations that needed the ground springs (a hinge or sliding group)
+    tangents: int = 0               # tangents assembled (status sets met)
+    low_rank: int = 0               # tangents solved by a low-rank update of a kept factor (no factorisation)
+    low_rank_refused: int = 0       # low-rank solves that did not reach the residual: factorised instead
+    back_substitutions: int = 0     # on kept factors for the low-rank updates' columns and refinements
+    assembly_seconds: float = 0.0   # CPU of assembling tangents and their free blocks
 
 
 class Equilibrium:
@@ -109,8 +145,12 @@ class Equilibrium:
 
     def __init__(self, net: StaticNetwork, confinement: float = 0.0,
                  max_iterations: int = MAX_ACTIVE_SET_ITERATIONS,
-                 changes_per_iteration: int = STATUS_CHANGES_PER_ITERATION, direction: float = 1.0):
-        """``direction`` +1: the platens close as the closure grows (compression); -1: they open (a pull)."""
+                 changes_per_iteration: int = STATUS_CHANGES_PER_ITERATION, direction: float = 1.0,
+                 reuse_factor: bool = True, max_low_rank_contacts: int = MAX_LOW_RANK_CONTACTS):
+        """``direction`` +1: the platens close as the closure grows (compression); -1: they open (a pull).
+        ``reuse_factor`` False: every tangent assembled by sparse products and factorised by SuperLU (the plain
+        direct path, the fast path's reference); True: the cached assembly and low-rank updates of a kept factor
+        (:mod:`.tangent`), at most ``max_low_rank_contacts`` changed contacts from it."""
         if max_iterations < 1 or changes_per_iteration < 1:
             raise ValueError("max_iterations and changes_per_iteration must be >= 1")
         self.net, self.max_iterations, self.changes_per_iteration = net, int(max_iterations), int(changes_per_iteration)
@@ -130,13 +170,34 @@ class Equilibrium:
         tri = net_tri_edges(net)
         self._tri_edges = tri
         self._order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
+        self.reuse_factor, self.max_low_rank_contacts = bool(reuse_factor), int(max_low_rank_contacts)
+        self._pattern = TangentPattern(net) if self.reuse_factor else None
+        self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
+
+    def forget_factor(self):
+        """Drop the kept factor (and with it the low-rank history): the next solve factorises afresh, as a new
+        ``Equilibrium`` on the same network would.  The fast path's answers depend on which factor is kept at
+        round-off (1e-12 relative); a caller that saves and restores a run calls this at every save, in the saved
+        and in the uninterrupted run alike, so that both go on bit for bit."""
+        self._key, self._lr, self._op, self._lu, self._k = None, None, None, None, None
 
     # ------------------------------------------------------------------ assembly
+    def force_rows(self, broken):
+        """The network's force rows at this broken set (:meth:`.network.StaticNetwork.force_rows`), kept for the
+        last few broken sets (the same matrices, so nothing changes but the work)."""
+        key = broken.tobytes()
+        hit = self._rows_cache.get(key)
+        if hit is None:
+            if len(self._rows_cache) >= ROWS_CACHE:
+                self._rows_cache.pop(next(iter(self._rows_cache)))
+            hit = self._rows_cache[key] = self.net.force_rows(broken)
+        return hit
+
     def tangent(self, status, sign, s_p, ground=False):
         """Tangent stiffness (ndof x ndof) of the affine law at these statuses."""
         n = self.net
         a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
-        gn, gt = n.force_rows(status != cl.INTACT)
+        gn, gt = self.force_rows(status != cl.INTACT)
         k = n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)
         if self._ground is None:      # each dof's own intact stiffness, once (its kind's median where it has none)
             d = np.abs(k.diagonal())
@@ -149,8 +210,17 @@ class Equilibrium:
 
     def fixed_dofs(self, status):
         """(fixed mask, number of dofs held because their group was cut loose, lateral pins)."""
-        n = self.net
         closed = status != cl.OPEN
+        key = closed.tobytes()
+        hit = self._fixed_cache.get(key)
+        if hit is None:
+            if len(self._fixed_cache) > FIXED_CACHE:
+                self._fixed_cache.clear()
+            hit = self._fixed_cache[key] = self._fixed_dofs(closed)
+        return hit[0].copy(), hit[1], hit[2]
+
+    def _fixed_dofs(self, closed):
+        n = self.net
         a, b = n.bond_nodes[closed, 0], n.bond_nodes[closed, 1]
         ea, eb = self._tri_edges
         nn = len(n.node_pos)
@@ -179,12 +249,64 @@ class Equilibrium:
         if key != self._key:
             self._grounded = False
             try:
-                self._factor_now(key, status, sign, s_p, False)
+                if self.reuse_factor:
+                    self._tangent_fast(key, status, sign, s_p)
+                else:
+                    self._factor_now(key, status, sign, s_p, False)
             except NumericalFailure:    # a hinge or a sliding group: once more with the ground springs
                 self._factor_now(key, status, sign, s_p, True)
         n = self.net
         _, _, _, _, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
-        return self._lu, self._k, self._gt.T @ b_s, self._fixed
+        # b_s is non-zero on broken (sticking) contacts only, whose force rows are their kinematic rows
+        b = (n.ct.T @ b_s) if self.reuse_factor else self._gt.T @ b_s
+        return self._lu, self._k, b, self._fixed
+
+    def _tangent_fast(self, key, status, sign, s_p):
+        """The fast path (:mod:`.tangent`): assemble on the cached pattern; solve by a low-rank update of the
+        kept factor where the tangent is close to it, else factorise it as the new reference."""
+        self._key = None
+        n = self.net
+        t0 = time.process_time()
+        a_nn, _, a_sn, a_ss, _, _ = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
+        coef = (a_nn, a_sn, a_ss, status != cl.INTACT)
+        fixed, held, _ = self.fixed_dofs(status)
+        data = self._pattern.data(*coef)
+        kff = self._pattern.free_block(data, fixed)
+        self._kfc = self._pattern.coupling(data, fixed)
+        self.counters.assembly_seconds += time.process_time() - t0
+        self.counters.tangents += 1
+        op = None
+        if self._lr is not None and np.array_equal(fixed, self._lr_fixed):
+            op = self._lr.prepare(coef)
+        self._fixed, self._held, self._kff, self._coef = fixed, held, kff, coef
+        if not kff.shape[0]:        # nothing free: nothing to solve
+            self._op, self._key, self._k, self._lu, self._lr = _PlainOp(None), key, None, None, None
+            return
+        if op is None:
+            op = self._refactor_fast()
+        elif op.z is not None:
+            self.counters.low_rank += 1
+        self._op, self._key, self._k, self._lu = _FastOp(op), key, None, None
+
+    def _refactor_fast(self):
+        """Factorise the current tangent (fast path) and keep it as the reference of later low-rank updates."""
+        kff = self._kff.copy()
+        kff.eliminate_zeros()       # the pattern's structural zeros (open contacts) stay out of the factor
+        t0 = time.process_time()
+        self._lr = None
+        try:
+            lu = spla.splu(kff, permc_spec="COLAMD") if kff.shape[0] else None
+        except RuntimeError:
+            raise NumericalFailure("static equilibrium: the stiffness matrix is singular") from None
+        finally:
+            self.counters.factor_seconds += time.process_time() - t0
+        self.counters.factorisations += 1
+        d = np.abs(lu.U.diagonal())
+        if d.min() <= PIVOT_RATIO * d.max():
+            raise NumericalFailure("static equilibrium: a pivot of the factor vanishes (a mechanism)")
+        self._lr = LowRankSolver(self.net, lu, self._coef, ~self._fixed, self.max_low_rank_contacts)
+        self._lr_fixed = self._fixed
+        return self._lr.prepare(self._coef)
 
     def _factor_now(self, key, status, sign, s_p, ground):
         """Assemble and factorise the free block at these statuses (``ground``: with the ground springs)."""
@@ -194,7 +316,7 @@ class Equilibrium:
         self._grounded = ground
         if ground:
             self.counters.grounded += 1
-        self._gn, self._gt = self.net.force_rows(status != cl.INTACT)
+        self._gn, self._gt = self.force_rows(status != cl.INTACT)
         free = ~fixed
         kff = k[free][:, free].tocsc()
         t0 = time.process_time()
@@ -207,6 +329,7 @@ class Equilibrium:
         self.counters.factorisations += 1
         self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
         self._kfc = k[free][:, fixed].tocsr()
+        self._op, self._lr = _PlainOp(lu), None
         if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread
             d = np.abs(lu.U.diagonal())
             if d.min() <= PIVOT_RATIO * d.max():
@@ -217,9 +340,18 @@ class Equilibrium:
         if not rhs.size:
             return rhs
         t0 = time.process_time()
-        x = lu.solve(rhs)
+        x = self._op.solve(kff, rhs)
+        if x is None:       # the low-rank update did not reach the residual: factorise this tangent
+            self.counters.low_rank_refused += 1
+            self.counters.solve_seconds += time.process_time() - t0
+            self._op = _FastOp(self._refactor_fast())
+            t0 = time.process_time()
+            x = self._op.solve(kff, rhs)
         self.counters.solve_seconds += time.process_time() - t0
         self.counters.solves += 1
+        if self._lr is not None:
+            self.counters.back_substitutions += self._lr.back_substitutions
+            self._lr.back_substitutions = 0
         if not np.all(np.isfinite(x)):
             raise NumericalFailure("static equilibrium: the solution is NaN or infinite (a singular system: a "
                                    "mechanism in the loading path)")
@@ -278,7 +410,7 @@ class Equilibrium:
     def platen_stress(self, u, fn, fs, broken, constant=True):
         """Platen stress [Pa, compression positive] of the internal forces (as ``elastic.solve_uniaxial``)."""
         n = self.net
-        gn, gt = n.force_rows(broken)
+        gn, gt = self.force_rows(broken)
         r = n.k_grain @ u + gn.T @ fn + gt.T @ fs
         if constant:
             r = r - self.f_ext
@@ -315,8 +447,8 @@ class Equilibrium:
         new = broken_now.broken & ~state.broken
         dn, ds = n.cn @ state.u, n.ct @ state.u
         fn_b, fs_b = cl.forces(dn, ds, broken_now.status, broken_now.sign, broken_now.s_p, n.kn, n.ks, n.tan_residual)
-        gn, gt = n.force_rows(state.broken)
-        gnb, gtb = n.force_rows(broken_now.broken)
+        gn, gt = self.force_rows(state.broken)
+        gnb, gtb = self.force_rows(broken_now.broken)
         w = new.astype(float)
         return -(gn.T @ (w * state.fn) + gt.T @ (w * state.fs) - gnb.T @ (w * fn_b) - gtb.T @ (w * fs_b))
 

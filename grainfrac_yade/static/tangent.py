@@ -1,0 +1,252 @@
+"""The fast path of the equilibrium's linear algebra: cached assembly and factor reuse by low-rank updates (pure).
+
+Assembly.  The tangent is K(s) = K_g + sum_i G_i^T A_i(s) C_i over contacts i (:mod:`.solver`), with A_i the 2 x 2
+affine law of contact i (a_nn, a_sn, a_ss; a_ns = 0) and G_i its force rows (torque arms while intact, the
+kinematic rows once broken).  Every contact's outer products g^T c are computed once on a fixed sparsity pattern
+(the union over all statuses), so a tangent is the constant K_g plus six sparse matrix-vector products of the
+coefficient vectors (:class:`TangentPattern`); the free block is a cached selection of the pattern's entries per
+set of fixed dofs.
+
+Factor reuse.  Between two status sets only the contacts whose (A_i, G_i) changed differ, each by a rank-2 term
+U_i V_i^T (U_i = G_i'^T A_i' - G_i^T A_i columns, V_i = C_i^T): a tangent within ``max_contacts`` changed contacts
+of a reference tangent whose SuperLU factor is kept is solved by the Sherman-Morrison-Woodbury formula on that
+factor (:class:`LowRankSolver`), K^-1 U cached per contact and status, then refined against the assembled new
+tangent until the relative residual is below :data:`FAST_RESIDUAL` (the level a direct SuperLU solve leaves).
+Anything else (more changes, another set of fixed dofs, a refinement that does not get there) makes a new
+reference factor: the caller falls back to the direct factorisation, which also does the singularity checks.
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+#: A low-rank (Woodbury) solve is accepted when its relative residual max|K x - b| / max|b| on the assembled new
+#: tangent is below RESIDUAL_MARGIN times the largest residual the direct solves on its reference factor left,
+#: or below FAST_RESIDUAL, whichever is larger [1].  Direct SuperLU solves leave 6e-16 (median) to 1.2e-15 (max)
+#: at 10 x 20 mm (392 solves of a fem path to 0.25 % strain) and 1.6e-14 to 2.0e-14 at paper size (the first 10
+#: solves); the low-rank solves 7e-16 to 2.4e-15 unrefined at 10 x 20 mm.  An accepted solution is then as exact
+#: as a direct one to within a factor 10 of round-off, far below what the bracketing (1e-9) and the tie rule
+#: (1e-12 relative on stress ratios) look at.
+RESIDUAL_MARGIN = 10.0
+FAST_RESIDUAL = 1e-14
+#: A refinement step must at least halve the residual [1], else the low-rank solve is refused (it stagnates at
+#: the capacitance's round-off) and the tangent factorised.
+REFINEMENT_GAIN = 0.5
+#: Refinement steps of a low-rank solve before giving up and refactorising [1]: each is one back-substitution on
+#: the reference factor; with a well-conditioned capacitance one or two reach FAST_RESIDUAL.
+MAX_REFINEMENT = 4
+#: Changed contacts relative to the reference factor beyond which the tangent is factorised anew [1]: each adds
+#: two back-substitutions (its K^-1 U columns) and two columns to every later solve, against one factorisation of
+#: ~18 back-substitutions at paper size (0.18 s / 0.010 s).  Measured (docs/studies/static_engine.md, "Cost at
+#: paper size"): 10 x 20 mm path to 0.8 % strain 18.4 / 15.8 / 16.0 CPU s at 16 / 48 / 128; paper-size creep at
+#: 160 MPa, events 1-200: 132.8 s at 48, 101.5 s at 128 (12 factorisations for 2,727 tangents).
+MAX_LOW_RANK_CONTACTS = 128
+
+
+def _outer_triplets(g: sp.csr_matrix, c: sp.csr_matrix):
+    """(row, col, value, contact) of every contact's outer product g_i^T c_i (rows of equal length)."""
+    g, c = g.tocsr(), c.tocsr()
+    gi, ci = np.diff(g.indptr), np.diff(c.indptr)
+    rows, cols, vals, who = [], [], [], []
+    for ng in np.unique(gi):            # contacts grouped by their rows' lengths: vectorised per group
+        for nc in np.unique(ci[gi == ng]):
+            sel = np.flatnonzero((gi == ng) & (ci == nc))
+            if not len(sel) or ng == 0 or nc == 0:
+                continue
+            gidx = g.indptr[sel][:, None] + np.arange(ng)
+            cidx = c.indptr[sel][:, None] + np.arange(nc)
+            r = np.repeat(g.indices[gidx], nc, axis=1)
+            v1 = np.repeat(g.data[gidx], nc, axis=1)
+            cc = np.tile(c.indices[cidx], (1, ng))
+            v2 = np.tile(c.data[cidx], (1, ng))
+            rows.append(r.ravel()), cols.append(cc.ravel()), vals.append((v1 * v2).ravel())
+            who.append(np.repeat(sel, ng * nc))
+    if not rows:
+        z = np.zeros(0, int)
+        return z, z, np.zeros(0), z
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), np.concatenate(who)
+
+
+class TangentPattern:
+    """The tangent K(s) of a network on one sparsity pattern (CSC, column-major), assembled from coefficients."""
+
+    #: The six (force row, kinematic row, coefficient) terms: intact bonds through G, broken contacts through C.
+    TERMS = (("gn", "cn", "nn"), ("gt", "cn", "sn"), ("gt", "ct", "ss"),
+             ("cn", "cn", "nn"), ("ct", "cn", "sn"), ("ct", "ct", "ss"))
+
+    def __init__(self, net):
+        self.net, n = net, net.ndof
+        kg = net.k_grain.tocoo()
+        parts = [(kg.row, kg.col, kg.data, None)]
+        trip = []
+        for gname, cname, _ in self.TERMS:
+            r, c, v, w = _outer_triplets(getattr(net, gname), getattr(net, cname))
+            trip.append((r, c, v, w))
+            parts.append((r, c, v, w))
+        diag = np.arange(n)
+        keys = np.concatenate([p[1].astype(np.int64) * n + p[0] for p in parts] + [diag * n + diag])
+        uniq, inv = np.unique(keys, return_inverse=True)
+        self.row, self.col = (uniq % n).astype(np.int64), (uniq // n).astype(np.int64)
+        self.nnz = len(uniq)
+        self.indptr = np.searchsorted(self.col, np.arange(n + 1))
+        off = len(kg.row)
+        self.base = np.bincount(inv[:off], weights=kg.data.astype(float), minlength=self.nnz).astype(float)
+        self.maps = []
+        for r, c, v, w in trip:
+            pos = inv[off:off + len(r)]
+            off += len(r)
+            self.maps.append(sp.csr_matrix((v.astype(float), (pos, w)), shape=(self.nnz, net.n_bonds)))
+        self._free_cache = {}
+
+    def data(self, a_nn, a_sn, a_ss, broken):
+        """The pattern's values at these per-contact coefficients (``broken``: rows C instead of G)."""
+        intact = ~broken
+        coef = {"nn": a_nn, "sn": a_sn, "ss": a_ss}
+        d = self.base.copy()
+        for (g, _, name), mp in zip(self.TERMS, self.maps):
+            w = np.where(broken, coef[name], 0.0) if g in ("cn", "ct") else np.where(intact, coef[name], 0.0)
+            d += mp @ w
+        return d
+
+    def full(self, data) -> sp.csc_matrix:
+        n = self.net.ndof
+        return sp.csc_matrix((data, self.row, self.indptr), shape=(n, n))
+
+    def free_block(self, data, fixed) -> sp.csc_matrix:
+        """The free x free block (CSC) of the tangent with these values."""
+        key = fixed.tobytes()
+        sel = self._free_cache.get(key)
+        if sel is None:
+            free = ~fixed
+            fmap = np.cumsum(free) - 1
+            take = np.flatnonzero(free[self.row] & free[self.col])
+            nf = int(free.sum())
+            indptr = np.searchsorted(fmap[self.col[take]], np.arange(nf + 1))
+            sel = (take, fmap[self.row[take]], indptr, nf)
+            if len(self._free_cache) > 64:
+                self._free_cache.clear()
+            self._free_cache[key] = sel
+        take, rows, indptr, nf = sel
+        return sp.csc_matrix((data[take], rows, indptr), shape=(nf, nf))
+
+    def coupling(self, data, fixed) -> sp.csc_matrix:
+        """The free x fixed block (CSC) of the tangent with these values."""
+        key = b"c" + fixed.tobytes()
+        sel = self._free_cache.get(key)
+        if sel is None:
+            free = ~fixed
+            fmap, xmap = np.cumsum(free) - 1, np.cumsum(fixed) - 1
+            take = np.flatnonzero(free[self.row] & fixed[self.col])
+            nx = int(fixed.sum())
+            indptr = np.searchsorted(xmap[self.col[take]], np.arange(nx + 1))
+            sel = (take, fmap[self.row[take]], indptr, (int(free.sum()), nx))
+            self._free_cache[key] = sel
+        take, rows, indptr, shape = sel
+        return sp.csc_matrix((data[take], rows, indptr), shape=shape)
+
+
+class LowRankSolver:
+    """Solves with a tangent K' = K + U V^T on the reference factor of K (Woodbury), refined against K' (module doc).
+    ``coef`` per contact: (a_nn, a_sn, a_ss, broken) of the reference; ``free`` its free dofs."""
+
+    def __init__(self, net, lu, coef, free, max_contacts=MAX_LOW_RANK_CONTACTS):
+        self.net, self.lu, self.coef, self.free, self.max_contacts = net, lu, coef, free, max_contacts
+        self._z = {}            # (contact, coefficients) -> (U columns, K^-1 U columns), free dofs
+        self.back_substitutions = 0
+        self.direct_residual = 0.0  # the largest relative residual of a direct solve on this factor
+        cols = np.flatnonzero(free)
+        m = net.n_bonds
+        # rows restricted to the free dofs, once per reference: 0..m-1 c_n, m..2m-1 c_t, then g_n, g_t
+        self._rows = sp.vstack([net.cn, net.ct, net.gn, net.gt]).tocsc()[:, cols].tocsr()
+        self._m = m
+
+    def _columns(self, i, new):
+        key = (int(i),) + tuple(float(x) for x in new[:3]) + (bool(new[3]),)
+        hit = self._z.get(key)
+        if hit is not None:
+            return hit
+        old = tuple(c[i] for c in self.coef)
+        m = self._m
+        dense = self._rows[[i, m + i, 2 * m + i, 3 * m + i]].toarray()
+
+        def rows(broken):
+            return (dense[0], dense[1]) if broken else (dense[2], dense[3])
+        gn1, gt1 = rows(new[3])
+        gn0, gt0 = rows(old[3])
+        wn = new[0] * gn1 + new[1] * gt1 - old[0] * gn0 - old[1] * gt0
+        wt = new[2] * gt1 - old[2] * gt0
+        u = np.stack([wn, wt], axis=1)
+        z = self.lu.solve(u)
+        self.back_substitutions += 2
+        self._z[key] = (u, z)
+        return u, z
+
+    def prepare(self, coef_new):
+        """The low-rank operator for the new coefficients, or None where it is not worth it (too many changes)."""
+        old_nn, old_sn, old_ss, old_b = self.coef
+        a_nn, a_sn, a_ss, b = coef_new
+        changed = np.flatnonzero((a_nn != old_nn) | (a_sn != old_sn) | (a_ss != old_ss) | (b != old_b))
+        if len(changed) > self.max_contacts:
+            return None
+        if not len(changed):
+            return _Woodbury(self, None, None, None)
+        zs = [self._columns(i, (a_nn[i], a_sn[i], a_ss[i], b[i])) for i in changed]
+        z = np.concatenate([q[1] for q in zs], axis=1)
+        # V's columns per contact are (c_n, c_t), interleaved to match U's (w_n, w_t) per contact
+        r = len(changed)
+        order = np.empty(2 * r, int)
+        order[0::2], order[1::2] = changed, self._m + changed
+        vt = self._rows[order]
+        cap = np.eye(2 * r) + vt @ z
+        try:
+            with warnings.catch_warnings():     # a singular capacitance (a mechanism) is refused just below
+                warnings.simplefilter("ignore", sla.LinAlgWarning)
+                lu_cap = sla.lu_factor(cap, check_finite=True)
+        except (ValueError, np.linalg.LinAlgError):
+            return None
+        if not np.all(np.isfinite(lu_cap[0])) or np.abs(np.diag(lu_cap[0])).min() == 0.0:
+            return None
+        return _Woodbury(self, z, vt, lu_cap)
+
+
+class _Woodbury:
+    def __init__(self, owner, z, vt, lu_cap):
+        self.owner, self.z, self.vt, self.lu_cap = owner, z, vt, lu_cap
+
+    def apply(self, rhs):
+        y = self.owner.lu.solve(rhs)
+        self.owner.back_substitutions += 1
+        if self.z is None:
+            return y
+        return y - self.z @ sla.lu_solve(self.lu_cap, self.vt @ y)
+
+    def direct(self, kff, rhs):
+        """The plain solve on the reference factor (``kff`` is its tangent); its residual is recorded."""
+        x = self.apply(rhs)
+        scale = np.abs(rhs).max()
+        if scale > 0 and np.all(np.isfinite(x)):
+            res = np.abs(kff @ x - rhs).max() / scale
+            self.owner.direct_residual = max(self.owner.direct_residual, res)
+        return x
+
+    def solve(self, kff, rhs):
+        """x with a relative residual within the accepted level (module constants), or None."""
+        scale = max(np.abs(rhs).max(), 1e-300)
+        accept = max(FAST_RESIDUAL, RESIDUAL_MARGIN * self.owner.direct_residual) * scale
+        x = self.apply(rhs)
+        last = np.inf
+        for _ in range(MAX_REFINEMENT + 1):
+            if not np.all(np.isfinite(x)):
+                return None
+            res = rhs - kff @ x
+            r = np.abs(res).max()
+            if r <= accept:
+                return x
+            if r > REFINEMENT_GAIN * last:
+                return None
+            last = r
+            x = x + self.apply(res)
+        return None
