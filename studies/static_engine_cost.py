@@ -30,6 +30,8 @@ from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 
+from .static_engine_probe import specimen_arguments
+
 
 def counters(eq, cpu, records, bonds):
     """The solver's counters and the CPU per equilibrium, per break (a record: a crossing and its cascade, as the
@@ -54,19 +56,12 @@ def sequence(records):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--params", action="append", default=[])
-    ap.add_argument("--width", type=float, default=10e-3)
-    ap.add_argument("--height", type=float, default=20e-3)
-    ap.add_argument("--seed", type=int, default=1)
+    ap = specimen_arguments(argparse.ArgumentParser())
     ap.add_argument("--breaks", type=int, default=10**9)
     ap.add_argument("--max-strain", type=float, default=0.02)
-    ap.add_argument("--creep-stress", type=float)
     ap.add_argument("--events", type=int, default=5)
-    ap.add_argument("--time-limit", type=float, default=1e13)
     ap.add_argument("--direct", action="store_true")
     ap.add_argument("--max-low-rank", type=int, help="changed contacts from a kept factor (solver default if unset)")
-    ap.add_argument("--set", action="append", default=[])
     ap.add_argument("--dump", help="write the break sequences (path and creep) to this JSON file")
     a = ap.parse_args(argv)
     p = load_parameters(extra_files=a.params,

@@ -48,16 +48,21 @@ def geometry(eq, state):
             "max_shear_disp_over_bond_length": slip, "max_cell_rotation_rad": theta}
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser()
+def specimen_arguments(ap):
+    """The arguments both static-engine study scripts take: parameter files, specimen size and seed, creep stress."""
     ap.add_argument("--params", action="append", default=[])
     ap.add_argument("--width", type=float, default=10e-3)
     ap.add_argument("--height", type=float, default=20e-3)
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--max-strain", type=float)
     ap.add_argument("--creep-stress", type=float)
     ap.add_argument("--time-limit", type=float, default=1e13)
     ap.add_argument("--set", action="append", default=[])
+    return ap
+
+
+def main(argv=None):
+    ap = specimen_arguments(argparse.ArgumentParser())
+    ap.add_argument("--max-strain", type=float)
     ap.add_argument("--skip-ucs", action="store_true")
     ap.add_argument("--changes-per-iteration", type=int, default=STATUS_CHANGES_PER_ITERATION)
     ap.add_argument("--max-iterations", type=int, default=MAX_ACTIVE_SET_ITERATIONS)

@@ -177,15 +177,6 @@ def platen_state(platens) -> dict:
     return platens.state_dict()
 
 
-def scene_arrays(scene) -> dict:
-    """The scene's bond bookkeeping for arrays.npz."""
-    return {"broken": scene.broken, "break_mode": scene.break_mode, "break_step": scene.break_step}
-
-
-def platen_state(platens) -> dict:
-    return platens.state_dict()
-
-
 def read(run_folder, test: str = "creep") -> tuple:
     """(checkpoint folder, state, arrays) of the ``test`` run in ``run_folder``; GrainfracError if it has
     none or it is bad."""

@@ -24,6 +24,8 @@ from ..law import failed_now
 
 #: Status of a contact: intact bond, broken and open, broken and sticking, broken and slipping.
 INTACT, OPEN, STICK, SLIP = 0, 1, 2, 3
+#: Names of the contact statuses, by code (what a message says).
+STATUS_NAMES = ("intact", "open", "stick", "slip")
 #: Relative force band [1] within which a contact at the friction limit keeps its status (stick or slip): the
 #: round-off of a solve (~1e-12 of the contact forces) would otherwise flip it back and forth.
 STATUS_HYSTERESIS = 1e-9

@@ -470,8 +470,9 @@ class Equilibrium:
             if key in seen and len(last) and worst <= CYCLE_ACCEPT_REL * scale:
                 return self._converged(closure, base, status, sign, u_last, it)
             if key in seen:
-                raise _Cycling(f"a status set came back after {it - 1} iterations; last changes "
-                               f"{[(int(w), int(status[w]), float(viol[w])) for w in last[:4]]}")
+                changes = ", ".join(f"contact {int(w)} to {cl.STATUS_NAMES[int(status[w])]} (off by {float(viol[w]):.3g} N)"
+                                    for w in last[:4])
+                raise _Cycling(f"a status set came back after {it - 1} iterations; last changes: {changes}")
             seen.add(key)
             u = self.displacements(closure, status, sign, base.s_p, base.u, extra)
             dn, ds = n.cn @ u, n.ct @ u
