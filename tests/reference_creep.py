@@ -78,7 +78,7 @@ def stored(name, folder):
 
     import pandas as pd
     sys.path.insert(0, str(ROOT))
-    from grainfrac_yade.protocols.columns import history_as_today, summary_as_today
+    from grainfrac_yade.runs.columns import history_as_today, summary_as_today
     summary = summary_as_today(json.loads((folder / f"reference_creep_{name}.json").read_text()))
     history = history_as_today(pd.read_csv(folder / f"reference_creep_{name}_history.csv",
                                            float_precision="round_trip"))

@@ -88,7 +88,7 @@ def test_engine_is_recorded_read_from_batch_tables_and_migrated():
 def test_old_step_names_are_read_as_today():
     """Histories and summaries of runs written before the step columns were renamed read as today's."""
     import pandas as pd
-    from grainfrac_yade.protocols.columns import history_as_today, summary_as_today
+    from grainfrac_yade.runs.columns import history_as_today, summary_as_today
     frame = history_as_today(pd.DataFrame({"dem_step": [1, 2], "dem_time_s": [0.1, 0.2], "axial_strain": [0, 1]}))
     assert list(frame.columns) == ["step", "time_s", "axial_strain"]
     assert history_as_today({"creep_time_s": 0.0, "dem_steps": 7}) == {"creep_time_s": 0.0, "step": 7}

@@ -31,7 +31,7 @@ from conftest import needs_yade
 # parameter keys added after the stored run was made, with the value the stored run had by construction
 from grainfrac_yade.params import ADDED_KEYS as ADDED_PARAMS
 # step columns and keys renamed after the stored run was made (read as today's; the stored files stay)
-from grainfrac_yade.protocols.columns import history_as_today, summary_as_today
+from grainfrac_yade.runs.columns import history_as_today, summary_as_today
 from platform_fingerprint import FINGERPRINT_KEYS, matching_set, stored_sets
 from reference_creep import UCS_COMMAND
 

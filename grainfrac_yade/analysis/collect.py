@@ -8,7 +8,7 @@ import pandas as pd
 
 from ..params import RENAMED_KEYS, migrate_tree
 from ..params import flatten as flatten_tree
-from ..protocols.columns import summary_as_today
+from ..runs.columns import summary_as_today
 from ..runs.slurm import FAILED, rows_without_runs
 
 #: Parameter paths copied from each run's params.json into the table (older params.json are read through

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
-from ..protocols.columns import history_as_today
+from ..runs.columns import history_as_today
 from ..runs.runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crack_phases, crackmaps, figures, rescale
 from .collect import code_version_note, collect_runs, flatten

@@ -57,7 +57,7 @@ from ..errors import GrainfracError
 from ..grains import grain_model
 from ..runs.runio import (ARRAYS_FILE, CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, SCENE_FILE,  # noqa: F401
                           check_files, checkpoint_folder, code_version)
-from .columns import HISTORY_RENAMED
+from ..runs.columns import HISTORY_RENAMED
 
 #: Layout of state.json and arrays.npz; a checkpoint of another layout is refused.
 FORMAT = 1
@@ -204,7 +204,7 @@ def read(run_folder, test: str = "creep") -> tuple:
 
 def history_arrays(arrays: dict, prefix: str, columns) -> dict:
     """The history columns a checkpoint's arrays.npz holds under ``prefix``, by today's names (older checkpoints
-    hold some under their old names, :data:`grainfrac_yade.protocols.columns.HISTORY_RENAMED`)."""
+    hold some under their old names, :data:`grainfrac_yade.runs.columns.HISTORY_RENAMED`)."""
     old = {new: name for name, new in HISTORY_RENAMED.items() if prefix + name in arrays}
     return {k: arrays[prefix + (k if prefix + k in arrays else old[k])].tolist() for k in columns}
 

@@ -55,7 +55,7 @@ from ..vtkio import due_times, merged_frame_note
 from ..wave import HoldBudget, hold_budget, scene_density
 from .checkpoints import Checkpointer, START_TABLE, base_state, inexact_note, platen_state, read, restore_platens, \
     restore_scene, scene_arrays
-from .columns import history_as_today
+from ..runs.columns import history_as_today
 from .confinement import broken_apart_reason
 from .cracks import bond_is_inter, broken_counts
 from .creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop

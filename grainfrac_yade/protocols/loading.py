@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import NumericalFailure
 from ..law import check_finite
-from .columns import STEP, STEPS
+from ..runs.columns import STEP, STEPS
 
 #: Bonds sampled for the mean bond force (every k-th of the given ones, k = len // this).
 BOND_FORCE_SAMPLE = 500
