@@ -224,6 +224,16 @@ def test_creep_hold_bad_target_is_one_line():
     assert "\n" not in str(exc.value)
 
 
+def test_creep_with_a_law_that_changes_stiffness_is_one_line():
+    """The area law changes the bonds' stiffness, which the static creep hold does not follow: refused."""
+    from grainfrac_yade.errors import GrainfracError
+    p = _params("stress_corrosion.law=area")
+    scene = engine_for(p).build_scene(build_specimen(p, 1), p)
+    with pytest.raises(GrainfracError, match="fix:") as exc:
+        engine_for(p).stress_corrosion(scene, p.stress_corrosion)
+    assert "\n" not in str(exc.value)
+
+
 def test_creep_killed_and_resumed_gives_the_uninterrupted_run(tmp_path, monkeypatch):
     """Checkpoints at every safe point (ramp, events, relaxations), the run killed after the sixth and resumed from
     it: history (but for wall times), events, failure and break times as the uninterrupted run's."""

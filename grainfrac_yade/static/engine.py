@@ -27,7 +27,8 @@ import numpy as np
 from ..errors import GrainfracError
 from ..law import MODE_CORRODED, Stresses, check_finite
 from ..protocols.corrosion import BondCorrosion
-from .scene import STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, build_scene, consolidate, scene_from_state  # noqa: F401
+from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, build_scene, consolidate,  # noqa: F401
+                    scene_from_state)
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
