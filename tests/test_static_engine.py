@@ -153,15 +153,116 @@ def test_misspelt_engine_flag_is_one_line(capsys, tmp_path):
     assert not (tmp_path / "x").exists()
 
 
-def test_paper_clock_and_creep_refused_in_one_line(capsys, tmp_path):
-    """The paper clock needs dynamics; the static creep hold is not on the scene interface yet."""
-    common = ["--engine", "static", "--width", "3e-3", "--height", "6e-3", "--stress", "100e6",
+def test_paper_clock_refused_in_one_line(capsys, tmp_path):
+    """The paper clock needs dynamics (the static creep hold runs with the event clock)."""
+    common = ["--engine", "static", "--width", "3e-3", "--height", "6e-3", "--stress", "100",
               "--out", str(tmp_path / "x")]
     rc, out = _cli(capsys, "creep", *common, "--set", "stress_corrosion.clock=paper")
     assert rc == 2 and out.err.count("\n") == 1 and "paper clock" in out.err and "fix:" in out.err
-    rc, out = _cli(capsys, "creep", *common)
-    assert rc == 2 and out.err.count("\n") == 1 and "creep" in out.err and "fix:" in out.err
     assert not (tmp_path / "x").exists()
+
+
+#: A tiny creep row on the static engine: 4 x 8 mm, seed 1, at 160 MPa (about 0.68 x its UCS: fails after a few
+#: events, in about a second).
+CREEP_ROW = ["--engine", "static", "--width", "4e-3", "--height", "8e-3", "--stress", "160", "--seed", "1"]
+#: summary.json keys that name the code or measure the machine, not the run
+NOT_THE_RUN = ("code_version", "wall_s", "cpu_s")
+
+
+def _creep_cli(capsys, out):
+    rc, _ = _cli(capsys, "creep", *CREEP_ROW, "--out", str(out))
+    assert rc == 0
+    return json.loads((out / "summary.json").read_text())
+
+
+def test_creep_runs_through_the_protocol_with_the_event_clock(capsys, tmp_path):
+    """creep --engine static: the protocol's ramp, hold and event clock on the static scene; the usual run
+    folder with finite values, and a lifetime from the core's failure rule (or a stated end)."""
+    import pandas as pd
+    s = _creep_cli(capsys, tmp_path / "a")
+    for name in ("summary.json", "history.csv", "cracks.csv"):
+        assert (tmp_path / "a" / name).is_file(), name
+    assert s["numerical_failure"] is False and s["failed_on_loading"] is False
+    assert s["failed"] is True and s["lifetime_s"] > 0 and math.isfinite(s["lifetime_s"]) and s["failure_reason"]
+    assert s["n_events"] >= 1 and s["broken_creep"] >= 1
+    hist = pd.read_csv(tmp_path / "a" / "history.csv")
+    assert np.isfinite(hist.select_dtypes("number").to_numpy()).all()
+    held = hist["axial_stress_pa"].to_numpy()[1:-1]   # the ramp's end (overshoot) and the failed row aside
+    assert np.allclose(held, 160e6, rtol=1e-6)
+    assert hist["creep_time_s"].is_monotonic_increasing
+    cracks = pd.read_csv(tmp_path / "a" / "cracks.csv")
+    assert len(cracks) == s["broken_total"] and np.isfinite(cracks.select_dtypes("number").to_numpy()).all()
+
+
+def test_creep_row_twice_is_identical(capsys, tmp_path):
+    """Deterministic: the same row twice gives the same summary (but for the machine's times) and cracks."""
+    a, b = _creep_cli(capsys, tmp_path / "a"), _creep_cli(capsys, tmp_path / "b")
+    for k in NOT_THE_RUN:
+        a.pop(k, None), b.pop(k, None)
+    assert json.dumps(a, sort_keys=True, default=str) == json.dumps(b, sort_keys=True, default=str)
+    assert (tmp_path / "a" / "cracks.csv").read_bytes() == (tmp_path / "b" / "cracks.csv").read_bytes()
+
+
+def test_creep_hold_failure_is_the_core_rule():
+    """Under the held stress a run's relaxation is one solve to it (Path.hold); once the failure rule says the
+    load cannot be regained the scene is out of equilibrium and the servo saturated closing."""
+    from grainfrac_yade.protocols.creep import run_creep
+    p = _params("specimen.width=4e-3", "specimen.height=8e-3")
+    run = run_creep(build_specimen(p, 1), p, 160e6)
+    scene, servo = run.scene, run.servo
+    assert run.failed and scene.hold_failure.startswith(("collapse", "no equilibrium"))
+    assert scene.unbalanced(1.0)[1] == math.inf and servo.clipped == 1 and servo.closing_clipped_steps > 0
+    assert run.rows[-2]["axial_stress_pa"] == pytest.approx(160e6, rel=1e-9)
+
+
+def test_creep_hold_bad_target_is_one_line():
+    from grainfrac_yade.errors import GrainfracError
+    p = _params()
+    pl = engine_for(p).build_scene(build_specimen(p, 1), p).attach_platens("free")
+    with pytest.raises(GrainfracError, match="fix:") as exc:
+        pl.hold_stress(-1.0, 70e9, 100, 1.0)
+    assert "\n" not in str(exc.value)
+
+
+def test_creep_with_a_law_that_changes_stiffness_is_one_line():
+    """The area law changes the bonds' stiffness, which the static creep hold does not follow: refused."""
+    from grainfrac_yade.errors import GrainfracError
+    p = _params("stress_corrosion.law=area")
+    scene = engine_for(p).build_scene(build_specimen(p, 1), p)
+    with pytest.raises(GrainfracError, match="fix:") as exc:
+        engine_for(p).stress_corrosion(scene, p.stress_corrosion)
+    assert "\n" not in str(exc.value)
+
+
+def test_creep_killed_and_resumed_gives_the_uninterrupted_run(tmp_path, monkeypatch):
+    """Checkpoints at every safe point (ramp, events, relaxations), the run killed after the sixth and resumed from
+    it: history (but for wall times), events, failure and break times as the uninterrupted run's."""
+    import grainfrac_yade.protocols.checkpoints as checkpoints
+    from grainfrac_yade.protocols.creep import resume_creep, run_creep
+    p = _params("specimen.width=4e-3", "specimen.height=8e-3", "numerics.checkpoint_interval=1e-9")
+    whole = run_creep(build_specimen(p, 1), p, 160e6, checkpoint_folder=tmp_path / "whole",
+                      run_values={"seed": 1})
+    write, written = checkpoints.Checkpointer.write, []
+
+    def killed_after_six(self, *args, **kwargs):
+        write(self, *args, **kwargs)
+        written.append(1)
+        if len(written) == 6:
+            raise KeyboardInterrupt
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", killed_after_six)
+    with pytest.raises(KeyboardInterrupt):
+        run_creep(build_specimen(p, 1), p, 160e6, checkpoint_folder=tmp_path / "cut", run_values={"seed": 1})
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
+    resumed = resume_creep(build_specimen(p, 1), p, 160e6, tmp_path / "cut")
+    assert resumed.resumes and whole.n_events > 1
+
+    def rows(run):
+        return [{k: v for k, v in r.items() if k != "wall_s"} for r in run.rows]
+    assert rows(resumed) == rows(whole)
+    assert (resumed.n_events, resumed.failed, resumed.failure_reason) == (whole.n_events, whole.failed,
+                                                                          whole.failure_reason)
+    assert np.array_equal(resumed.break_time, whole.break_time, equal_nan=True)
+    assert np.array_equal(resumed.scene.broken, whole.scene.broken)
 
 
 def test_dynamic_only_setting_warns_once():

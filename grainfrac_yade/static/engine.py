@@ -7,9 +7,11 @@ each followed along the sequentially linear path with bonds broken one at a time
 imports YADE.
 
 What the protocols reach through an engine module: ``build_scene``, ``scene_from_state``, ``consolidate`` (the
-isotropic stage of a confined test).  Not in the static engine yet, each refused with one line naming the fix
-(:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the creep hold (a held platen
-stress in the static scene), the Brazilian jaws and levers, VTK series.
+isotropic stage of a confined test) and ``stress_corrosion`` (the creep test's bond writer, :class:`StaticCorrosion`:
+the creep test of :mod:`grainfrac_yade.protocols.creep` runs on the static scene's held platen stress with the event
+clock; the paper clock needs dynamics and is refused).  Not in the static engine yet, each refused with one line
+naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the Brazilian jaws
+and levers, VTK series, bench.
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
@@ -20,8 +22,13 @@ from __future__ import annotations
 
 import importlib.metadata
 
+import numpy as np
+
 from ..errors import GrainfracError
-from .scene import VTK_REFUSED, StaticScene, build_scene, consolidate, scene_from_state  # noqa: F401
+from ..law import MODE_CORRODED, Stresses, check_finite
+from ..protocols.corrosion import BondCorrosion
+from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, build_scene, consolidate,  # noqa: F401
+                    scene_from_state)
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
@@ -31,8 +38,6 @@ AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
 
 #: Commands the static engine cannot run yet -> the one line that says so and the fix.
 UNSUPPORTED = {
-    "creep": ("the static engine's creep hold needs a held platen stress in the static scene (the creep protocol "
-              "drives a stress servo; not built yet); fix: --engine yade (numerics.engine = \"yade\")"),
     "bench": ("the static engine has no DEM steps to time (bench measures YADE's stepping and creep runs); fix: "
               "bench with numerics.engine = \"yade\""),
     "brazilian": ("the static engine's Brazilian test needs the disc's jaws in the static core (not built yet); "
@@ -49,14 +54,68 @@ def _refuse(what: str):
     raise GrainfracError(UNSUPPORTED[what])
 
 
-def run_creep(*args, **kwargs):
-    """Refused (:data:`UNSUPPORTED`)."""
-    _refuse("creep")
+class StaticCorrosion(BondCorrosion):
+    """A degradation law's state on a static scene's bonds (:class:`BondCorrosion`): reads the solved bond forces,
+    writes the law's strengths into the path's (J^T, J^C per intact area, as the core's own creep hold does,
+    :mod:`.creep`) and hands the bonds at their failure point to the scene's next solve."""
+
+    name = "StressCorrosion"
+
+    def __init__(self, scene: StaticScene, sc_params):
+        self.scene = scene
+        super().__init__(scene.layout, scene.props, sc_params)
+        if not self.law.exact_jump:
+            raise GrainfracError(STIFFNESS_LAW_REFUSED)
+
+    def stresses(self, idx) -> Stresses:
+        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``; NumericalFailure if not finite."""
+        idx = np.asarray(idx, dtype=np.int64)
+        fn, fs = self.scene.bond_forces(idx)
+        check_finite("bond normal force", fn, idx)
+        check_finite("bond shear force", fs, idx)
+        return Stresses(idx, fn / self.area0[idx], fs / self.area0[idx])
+
+    def intact(self) -> np.ndarray:
+        return np.flatnonzero(~self.scene.broken)
+
+    def write(self, idx):
+        """The law's strengths of bonds ``idx`` into the scene (no solve: the next one follows them)."""
+        idx = np.asarray(idx, dtype=np.int64)
+        jt, jc, _ = self.law.strengths(self.state.subset(idx))
+        check_finite("strength written to a static bond", jt, idx)
+        check_finite("strength written to a static bond", jc, idx)
+        self.scene.write_bond_strengths(idx, jt, jc)
+
+    def hand_over_failures(self, idx, sigma, tau, modes):
+        """Bonds ``idx`` at their failure point (written strengths at their stresses, :data:`MODE_CORRODED`: none
+        left): broken at the scene's next solve (:meth:`.scene.StaticScene.hand_over`)."""
+        idx = np.asarray(idx, dtype=np.int64)
+        corroded = idx[np.asarray(modes) == MODE_CORRODED]
+        if len(corroded):
+            self.scene.write_bond_strengths(corroded, 0.0, 0.0)
+        self.scene.hand_over(idx)
+
+    def degrade(self, dt, stresses: Stresses):
+        """The law for creep time ``dt`` under frozen ``stresses``, written (the paper clock's step)."""
+        self.advance(dt, stresses)
+        self.write(stresses.index)
+
+    def load_state(self, state: dict, write: bool = True):
+        """Restore :meth:`state_dict` output; ``write``: into the scene's bonds (False after a checkpoint's restore,
+        whose scene file holds the strengths)."""
+        self.load_arrays(state)
+        if write:
+            self.write(self.intact())
 
 
-def resume_creep(*args, **kwargs):
-    """Refused (:data:`UNSUPPORTED`)."""
-    _refuse("creep")
+def stress_corrosion(scene: StaticScene, sc_params, saved: dict | None = None) -> StaticCorrosion:
+    """The creep test's bond writer of a static ``scene`` (``[stress_corrosion]`` parameters), listed among its
+    drivers; ``saved``: the law's state from a checkpoint (the strengths came back with the scene)."""
+    corr = StaticCorrosion(scene, sc_params)
+    if saved is not None:
+        corr.load_state(saved, write=False)
+    scene.drivers.append(corr)
+    return corr
 
 
 def apply_levers(*args, **kwargs):

@@ -13,6 +13,13 @@ The test protocols (:mod:`grainfrac_yade.protocols`) drive it unchanged; their c
 * **steps** counts equilibria solved (:class:`.solver.Counters`); **time** is the load parameter [s]: the time a
   machine closing at the protocol's speed would take to this closure (a UCS history's ``time_s`` therefore
   reads as YADE's DEM time at the same strain).
+* **hold_stress(S)** (the creep hold): load control at S from then on (:class:`StaticServo`): ``run(n)`` and
+  ``equilibrate`` break what the creep law took to its strength (the cascade at the reached closure) and regain S
+  along the path (:meth:`.cascade.Path.hold`, one solve to the held stress, whatever n); a held stress above S (the
+  ramp's overshoot) is first unloaded to S.  Where the core's failure rule (:mod:`.failure`) says the specimen
+  cannot hold S, the scene stays in the state reached, reports itself out of equilibrium (:meth:`StaticScene.
+  unbalanced` infinite) and the servo saturated closing: the protocol's collapse watch or its relaxation budget
+  ends the run as a failure (:data:`HOLD_FAILED_UNBALANCED`).
 * **confine(sigma_3)**: a constant lateral traction on the side nodes (a dead load, :meth:`.network.StaticNetwork.
   confinement_force`); the isotropic stage is the path to an axial stress sigma_3 (:func:`consolidate`).
 * **save / restore**: an ``.npz`` of the core's state (displacements, contact statuses, shear references, forces,
@@ -23,7 +30,8 @@ The test protocols (:mod:`grainfrac_yade.protocols`) drive it unchanged; their c
 Where no set of contact statuses settles (frictional contacts with a non-associated slip rule need not have a
 unique quasi-static equilibrium) the core raises :class:`~grainfrac_yade.errors.NumericalFailure`: the protocols
 end the run as a numerical failure with that reason.  Rough platens and the Brazilian jaws are not in the core
-yet: refused with one line.
+yet: refused with one line.  The creep hold follows a law that changes strengths only (a law that changes the
+bonds' stiffness, the area law, is refused in one line: :data:`STIFFNESS_LAW_REFUSED`).
 """
 from __future__ import annotations
 
@@ -34,6 +42,7 @@ import numpy as np
 from ..engines import SceneState
 from ..errors import GrainfracError, NumericalFailure
 from ..grains import layout_for
+from ..layout import bond_properties
 from . import contacts as cl
 from .cascade import Path
 from .failure import FailureRule
@@ -58,9 +67,17 @@ def load_increment(params) -> float:
     return params.ucs.record_strain_increment / params.ucs.strain_rate
 
 
-#: The one line that refuses a held platen stress (the creep hold) on the static engine.
-HOLD_REFUSED = ("static engine: a held platen stress (the creep hold of protocols/creep.py) is not in the static "
-                "scene yet; fix: --engine yade (numerics.engine = \"yade\")")
+#: What :meth:`StaticScene.unbalanced` reports once the failure rule says the held load cannot be regained [N and
+#: 1]: no equilibrium exists under it, so the protocol's equilibrium check never passes (its relaxation budget, or
+#: its collapse watch first, ends the run as a failure).
+HOLD_FAILED_UNBALANCED = math.inf
+#: Newton steps of the unloading to a held stress below the ramp's end [1]: along one linear branch the first step
+#: lands on it; a status change on the way (a closed contact opening) costs one more each.
+MAX_UNLOAD_STEPS = 50
+#: The one line that refuses a degradation law that changes the bonds' stiffness on the static engine.
+STIFFNESS_LAW_REFUSED = ("static engine: the creep hold follows laws that lower strengths only; this law changes the "
+                         "bonds' stiffness (the area law); fix: stress_corrosion.law = \"hillig_charles\", or "
+                         "--engine yade")
 #: The one line that refuses a VTK series on the static engine.
 VTK_REFUSED = "static engine: VTK series (--vtk-every) are not written yet; fix: leave out --vtk-every, or --engine yade"
 
@@ -79,13 +96,27 @@ class StaticPlatens:
         # reference positions (what a checkpoint keeps of YADE's platens): the closure is measured from them
         self.y0_top, self.y0_bottom, self.x0_gap = net.height, 0.0, net.width
 
-    def hold_stress(self, target: float, young: float, response_steps: int, max_speed: float):
-        """Refused: a held stress on the static platens (the creep hold) is not built yet (one line)."""
-        raise GrainfracError(HOLD_REFUSED)
+    def hold_stress(self, target: float, young: float, response_steps: int, max_speed: float) -> "StaticServo":
+        """Load control at ``target`` [Pa] from here on (module doc): a :class:`StaticServo`, listed among the scene's
+        drivers; ``young`` and ``response_steps`` only set its nominal gain (the held stress is solved, not servoed)."""
+        if not (math.isfinite(target) and target > 0):
+            raise GrainfracError(f"static engine: a held platen stress must be finite and > 0 Pa (got {target!r}); "
+                                 "fix: a positive creep stress")
+        gain = self.height / (young * response_steps) if young > 0 and response_steps > 0 else 0.0
+        return self._servo(StaticServo(self.scene, float(target), gain, float(max_speed)))
 
-    def resume_hold(self, saved: dict):
-        """Refused, as :meth:`hold_stress`."""
-        raise GrainfracError(HOLD_REFUSED)
+    def resume_hold(self, saved: dict) -> "StaticServo":
+        """:meth:`hold_stress` as a checkpoint saved it (``saved``: the servo's attributes by name; the hold's
+        own state, failure included, came back with the scene's file)."""
+        servo = StaticServo(self.scene, float(saved["target"]), float(saved["gain"]), float(saved["max_speed"]))
+        servo.closing_clipped_steps = int(saved.get("closing_clipped_steps", 0))
+        return self._servo(servo)
+
+    def _servo(self, servo: "StaticServo") -> "StaticServo":
+        scene = self.scene
+        scene.drivers = [d for d in scene.drivers if not isinstance(d, StaticServo)] + [servo]
+        scene.hold_target = servo.target
+        return servo
 
     def set_axial_velocity(self, closing_speed: float) -> None:
         """The platens approach each other at ``closing_speed`` [m/s of the load parameter]."""
@@ -115,6 +146,36 @@ class StaticPlatens:
 
     def rebind(self, reaction: float) -> None:
         """After a restore: nothing to fetch (the stress is the restored state's)."""
+
+
+class StaticServo:
+    """The held platen stress of a static scene: what the creep protocol reads of a stress servo.  The stress is
+    solved at the target (module doc), so the servo never clips, unless the failure rule says the target cannot be
+    regained: then it reads as saturated closing (``clipped`` +1, ``closing_clipped_steps`` growing by the steps
+    asked of the scene), which is how a platen that cannot hold its load looks to the protocol."""
+
+    name = "StaticStressHold"
+
+    def __init__(self, scene: "StaticScene", target: float, gain: float, max_speed: float):
+        self.scene, self.target, self.gain, self.max_speed = scene, target, gain, max_speed
+        self.closing_clipped_steps = 0
+
+    @property
+    def stress(self) -> float:
+        """The axial stress of the solved state [Pa]."""
+        return float(self.scene.state.stress)
+
+    @property
+    def clipped(self) -> int:
+        return 1 if self.scene.hold_failure else 0
+
+    def count(self, n_steps: int) -> None:
+        """``n_steps`` asked of the scene: saturated closing while the held load is lost, none otherwise."""
+        self.closing_clipped_steps = self.closing_clipped_steps + int(n_steps) if self.scene.hold_failure else 0
+
+    def state_dict(self) -> dict:
+        return {"target": self.target, "gain": self.gain, "max_speed": self.max_speed, "stress": self.stress,
+                "clipped": self.clipped, "closing_clipped_steps": self.closing_clipped_steps}
 
 
 class StaticConfinement:
@@ -157,6 +218,15 @@ class StaticScene:
         self.break_mode = np.zeros(m, np.int8)
         self.break_step = np.full(m, -1, np.int64)
         self.state = self.eq.initial(0.0)
+        #: the bonds' intact properties in the layout's order (:func:`grainfrac_yade.layout.bond_properties`)
+        self.props = bond_properties(specimen, self.layout, params)
+        #: the held platen stress [Pa] (:meth:`StaticPlatens.hold_stress`), None under displacement control
+        self.hold_target = None
+        #: the failure rule's reason once the held stress cannot be regained ("" while it is held)
+        self.hold_failure = ""
+        #: canonical bonds the creep law took to their failure point, broken at the next solve if the cascade did not
+        self.hold_pending = np.zeros(0, np.int64)
+        self.hold_rule = FailureRule(params.creep.collapse_strain_increment)
 
     # ------------------------------------------------------------------ counters
     @property
@@ -182,7 +252,11 @@ class StaticScene:
         return next((d for d in self.drivers if isinstance(d, StaticPlatens)), None)
 
     def run(self, n_steps: int) -> None:
-        """``n_steps`` increments of the load parameter, the closure following the platens' speed."""
+        """``n_steps`` increments of the load parameter, the closure following the platens' speed; under a held
+        stress one solve to it, whatever ``n_steps`` (:meth:`hold`)."""
+        if self.hold_target is not None:
+            self.hold(n_steps)
+            return
         pl = self._platens()
         speed = pl.velocity if pl is not None else 0.0
         for _ in range(int(n_steps)):
@@ -199,7 +273,10 @@ class StaticScene:
         self._take(state)
 
     def unbalanced(self, reference: float) -> tuple:
-        """(0, 0): a solved static state is in equilibrium (the active-set solution is exact to round-off)."""
+        """(0, 0): a solved static state is in equilibrium (the active-set solution is exact to round-off); infinite
+        once the held stress cannot be regained (:data:`HOLD_FAILED_UNBALANCED`)."""
+        if self.hold_failure:
+            return HOLD_FAILED_UNBALANCED, HOLD_FAILED_UNBALANCED
         return 0.0, 0.0
 
     def relaxation_damping(self, damping: float) -> None:
@@ -208,8 +285,47 @@ class StaticScene:
     def equilibrate(self, balanced, check_steps: int, max_steps: int):
         """One solve at the current closure and loads, and the cascade of what is at its strength: 1 step."""
         before = self.steps
-        self._take(self.path.cascade(self.eq.solve(self.state.closure, self.state)))
+        if self.hold_target is not None:
+            self.hold(1)
+        else:
+            self._take(self.path.cascade(self.eq.solve(self.state.closure, self.state)))
         return max(1, self.steps - before)
+
+    def hold(self, n_steps: int = 1) -> None:
+        """Under the held stress: the cascade of what is at its strength at the reached closure (the bonds handed
+        over by the creep law among it), then the path back to the held stress (:meth:`.cascade.Path.hold`, with the
+        failure rule of :mod:`.failure`); a stress above it (the ramp's overshoot) unloaded to it first.  Once the
+        rule says the load cannot be regained, nothing moves any more (module doc)."""
+        servo = next((d for d in self.drivers if isinstance(d, StaticServo)), None)
+        if not self.hold_failure:
+            state = self.path.cascade(self.state)
+            for c in self.hold_pending:
+                if not state.broken[c]:
+                    state = self.path.cascade(state, first=int(c))
+            self.hold_pending = np.zeros(0, np.int64)
+            state = self._unload(state, self.hold_target)
+            state, reason = self.path.hold(state, self.hold_target, self.hold_rule)
+            self._take(state)
+            self.hold_failure = reason or ""
+        if servo is not None:
+            servo.count(n_steps)
+
+    def _unload(self, state: State, target: float) -> State:
+        """``state`` with its platen stress brought down to ``target`` [Pa] if above it, by Newton steps on the
+        tangent response (opening platens break nothing; a cascade is checked after)."""
+        for _ in range(MAX_UNLOAD_STEPS):
+            if state.stress <= target * (1 + self.path.bracket_tol):
+                break
+            _, _, _, slope = self.eq.response(state)
+            if not slope > 0:
+                break
+            state = self.eq.solve(state.closure - (state.stress - target) / slope, state)
+        return self.path.cascade(state)
+
+    def hand_over(self, indices) -> None:
+        """Bonds ``indices`` (layout order) reached their failure point under the creep law: broken at the next
+        solve, by the cascade (their strengths are written) or alone if it leaves them intact."""
+        self.hold_pending = np.union1d(self.hold_pending, self._idx(indices))
 
     def _take(self, state: State) -> None:
         if not (math.isfinite(state.stress) and np.all(np.isfinite(state.fn)) and np.all(np.isfinite(state.fs))):
@@ -337,7 +453,9 @@ class StaticScene:
         out = {"state_" + k: np.asarray(getattr(self.state, k)) for k in STATE_FIELDS}
         out.update(jt=self.path.jt, jc=self.path.jc, broken=self.broken, break_mode=self.break_mode,
                    break_step=self.break_step, time=np.float64(self._time), steps=np.int64(self.steps),
-                   confinement=np.float64(self.confinement_stress), n_bonds=np.int64(self.n_bonds))
+                   confinement=np.float64(self.confinement_stress), n_bonds=np.int64(self.n_bonds),
+                   hold_target=np.float64(math.nan if self.hold_target is None else self.hold_target),
+                   hold_failure=np.str_(self.hold_failure), hold_pending=self.hold_pending)
         return out
 
     def save(self, path) -> None:
@@ -368,6 +486,10 @@ class StaticScene:
         self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()
         self._time = float(a["time"])
         self._steps_offset = int(a["steps"]) - self.eq.counters.equilibria
+        target = float(a["hold_target"]) if "hold_target" in a else math.nan
+        self.hold_target = None if math.isnan(target) else target
+        self.hold_failure = str(a["hold_failure"]) if "hold_failure" in a else ""
+        self.hold_pending = a["hold_pending"].astype(np.int64) if "hold_pending" in a else np.zeros(0, np.int64)
 
     def checkpoint_state(self) -> dict:
         return {"n_bodies": int(len(self.net.node_pos)), "n_bonds": self.n_bonds, "engine": "static"}
