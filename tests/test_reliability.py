@@ -173,6 +173,27 @@ def _event_loop(bonds, holder=None):
     return n, holder, clock
 
 
+def test_a_numerical_failure_in_the_event_loop_keeps_the_count_of_the_events_before_it():
+    """The creep run's ``n_events`` (summary.json) counted 0 when a NumericalFailure ended the event loop: the
+    loop's own count was lost with the exception.  Two bonds under different shear stresses fail one after the
+    other (two events); the relaxation after the second raises."""
+    from grainfrac_yade.protocols.creep import CreepRun
+
+    class FailingAfterTheSecond(StandInHolder):
+        def relax(self, creep_time, safe_point=None, resume=None):
+            super().relax(creep_time)
+            if self.corr.scene.broken.all():   # the relaxation after the second event
+                raise NumericalFailure("a stand-in blow-up")
+            return True
+
+    holder = FailingAfterTheSecond()
+    holder.params, holder.n_events = load_parameters(overrides=["stress_corrosion.creep_time_limit=1e30"]), 0
+    holder.corr = StandInBonds([0.0, 0.0], [5e6, 10e6], JT, JC, breaks=True)
+    with pytest.raises(NumericalFailure, match="a stand-in blow-up"):
+        CreepRun.run_event_clock(holder)
+    assert holder.corr.scene.broken.all() and holder.n_events == 2 == holder.clock.n_events
+
+
 def test_repeated_zero_intervals_that_break_nothing_end_after_a_bounded_number():
     """sigma = 0 with J^T = 0: failed by the law (>=) at dt = 0, but a contact law that breaks only
     on F > FnMax never breaks it; the loop used to hand it over and relax forever."""

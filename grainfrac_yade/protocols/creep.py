@@ -287,7 +287,11 @@ class CreepRun:
         if resume is None:
             self.clock = EventClock(self.params.stress_corrosion.max_strength_loss_fraction,
                                     self.params.stress_corrosion.creep_time_limit)
-        self.n_events = event_clock_loop(self, self.corr, self.clock, resume)
+        try:
+            self.n_events = event_clock_loop(self, self.corr, self.clock, resume)
+        except NumericalFailure:
+            self.n_events = self.clock.n_events   # the events before it: the loop's own count ends with it
+            raise
 
     def run_paper_clock(self, resume=None):
         """Paper clock loop; ``resume``: its counters at a checkpoint (the clock is restored with it).
