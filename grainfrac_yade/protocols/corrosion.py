@@ -4,25 +4,28 @@ The law (:mod:`grainfrac_yade.law`, built once from ``[stress_corrosion]``) and 
 (:class:`~grainfrac_yade.law.BondState`: strengths J^T, J^C of paper Eq. 7, or area fractions) are pure
 numpy.  :class:`BondCorrosion` keeps them with each bond's intact values (area A0, strengths, stiffness,
 friction) and the creep time, steps the law under frozen stresses and gives its state for checkpoints.
-What the law says a bond can carry is written into an engine's bonds by that engine's subclass
-(YADE: :class:`grainfrac_yade.yade_adapter.corrosion_engine.StressCorrosion`, which also reads the
-bond forces).
+The stresses it steps the law under are read off the scene's bond forces (:meth:`BondCorrosion.stresses`,
+through the scene interface); what the law says a bond can carry is written into an engine's bonds by that
+engine's subclass (YADE: :class:`grainfrac_yade.yade_adapter.corrosion_engine.StressCorrosion`; static:
+:class:`grainfrac_yade.static.engine.StaticCorrosion`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..law import Stresses, build_law, degrade_step
+from ..law import Stresses, build_law, check_finite, degrade_step
 
 #: Names of the law's state arrays in checkpoints (state_dict), with the value of an intact bond.
 STATE_KEYS = {"tensile_strength": "tensile_strength_pa", "cohesion": "cohesion_pa", "area_fraction": "area_fraction"}
 
 
 class BondCorrosion:
-    """A degradation law's state on the bonds of a layout (``layout.bond_area``) with bond properties
-    ``props`` (:func:`grainfrac_yade.layout.bond_properties`)."""
+    """A degradation law's state on the bonds of ``scene`` (:class:`grainfrac_yade.engines.Scene`: its layout's
+    ``bond_area`` and its bond properties ``props``, :func:`grainfrac_yade.layout.bond_properties`)."""
 
-    def __init__(self, layout, props, sc_params):
+    def __init__(self, scene, sc_params):
+        layout, props = scene.layout, scene.props
+        self.scene = scene
         self.p = sc_params
         self.law = build_law(sc_params)
         self.area0 = layout.bond_area.copy()
@@ -35,6 +38,20 @@ class BondCorrosion:
         self.creep_time = 0.0
         #: broken bonds whose contact stiffness was given back (laws that change stiffness)
         self.restored = np.zeros(layout.n_bonds, bool)
+
+    def stresses(self, idx) -> Stresses:
+        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``, from the scene's bond forces.
+
+        NumericalFailure if a force is NaN or infinite."""
+        idx = np.asarray(idx, dtype=np.int64)
+        fn, fs = self.scene.bond_forces(idx)
+        check_finite("bond normal force", fn, idx)
+        check_finite("bond shear force", fs, idx)
+        return Stresses(idx, fn / self.area0[idx], fs / self.area0[idx])
+
+    def intact(self) -> np.ndarray:
+        """The scene's intact bonds."""
+        return np.flatnonzero(~self.scene.broken)
 
     def strengths(self, idx=None):
         """What bonds ``idx`` can carry now, per intact area: (J^T, J^C) [Pa] (all bonds by default)."""

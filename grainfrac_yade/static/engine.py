@@ -62,21 +62,9 @@ class StaticCorrosion(BondCorrosion):
     name = "StressCorrosion"
 
     def __init__(self, scene: StaticScene, sc_params):
-        self.scene = scene
-        super().__init__(scene.layout, scene.props, sc_params)
+        super().__init__(scene, sc_params)
         if not self.law.exact_jump:
             raise GrainfracError(STIFFNESS_LAW_REFUSED)
-
-    def stresses(self, idx) -> Stresses:
-        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``; NumericalFailure if not finite."""
-        idx = np.asarray(idx, dtype=np.int64)
-        fn, fs = self.scene.bond_forces(idx)
-        check_finite("bond normal force", fn, idx)
-        check_finite("bond shear force", fs, idx)
-        return Stresses(idx, fn / self.area0[idx], fs / self.area0[idx])
-
-    def intact(self) -> np.ndarray:
-        return np.flatnonzero(~self.scene.broken)
 
     def write(self, idx):
         """The law's strengths of bonds ``idx`` into the scene (no solve: the next one follows them)."""

@@ -41,22 +41,7 @@ class StressCorrosion(BondCorrosion):
     name = "StressCorrosion"
 
     def __init__(self, scene, sc_params):
-        self.scene = scene
-        super().__init__(scene.layout, scene.props, sc_params)
-
-    # ------------------------------------------------------------------ reading
-    def stresses(self, idx) -> Stresses:
-        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``.
-
-        NumericalFailure if a force is NaN or infinite."""
-        idx = np.asarray(idx, dtype=np.int64)
-        fn, fs = self.scene.bond_forces(idx)
-        check_finite("bond normal force", fn, idx)
-        check_finite("bond shear force", fs, idx)
-        return Stresses(idx, fn / self.area0[idx], fs / self.area0[idx])
-
-    def intact(self) -> np.ndarray:
-        return np.flatnonzero(~self.scene.broken)
+        super().__init__(scene, sc_params)
 
     # ------------------------------------------------------------------ writing
     def write(self, idx):
