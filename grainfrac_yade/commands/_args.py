@@ -70,17 +70,17 @@ def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
     """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
     without dynamics, a test the engine does not have yet, a VTK series ``vtk`` it does not write), and warn
     once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  Nothing for
-    a dynamic engine (YADE)."""
+    a dynamic engine (YADE); an engine without dynamics says what it refuses in its module (``UNSUPPORTED``,
+    ``VTK_REFUSED``, ``warn_dynamic_only``: docs/maintainers.md, adding an engine)."""
     module = engine_for(params)
     if getattr(module, "DYNAMIC", False):
         return
     if command == "creep" and params.stress_corrosion.clock == "paper":
         require_dynamic(params, "the paper clock (its unbalanced force, Eq. 8)")
-    refusal = getattr(module, "UNSUPPORTED", {}).get(command)
+    refusal = module.UNSUPPORTED.get(command)
     if refusal:
         raise GrainfracError(refusal)
-    if vtk and getattr(module, "VTK_REFUSED", ""):
+    if vtk and module.VTK_REFUSED:
         raise GrainfracError(module.VTK_REFUSED)
-    for line in getattr(module, "warn_dynamic_only", lambda o: [])([o for o in overrides
-                                                                     if override_origin(o) == "--set"]):
+    for line in module.warn_dynamic_only([o for o in overrides if override_origin(o) == "--set"]):
         print(line, file=sys.stderr)
