@@ -236,6 +236,10 @@ class Scene(Protocol):
     def counts(self) -> dict:
         """Sizes of the scene as the engine holds it: ``n_bodies``, ``n_interactions`` (real), ``n_bonds``."""
 
+    def summary_keys(self) -> dict:
+        """What a run's summary.json records of the engine beyond the common keys (YADE: nothing; static: its
+        name and the dynamic-only settings it did not use)."""
+
     # ------------------------------------------------------------------ state
     def save(self, path) -> None:
         """Write the engine's whole scene to ``path`` (a checkpoint: resuming from it is exact)."""

@@ -82,7 +82,7 @@ class LoadingTest:
         result.update({"dem_timestep_s": scene.dt, "n_bonds": scene.n_bonds, **counts,
                        "numerical_failure": numerical, "bonds_erased_by_sliding": scene.sliding_erasures(),
                        "peak_reached": peak_reached, "end_reason": end, **extra})
-        result.update(getattr(scene, "summary_keys", dict)())   # an engine's own record (the YADE scene has none)
+        result.update(scene.summary_keys())
         if self.resumes:
             result["resumed_from"] = self.resumes
         return result

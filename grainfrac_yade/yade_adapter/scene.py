@@ -146,6 +146,10 @@ class GrainScene:
         return {"n_bodies": len(self.O.bodies), "n_interactions": self.O.interactions.countReal(),
                 "n_interactions_listed": len(self.O.interactions), "n_bonds": self.n_bonds}
 
+    def summary_keys(self) -> dict:
+        """Nothing beyond the common keys: YADE's summaries are as they were before engines could be chosen."""
+        return {}
+
     # ------------------------------------------------------------------ counters
     @property
     def steps(self) -> int:
