@@ -115,7 +115,11 @@ class NumericsParams:
     """DEM integration knobs, and the engine that computes the scene."""
     engine: str = _spec("", "choice", "mechanical engine of the scene (grainfrac_yade.engines): yade = YADE's "
                         "explicit DEM with dynamic relaxation; static = static equilibrium between bond failures (grainfrac_yade.static: "
-                        "no inertia, no loading rate)", ("yade", "static"))
+                        "no inertia, no loading rate); hybrid = static, with YADE's dynamics where the static "
+                        "equilibrium gives out or a cascade grows (grainfrac_yade.hybrid)", ("yade", "static", "hybrid"))
+    handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
+                                        "before YADE's dynamics take over from its state; 0 = only where the static "
+                                        "equilibrium gives out")
     damping: float = _spec("1", "unit_interval_open", "Cundall non-viscous damping")
     timestep_safety: float = _spec("1", "unit_interval_open", "fraction of the critical time step")
     density_scale: float = _spec("1", "positive", "mass scaling factor for quasi-static runs")

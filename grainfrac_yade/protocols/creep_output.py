@@ -165,7 +165,7 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "n_bonds": run.scene.n_bonds, "bonds_erased_by_sliding": run.scene.sliding_erasures(),
         **budget_fields(getattr(run, "hold_budget", None)),
         "steps": int(run.scene.steps), "wall_s": time.time() - t0,
-        "cpu_s": time.process_time() - c0,
+        "cpu_s": time.process_time() - c0, **run.scene.summary_keys(),
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
         "vtk_creep_times_s": run.vtk_written,

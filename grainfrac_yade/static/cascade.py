@@ -42,6 +42,16 @@ MAX_BRACKET_ITERATIONS = 200
 MAX_STEPS_WITHOUT_BREAK = 10_000
 
 
+class LargeCascade(Exception):
+    """A cascade broke more bonds at one closure than :attr:`Path.max_cascade` allows: ``state`` is the converged
+    state after the last of them (bonds still at their strength left intact), for an engine with inertia to take
+    over from (released energy may break more than the static cascade does)."""
+
+    def __init__(self, state, bonds: int):
+        super().__init__(f"static cascade: {bonds} bonds broken at closure {state.closure:.6g} m")
+        self.state, self.bonds = state, int(bonds)
+
+
 @dataclass
 class Record:
     """One row of the path: after a break (or a reached target)."""
@@ -60,6 +70,10 @@ class Path:
         self.jt, self.jc = eq.net.tensile_strength.copy(), eq.net.cohesion.copy()
         self.records: list[Record] = []
         self.steps = 0
+        #: the last converged state the path stood on (a hand-over starts from it if a solve gives out)
+        self.last_state = None
+        #: bonds one cascade may break before :class:`LargeCascade` is raised; None: no limit (the static engine)
+        self.max_cascade = None
 
     # ------------------------------------------------------------------ ratios and the tie rule
     def ratios(self, state: State):
@@ -97,8 +111,14 @@ class Path:
         return self.eq.solve(state.closure, base, self.eq.release_force(state, base))
 
     def cascade(self, state: State, first: int | None = None, record: Record | None = None) -> State:
-        """Break ``first`` (if given), then every bond at its strength, one at a time, the most overstressed first."""
+        """Break ``first`` (if given), then every bond at its strength, one at a time, the most overstressed first;
+        :class:`LargeCascade` after :attr:`max_cascade` bonds if that is set."""
+        broken = 0
         while True:
+            self.last_state = state
+            if self.max_cascade is not None and broken >= self.max_cascade and (first is not None or
+                                                                               self.over(state).any()):
+                raise LargeCascade(state, broken)
             ratio, mode = self.ratios(state)
             if first is not None:
                 bond, first = first, None
@@ -108,6 +128,7 @@ class Path:
                     return state
                 bond = self.pick(ratio, hit)
             state = self.break_bond(state, bond, int(mode[bond]))
+            broken += 1
             if record is not None:
                 record.bonds.append(bond)
                 record.modes.append(int(mode[bond]))
@@ -125,6 +146,7 @@ class Path:
         stress, or to ``max_closure``.  Returns (new state, what: "break" / "target" / "end" / "none");
         "none": nothing lies ahead (no crossing, no target reachable, no closure limit)."""
         n = self.net
+        self.last_state = state
         v, fn1, fs1, p1 = self.eq.response(state)
         x = cl.crossing_increment(state.fn, state.fs, fn1, fs1, n.area, self.jt, self.jc, n.tan_friction)
         x = np.where(state.broken, np.inf, x)
@@ -201,6 +223,7 @@ class Path:
         """Regain the platen stress ``target`` [Pa] from ``state`` along the path: (state, failure reason or None)."""
         start, quiet = state.closure, 0
         while True:
+            self.last_state = state
             if state.stress >= target * (1 - self.bracket_tol) and not self.over(state).any():
                 return state, None
             state, what = self.step(state, target)

@@ -199,6 +199,9 @@ class StaticConfinement:
 class StaticScene:
     """A specimen's static scene (module doc); bond arrays of the interface in the layout's order."""
 
+    #: The engine a checkpoint of this scene names (a checkpoint is resumed by the engine that wrote it).
+    engine_name = "static"
+
     def __init__(self, specimen, params, layout=None):
         self.specimen, self.params = specimen, params
         self.layout = layout or layout_for(specimen, params)
@@ -492,12 +495,12 @@ class StaticScene:
         self.hold_pending = a["hold_pending"].astype(np.int64) if "hold_pending" in a else np.zeros(0, np.int64)
 
     def checkpoint_state(self) -> dict:
-        return {"n_bodies": int(len(self.net.node_pos)), "n_bonds": self.n_bonds, "engine": "static"}
+        return {"n_bodies": int(len(self.net.node_pos)), "n_bonds": self.n_bonds, "engine": self.engine_name}
 
     def restore_checkpoint(self, where, scene_file, saved: dict, arrays: dict, confinement=None) -> None:
-        if saved.get("engine") != "static" or saved["n_bonds"] != self.n_bonds:
+        if saved.get("engine") != self.engine_name or saved["n_bonds"] != self.n_bonds:
             raise GrainfracError(f"{where}: checkpoint of another scene (engine {saved.get('engine', 'yade')!r}, "
-                                 f"{saved['n_bonds']} bonds; rebuilt: static, {self.n_bonds}); fix: resume it with the "
+                                 f"{saved['n_bonds']} bonds; rebuilt: {self.engine_name}, {self.n_bonds}); fix: resume it with the "
                                  "engine that wrote it, or start the run again with --overwrite")
         try:
             self.restore(scene_file)
@@ -558,6 +561,17 @@ class StaticScene:
             bond_plane_normal=normal if self.layout.model in BONDS_ON_FACES else np.zeros((self.n_bonds, 3)),
             platens=None if platens is None else platens.state_dict())
 
+    def displacements(self, state: SceneState) -> np.ndarray:
+        """The network's displacement vector [m, rad] of ``state``'s node displacements and rotations."""
+        net = self.net
+        u = np.zeros(net.ndof)
+        for col in range(2):
+            ok = net.dofs[:, col] >= 0
+            u[net.dofs[ok, col]] = state.node_displacement[ok, col]
+        ok = net.dofs[:, 2] >= 0
+        u[net.dofs[ok, 2]] = state.node_rotation[ok]
+        return u
+
     def apply_state(self, state: SceneState) -> None:
         """Put ``state`` into this freshly built scene and solve the equilibrium there: displacements, broken set,
         strengths, shear references; the statuses follow from the return mapping and the solve (module doc)."""
@@ -566,12 +580,7 @@ class StaticScene:
             raise GrainfracError(f"a state of {len(state.node_position)} nodes and {len(state.bond_broken)} bonds does "
                                  f"not fit this static scene ({len(net.node_pos)} nodes, {self.n_bonds} bonds); fix: "
                                  "build the scene from the specimen, layout and parameters the state was made with")
-        u = np.zeros(net.ndof)
-        for col in range(2):
-            ok = net.dofs[:, col] >= 0
-            u[net.dofs[ok, col]] = state.node_displacement[ok, col]
-        ok = net.dofs[:, 2] >= 0
-        u[net.dofs[ok, 2]] = state.node_rotation[ok]
+        u = self.displacements(state)
         order = net.order
         broken = np.asarray(state.bond_broken, bool)[order]
         area = net.area

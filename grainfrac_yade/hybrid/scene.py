@@ -1,0 +1,254 @@
+"""The hybrid engine's scene: the static scene, with YADE's dynamic relaxation where statics give out.
+
+:class:`HybridScene` is a :class:`grainfrac_yade.static.scene.StaticScene` (the protocols drive it the same way:
+displacement control along the sequentially linear path, the held platen stress of a creep hold) that hands its
+state to the dynamic engine (``yade``, through the engine registry and the engine-neutral
+:class:`grainfrac_yade.engines.SceneState`) at two points:
+
+* **the static equilibrium gives out**: no set of frictional contact statuses settles (the core's
+  :class:`~grainfrac_yade.errors.NumericalFailure`; frictional equilibria with non-associated slip need not be
+  unique or exist), from the last converged state the path stood on;
+* **a cascade grows**: more than ``numerics.handover_cascade_bonds`` bonds broken at one closure (0: never), from
+  the state after the last of them (:class:`~grainfrac_yade.static.cascade.LargeCascade`): the released energy may
+  break more under inertia than the static cascade does.
+
+A **dynamic stint** then relaxes YADE's scene from that state under the control the protocol had set: the platens
+fixed where they are (a displacement-controlled test: UCS, the creep ramp) or YADE's stress servo at the held
+stress (a creep hold), with the creep protocol's own criteria: equilibrium (``creep.equilibrium_tolerance``, and the
+held stress within ``creep.stress_tolerance``), collapse (:class:`~grainfrac_yade.protocols.creep_loops.CollapseWatch`:
+the servo saturated while the axial strain grows by ``creep.collapse_strain_increment``), checked every
+``creep.check_period`` DEM steps within the hold's relaxation budget (``creep.max_relaxation_steps`` /
+``_crossings``).  Bonds the creep law had handed over and the cascade had not yet broken are broken in YADE first.
+
+At equilibrium (or, with the platens fixed, at the end of the budget) what the stint broke comes back: the
+bonds YADE broke, in its order, each broken alone in the static state the stint started from with the static
+equilibrium restored (the static model keeps its own small-strain state and contact statuses; the stint decides
+which bonds break), then the static cascade; a held stress is then regained along the static path.  Under a held
+stress a collapse (or no equilibrium within the budget) ends the hold as the static failure rule does
+(:attr:`hold_failure`), with the broken set YADE reached.  Inertia is thus simulated only where the static path cannot go on.
+
+Not bit-reproducible between processes once a stint ran (YADE sums fem node forces in an order keyed by memory
+address, docs/studies/paper_fem.md); a run without stints is the static engine's, bit for bit.  Every stint is
+logged (:attr:`stints`) and summarised in summary.json (:meth:`summary_keys`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+
+import numpy as np
+
+from ..engines import SceneState
+from ..engines.registry import engine as engine_module
+from ..errors import GrainfracError, NumericalFailure
+from ..protocols.creep_loops import CollapseWatch, collapsing
+from ..protocols.loading import held_at_equilibrium, mean_bond_force
+from ..static.cascade import LargeCascade
+from ..static.scene import StaticScene
+from ..wave import hold_budget, scene_density
+
+#: The engine the dynamic stints run on (``numerics.engine`` of the registry).
+DYNAMIC_ENGINE = "yade"
+#: Dynamic stints one static solve may call before the run ends as a numerical failure [1]: each stint leaves a
+#: new broken set; where statics give out again at once, three stints in a row say that the hand-back does not
+#: settle (a state the static model cannot hold in any status set).
+MAX_STINTS_PER_SOLVE = 3
+#: Smallest axial strain taken for the secant modulus that sets the servo's gain and the wave-crossing budget [1]
+#: (the creep protocol's floor, so that a hand-over at zero strain still has a finite modulus).
+SERVO_STRAIN_FLOOR = 1e-6
+
+
+#: The one line that refuses finite-element cells: YADE's fem elements do not take a handed-over state (measured:
+#: 3 x 6 mm at 171 MPa, every bond broke within 200 DEM steps of a stint with the platens fixed; rigid cells stay
+#: at their stress in equilibrium, tests/test_hybrid_engine.py).
+FEM_REFUSED = ("the hybrid engine runs rigid cells only (YADE's finite elements do not take a handed-over state yet); "
+               "fix: resolution.grain_model = \"rigid\", or --engine static / --engine yade")
+
+
+def refuse_params(params) -> str:
+    """The one line that refuses ``params`` before a run folder is made ("" if none): finite-element cells."""
+    return FEM_REFUSED if params.resolution.grain_model == "fem" else ""
+
+
+
+class HybridScene(StaticScene):
+    """A static scene whose solves hand over to YADE's dynamics where statics give out (module doc)."""
+
+    engine_name = "hybrid"
+
+    def __init__(self, specimen, params, layout=None):
+        refusal = refuse_params(params)
+        if refusal:
+            raise GrainfracError(refusal)
+        super().__init__(specimen, params, layout)
+        self.path.max_cascade = params.numerics.handover_cascade_bonds or None
+        #: one dict per dynamic stint: why, where, outcome, DEM steps, bonds broken in it, CPU [s]
+        self.stints: list[dict] = []
+
+    # ------------------------------------------------------------------ the two solves that may hand over
+    def move_to(self, closure: float) -> None:
+        for _ in range(MAX_STINTS_PER_SOLVE + 1):
+            try:
+                super().move_to(closure)
+                return
+            except (NumericalFailure, LargeCascade) as exc:
+                self._attempt(exc, held=False)
+        raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static path "
+                               f"a state it can go on from (closure {self.state.closure:.6g} m)")
+
+    def hold(self, n_steps: int = 1) -> None:
+        for _ in range(MAX_STINTS_PER_SOLVE + 1):
+            pending = self.hold_pending.copy()
+            try:
+                super().hold(n_steps)
+                return
+            except (NumericalFailure, LargeCascade) as exc:
+                self.hold_pending = pending
+                self._attempt(exc, held=True)
+                if self.hold_failure:
+                    servo = self._servo()
+                    if servo is not None:
+                        servo.count(n_steps)
+                    return
+        raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static hold "
+                               f"a state it can go on from (stress {self.state.stress:.6g} Pa)")
+
+    def _servo(self):
+        return next((d for d in self.drivers if hasattr(d, "closing_clipped_steps")), None)
+
+    def _attempt(self, exc, held: bool) -> None:
+        """A stint from where ``exc`` left the static path; its take-back may itself meet a status set that does not
+        settle: the bonds taken back so far stay broken, and the caller's next solve goes on from there."""
+        before = len(self.stints)
+        try:
+            self._stint(exc, held)
+        except (NumericalFailure, LargeCascade):
+            if len(self.stints) == before:    # no stint ran: nothing to start it from
+                raise
+            self.stints[-1]["taken_back"] = False
+
+    # ------------------------------------------------------------------ the dynamic stint
+    def _stint(self, exc, held: bool) -> None:
+        """Relax YADE's scene from the state where statics gave out (module doc); the static scene takes the
+        outcome back.  NumericalFailure if there is no converged state to start from (a NaN, not a status cycle)."""
+        start = exc.state if isinstance(exc, LargeCascade) else self.path.last_state
+        if start is None or not (math.isfinite(start.stress) and np.all(np.isfinite(start.fn))):
+            raise exc
+        c0 = time.process_time()
+        self._take(start)
+        pending = np.setdiff1d(self.net.order[self.hold_pending], np.flatnonzero(self.broken)) if held else \
+            np.zeros(0, np.int64)
+        self.hold_pending = np.zeros(0, np.int64)
+        platens = self._platens()
+        log = {"reason": str(exc).split(";")[0][:200], "held": held, "closure_m": float(start.closure),
+               "stress_pa": float(start.stress), "broken_before": int(self.broken.sum()) + len(pending)}
+        dyn = engine_module(DYNAMIC_ENGINE).scene_from_state(self.specimen, self.params, self.export_state(platens),
+                                                             self.layout)
+        ypl = dyn.attach_platens("free")
+        if len(pending):
+            _, mode = self.path.ratios(start)
+            modes = mode[self.canon[pending]]
+            for m in np.unique(modes):
+                dyn.break_bonds(pending[modes == m], int(m))
+        outcome, steps, servo = self._relax(dyn, ypl, start, held)
+        log.update(outcome=outcome, dem_steps=int(steps), broken_after=int(dyn.broken.sum()),
+                   stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
+        log["cpu_s"] = time.process_time() - c0
+        self.stints.append(log)
+        if outcome == "equilibrium" or (outcome == "budget" and not held):
+            self._take_back(dyn, steps)
+            log["cpu_s"] = time.process_time() - c0
+        else:
+            self.hold_failure = (f"dynamic stint: {outcome}: YADE from the static state could not hold "
+                                 f"{self.hold_target:.6g} Pa ({log['reason']})")
+            new = dyn.broken & ~self.broken
+            self.broken[new], self.break_mode[new] = True, dyn.break_mode[new]
+            self.break_step[new] = self.steps
+            # the platens as the stint left them: the run's last row shows the load the specimen kept
+            closure = self.state.closure + (ypl.axial_strain() * self.net.height)
+            self.state = dataclasses.replace(self.state, closure=closure, stress=log["stress_after_pa"])
+            self._steps_offset += int(steps)
+
+    def _relax(self, dyn, platens, start, held: bool):
+        """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
+        servo or None); outcome "equilibrium", "collapse" or "budget" (none within the relaxation budget)."""
+        cp = self.params.creep
+        strain = max(start.closure / self.net.height, SERVO_STRAIN_FLOOR)
+        young = max(start.stress, 0.0) / strain
+        budget = hold_budget(cp, self.net.height, young, scene_density(self.params), dyn.dt)
+        servo = watch = None
+        if held:
+            servo = platens.hold_stress(self.hold_target, young, budget.servo_response_steps,
+                                        cp.servo_max_strain_rate * self.net.height)
+            if cp.collapse_strain_increment > 0:
+                watch = CollapseWatch(cp.collapse_strain_increment, platens.axial_strain())
+        else:
+            platens.set_axial_velocity(0.0)
+        if cp.relaxation_damping > 0:
+            dyn.relaxation_damping(cp.relaxation_damping)
+        done = 0
+        while done < budget.max_relaxation_steps:
+            dyn.run(cp.check_period)
+            done += cp.check_period
+            if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
+                                                  platens.axial_strain()):
+                return "collapse", done, servo
+            intact = np.flatnonzero(~dyn.broken)
+            if held:
+                balanced = held_at_equilibrium(dyn, servo, intact, cp)
+            else:
+                balanced = dyn.unbalanced(mean_bond_force(dyn, intact))[1] < cp.equilibrium_tolerance
+            if balanced:
+                return "equilibrium", done, servo
+        return "budget", done, servo
+
+    def _take_back(self, dyn, dem_steps: int) -> None:
+        """What the stint broke, into the static state it started from: the bonds YADE broke, in the order it broke
+        them (ties: canonical order), each broken alone and the static equilibrium restored at the same closure
+        (:meth:`.cascade.Path.break_bond`), then the static cascade.  The static model keeps its own small-strain
+        state and contact statuses; the stint decides which bonds break.  The counters go on (steps: equilibria and
+        the stint's DEM steps)."""
+        new = np.flatnonzero(dyn.broken & ~self.broken)
+        order = np.lexsort((self.canon[new], dyn.break_step[new]))
+        state = self.state
+        self._steps_offset += int(dem_steps)
+        try:
+            for k in new[order]:
+                state = self.path.break_bond(state, int(self.canon[k]), int(dyn.break_mode[k]))
+            state = self.path.cascade(state)
+        finally:
+            self._take(state)
+        self.path.last_state = self.state
+
+    # ------------------------------------------------------------------ records
+    def summary_keys(self) -> dict:
+        """The engine's name, no unused settings (the stints use the dynamic ones), and the stints' totals and log."""
+        return {"engine": self.engine_name, "settings_not_used": {}, "dynamic_stints": len(self.stints),
+                "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
+                "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
+                "dynamic_stint_log": list(self.stints), "engine_failure_reason": self.hold_failure}
+
+    def _arrays(self) -> dict:
+        out = super()._arrays()
+        out["hybrid_stints"] = np.str_(json.dumps(self.stints))
+        return out
+
+    def restore(self, path) -> None:
+        super().restore(path)
+        with np.load(path) as data:
+            self.stints = json.loads(str(data["hybrid_stints"])) if "hybrid_stints" in data.files else []
+
+
+def build_scene(specimen, params, layout=None) -> HybridScene:
+    """The hybrid scene of ``specimen`` (rigid or fem cells)."""
+    return HybridScene(specimen, params, layout)
+
+
+def scene_from_state(specimen, params, state: SceneState, layout=None) -> HybridScene:
+    """A hybrid scene of ``specimen`` in ``state`` (of any engine), the static equilibrium solved there."""
+    scene = HybridScene(specimen, params, layout)
+    scene.apply_state(state)
+    return scene
+

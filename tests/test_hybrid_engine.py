@@ -1,0 +1,115 @@
+"""The hybrid engine: the static scene with YADE's dynamic stints where statics give out (tiny specimens)."""
+import json
+
+import numpy as np
+import pytest
+
+from conftest import needs_yade
+
+from grainfrac_yade.engines import Scene
+from grainfrac_yade.engines.registry import ENGINE_NAMES, engine, engine_for
+from grainfrac_yade.errors import GrainfracError
+from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.params.schema import NumericsParams
+
+TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
+FEM = "params/presets/fem.toml"
+
+
+def _params(engine_name, *extra, fem=False):
+    return load_parameters(extra_files=[FEM] if fem else (), overrides=[*TINY, f"numerics.engine={engine_name}", *extra])
+
+
+def test_hybrid_engine_module():
+    """Registered (and a choice of numerics.engine), no dynamics between stints, its refusals in one line."""
+    import dataclasses
+    choices = next(f for f in dataclasses.fields(NumericsParams) if f.name == "engine").metadata["choices"]
+    assert "hybrid" in ENGINE_NAMES and tuple(choices) == ENGINE_NAMES
+    module = engine("hybrid")
+    assert module.NAME == "hybrid" and module.DYNAMIC is False
+    assert "brazilian" in module.UNSUPPORTED and module.warn_dynamic_only(["numerics.damping=0.7"]) == []
+    assert module.refuse_params(_params("hybrid")) == ""
+    line = module.refuse_params(_params("hybrid", fem=True))
+    assert "rigid cells only" in line and "fix:" in line and "\n" not in line
+    with pytest.raises(GrainfracError, match="rigid cells only"):
+        module.build_scene(build_specimen(_params("hybrid", fem=True), 1), _params("hybrid", fem=True))
+
+
+def test_without_a_stint_the_hybrid_path_is_the_static_one():
+    """Where statics never give out, the hybrid scene is the static scene, bit for bit."""
+    paths = {}
+    for name in ("static", "hybrid"):
+        p = _params(name)
+        scene = engine_for(p).build_scene(build_specimen(p, 1), p)
+        assert isinstance(scene, Scene)
+        pl = scene.attach_platens("free")
+        pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
+        stress = []
+        for _ in range(60):
+            scene.run(2)
+            stress.append(pl.axial_stress())
+        paths[name] = (np.array(stress), scene.broken.copy(), scene.state.u.copy())
+        if name == "hybrid":
+            assert scene.stints == [] and scene.summary_keys()["dynamic_stints"] == 0
+    (sa, ba, ua), (sb, bb, ub) = paths["static"], paths["hybrid"]
+    assert np.array_equal(sa, sb) and np.array_equal(ba, bb) and np.array_equal(ua, ub)
+
+
+@needs_yade
+def test_a_rigid_static_state_stays_in_equilibrium_in_yade():
+    """The hand-over itself: YADE started from a loaded static state (rigid cells, 0.2 % strain, 170 MPa) with the
+    platens fixed keeps its stress (within 0.1 %: the dynamic relaxation's residual) and breaks nothing."""
+    p = _params("static")
+    specimen = build_specimen(p, 1)
+    static = engine("static").build_scene(specimen, p)
+    pl = static.attach_platens("free")
+    pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
+    static.run(100)
+    assert static.broken.sum() == 0
+    dyn = engine("yade").scene_from_state(specimen, p, static.export_state(pl))
+    ypl = dyn.attach_platens("free")
+    ypl.set_axial_velocity(0.0)
+    dyn.run(2000)
+    assert ypl.axial_stress() == pytest.approx(pl.axial_stress(), rel=1e-3)
+    assert dyn.broken.sum() == 0 and dyn.unbalanced(1.0)[1] < 1e-2
+
+
+@needs_yade
+@pytest.mark.xfail(strict=True, reason="YADE's fem elements do not take a handed-over state: every bond breaks")
+def test_a_fem_static_state_stays_in_equilibrium_in_yade():
+    """The same hand-over with finite-element cells (measured: every bond broken within 200 DEM steps); strict, so
+    that the day it holds this test says so and the hybrid engine may take fem cells."""
+    p = _params("static", fem=True)
+    specimen = build_specimen(p, 1)
+    static = engine("static").build_scene(specimen, p)
+    pl = static.attach_platens("free")
+    pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
+    static.run(100)
+    dyn = engine("yade").scene_from_state(specimen, p, static.export_state(pl))
+    ypl = dyn.attach_platens("free")
+    ypl.set_axial_velocity(0.0)
+    dyn.run(2000)
+    assert ypl.axial_stress() == pytest.approx(pl.axial_stress(), rel=1e-2)
+    assert dyn.broken.sum() <= static.broken.sum() + 5
+
+
+@needs_yade
+def test_a_creep_hold_hands_a_cascade_to_yade_and_takes_its_breaks_back(tmp_path):
+    """Creep on 4 x 8 mm (seed 3, 160 MPa) with a cascade limit of 2 bonds: a stint under the held stress reaches
+    equilibrium, the bonds YADE broke are broken in the static scene after it, the hold goes on to a physical
+    failure (the static rule), and summary.json records the engine and the stint."""
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
+    p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.engine=hybrid",
+                                   "numerics.handover_cascade_bonds=2"])
+    summary = run_creep_to_folder(p, 3, tmp_path / "run", 160e6, 160e6 / p.calibration.reference_ucs,
+                                  p.calibration.reference_ucs)
+    assert summary["engine"] == "hybrid" and summary["dynamic_stints"] >= 1
+    stint = summary["dynamic_stint_log"][0]
+    assert stint["held"] is True and stint["outcome"] == "equilibrium" and stint["dem_steps"] > 0
+    assert stint["broken_after"] > stint["broken_before"] and stint.get("taken_back", True)
+    assert stint["stress_after_pa"] == pytest.approx(160e6, rel=p.creep.stress_tolerance)
+    assert summary["lifetime_s"] > 0 and summary["numerical_failure"] is False
+    assert summary["broken_total"] >= stint["broken_after"]
+    saved = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert saved["dynamic_stint_dem_steps"] == sum(s["dem_steps"] for s in saved["dynamic_stint_log"])
