@@ -2,7 +2,7 @@
 
 :class:`HybridScene` is a :class:`grainfrac_yade.static.scene.StaticScene` (the protocols drive it the same way:
 displacement control along the sequentially linear path, the held platen stress of a creep hold) that hands its
-state to the dynamic engine (``yade``, through the engine registry and the engine-neutral
+state to the dynamic engine (YADE's engine module, :mod:`grainfrac_yade.yade_adapter.engine`, through the engine-neutral
 :class:`grainfrac_yade.engines.SceneState`) at two points:
 
 * **the static equilibrium gives out**: no set of frictional contact statuses settles (the core's
@@ -41,16 +41,14 @@ import time
 import numpy as np
 
 from ..engines import SceneState
-from ..engines.registry import engine as engine_module
 from ..errors import GrainfracError, NumericalFailure
 from ..protocols.creep_loops import CollapseWatch, collapsing
 from ..protocols.loading import held_at_equilibrium, mean_bond_force
 from ..static.cascade import LargeCascade
 from ..static.scene import StaticScene
 from ..wave import hold_budget, scene_density
+from ..yade_adapter import engine as dynamic_engine
 
-#: The engine the dynamic stints run on (``numerics.engine`` of the registry).
-DYNAMIC_ENGINE = "yade"
 #: Dynamic stints one static solve may call before the run ends as a numerical failure [1]: each stint leaves a
 #: new broken set; where statics give out again at once, three stints in a row say that the hand-back does not
 #: settle (a state the static model cannot hold in any status set).
@@ -144,7 +142,7 @@ class HybridScene(StaticScene):
         platens = self._platens()
         log = {"reason": str(exc).split(";")[0][:200], "held": held, "closure_m": float(start.closure),
                "stress_pa": float(start.stress), "broken_before": int(self.broken.sum()) + len(pending)}
-        dyn = engine_module(DYNAMIC_ENGINE).scene_from_state(self.specimen, self.params, self.export_state(platens),
+        dyn = dynamic_engine.scene_from_state(self.specimen, self.params, self.export_state(platens),
                                                              self.layout)
         ypl = dyn.attach_platens("free")
         if len(pending):
