@@ -8,7 +8,6 @@ from conftest import needs_yade
 
 from grainfrac_yade.engines import Scene
 from grainfrac_yade.engines.registry import ENGINE_NAMES, engine, engine_for
-from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.params.schema import NumericsParams
@@ -29,11 +28,6 @@ def test_hybrid_engine_module():
     module = engine("hybrid")
     assert module.NAME == "hybrid" and module.DYNAMIC is False
     assert "brazilian" in module.UNSUPPORTED and module.warn_dynamic_only(["numerics.damping=0.7"]) == []
-    assert module.refuse_params(_params("hybrid")) == ""
-    line = module.refuse_params(_params("hybrid", fem=True))
-    assert "rigid cells only" in line and "fix:" in line and "\n" not in line
-    with pytest.raises(GrainfracError, match="rigid cells only"):
-        module.build_scene(build_specimen(_params("hybrid", fem=True), 1), _params("hybrid", fem=True))
 
 
 def test_without_a_stint_the_hybrid_path_is_the_static_one():
@@ -56,42 +50,54 @@ def test_without_a_stint_the_hybrid_path_is_the_static_one():
     assert np.array_equal(sa, sb) and np.array_equal(ba, bb) and np.array_equal(ua, ub)
 
 
-@needs_yade
-def test_a_rigid_static_state_stays_in_equilibrium_in_yade():
-    """The hand-over itself: YADE started from a loaded static state (rigid cells, 0.2 % strain, 170 MPa) with the
-    platens fixed keeps its stress (within 0.1 %: the dynamic relaxation's residual) and breaks nothing."""
-    p = _params("static")
+def _static_state_in_yade(fem: bool, increments: int):
+    p = _params("static", fem=fem)
     specimen = build_specimen(p, 1)
     static = engine("static").build_scene(specimen, p)
     pl = static.attach_platens("free")
     pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
-    static.run(100)
-    assert static.broken.sum() == 0
+    static.run(increments)
     dyn = engine("yade").scene_from_state(specimen, p, static.export_state(pl))
     ypl = dyn.attach_platens("free")
     ypl.set_axial_velocity(0.0)
-    dyn.run(2000)
-    assert ypl.axial_stress() == pytest.approx(pl.axial_stress(), rel=1e-3)
-    assert dyn.broken.sum() == 0 and dyn.unbalanced(1.0)[1] < 1e-2
+    return static, pl, dyn, ypl
 
 
 @needs_yade
-@pytest.mark.xfail(strict=True, reason="YADE's fem elements do not take a handed-over state: every bond breaks")
-def test_a_fem_static_state_stays_in_equilibrium_in_yade():
-    """The same hand-over with finite-element cells (measured: every bond broken within 200 DEM steps); strict, so
-    that the day it holds this test says so and the hybrid engine may take fem cells."""
-    p = _params("static", fem=True)
-    specimen = build_specimen(p, 1)
-    static = engine("static").build_scene(specimen, p)
-    pl = static.attach_platens("free")
-    pl.set_axial_velocity(p.ucs.strain_rate * pl.height)
-    static.run(100)
-    dyn = engine("yade").scene_from_state(specimen, p, static.export_state(pl))
-    ypl = dyn.attach_platens("free")
-    ypl.set_axial_velocity(0.0)
+@pytest.mark.parametrize("fem, rel_stress, rel_unbalanced", [(False, 1e-3, 1e-2), (True, 1e-8, 1e-6)])
+def test_a_static_state_stays_in_equilibrium_in_yade(fem, rel_stress, rel_unbalanced):
+    """The hand-over itself: YADE started from a loaded static state (0.2 % strain, about 170 MPa) with the platens
+    fixed keeps its stress and its broken set for 2,000 DEM steps.  Fem cells: the same nodes, elements and
+    springs, so the static equilibrium is YADE's to round-off (measured 2e-10 of the mean bond force unbalanced;
+    stated 1e-6, stress 1e-8).  Rigid cells: YADE's torque arms and rotations differ from the static rows at
+    second order (measured 0.02 % of the stress; stated 0.1 %, unbalanced below 1 % once relaxed)."""
+    static, pl, dyn, ypl = _static_state_in_yade(fem, 100)
     dyn.run(2000)
-    assert ypl.axial_stress() == pytest.approx(pl.axial_stress(), rel=1e-2)
-    assert dyn.broken.sum() <= static.broken.sum() + 5
+    assert ypl.axial_stress() == pytest.approx(pl.axial_stress(), rel=rel_stress)
+    assert np.array_equal(dyn.broken, static.broken)
+    assert dyn.unbalanced(float(np.abs(static.bond_forces()[0]).mean()))[1] < rel_unbalanced
+
+
+@needs_yade
+def test_a_fem_yade_state_round_trips_in_equilibrium():
+    """YADE -> SceneState -> a new YADE scene, fem cells (clumped apex nodes): the new scene is in the old one's
+    equilibrium (the clumps' principal frames kept under the state's rotations)."""
+    p = _params("yade", fem=True)
+    specimen = build_specimen(p, 1)
+    yade = engine("yade")
+    a = yade.build_scene(specimen, p)
+    pa = a.attach_platens("free")
+    pa.set_axial_velocity(0.5 * pa.height)
+    a.run(3000)
+    pa.set_axial_velocity(0.0)
+    a.run(3000)
+    ref = float(np.abs(a.bond_forces()[0]).mean())
+    b = yade.scene_from_state(specimen, p, a.export_state(pa))
+    pb = b.attach_platens("free")
+    pb.set_axial_velocity(0.0)
+    b.run(10)
+    assert pb.axial_stress() == pytest.approx(pa.axial_stress(), rel=1e-6)
+    assert b.broken.sum() == a.broken.sum() and b.unbalanced(ref)[1] < 1e-3
 
 
 @needs_yade

@@ -71,13 +71,13 @@ def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
     without dynamics, a test the engine does not have yet, a VTK series ``vtk`` it does not write), and warn
     once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  Nothing for
     a dynamic engine (YADE); an engine without dynamics says what it refuses in its module (``UNSUPPORTED``,
-    ``refuse_params``, ``VTK_REFUSED``, ``warn_dynamic_only``: docs/maintainers.md, adding an engine)."""
+    ``VTK_REFUSED``, ``warn_dynamic_only``: docs/maintainers.md, adding an engine)."""
     module = engine_for(params)
     if getattr(module, "DYNAMIC", False):
         return
     if command == "creep" and params.stress_corrosion.clock == "paper":
         require_dynamic(params, "the paper clock (its unbalanced force, Eq. 8)")
-    refusal = module.UNSUPPORTED.get(command) or module.refuse_params(params)
+    refusal = module.UNSUPPORTED.get(command)
     if refusal:
         raise GrainfracError(refusal)
     if vtk and module.VTK_REFUSED:

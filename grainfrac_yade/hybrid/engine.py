@@ -12,7 +12,7 @@ from ..static.engine import (AXIAL_STRAIN, DIAMETRAL_STRAIN, VTK_REFUSED, Strain
                              apply_levers, consolidate, stress_corrosion)
 from ..static.engine import UNSUPPORTED as STATIC_UNSUPPORTED
 from ..static.engine import version as static_version
-from .scene import FEM_REFUSED, HybridScene, build_scene, refuse_params, scene_from_state  # noqa: F401
+from .scene import HybridScene, build_scene, scene_from_state  # noqa: F401
 
 #: The value of ``numerics.engine`` that selects this engine.
 NAME = "hybrid"

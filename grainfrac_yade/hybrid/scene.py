@@ -41,7 +41,7 @@ import time
 import numpy as np
 
 from ..engines import SceneState
-from ..errors import GrainfracError, NumericalFailure
+from ..errors import NumericalFailure
 from ..protocols.creep_loops import CollapseWatch, collapsing
 from ..protocols.loading import held_at_equilibrium, mean_bond_force
 from ..static.cascade import LargeCascade
@@ -58,28 +58,12 @@ MAX_STINTS_PER_SOLVE = 3
 SERVO_STRAIN_FLOOR = 1e-6
 
 
-#: The one line that refuses finite-element cells: YADE's fem elements do not take a handed-over state (measured:
-#: 3 x 6 mm at 171 MPa, every bond broke within 200 DEM steps of a stint with the platens fixed; rigid cells stay
-#: at their stress in equilibrium, tests/test_hybrid_engine.py).
-FEM_REFUSED = ("the hybrid engine runs rigid cells only (YADE's finite elements do not take a handed-over state yet); "
-               "fix: resolution.grain_model = \"rigid\", or --engine static / --engine yade")
-
-
-def refuse_params(params) -> str:
-    """The one line that refuses ``params`` before a run folder is made ("" if none): finite-element cells."""
-    return FEM_REFUSED if params.resolution.grain_model == "fem" else ""
-
-
-
 class HybridScene(StaticScene):
     """A static scene whose solves hand over to YADE's dynamics where statics give out (module doc)."""
 
     engine_name = "hybrid"
 
     def __init__(self, specimen, params, layout=None):
-        refusal = refuse_params(params)
-        if refusal:
-            raise GrainfracError(refusal)
         super().__init__(specimen, params, layout)
         self.path.max_cascade = params.numerics.handover_cascade_bonds or None
         #: one dict per dynamic stint: why, where, outcome, DEM steps, bonds broken in it, CPU [s]

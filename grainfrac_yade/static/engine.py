@@ -45,11 +45,6 @@ UNSUPPORTED = {
 }
 
 
-def refuse_params(params) -> str:
-    """The one line that refuses ``params`` before a run folder is made: none (every grain model runs)."""
-    return ""
-
-
 def version() -> str:
     """The versions of the libraries the static engine computes with (numpy, scipy)."""
     return "numpy " + importlib.metadata.version("numpy") + ", scipy " + importlib.metadata.version("scipy")

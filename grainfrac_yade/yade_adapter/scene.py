@@ -91,6 +91,9 @@ class GrainScene:
     time_offset: float = 0.0
     #: (n_nodes, 3) where the nodes were built [m] (:meth:`node_bodies`), the origin of their displacements
     node_origin: np.ndarray = None
+    #: each node body's orientation as built (a clump's principal frame, identity for a sphere): rotations are
+    #: exported about z relative to it, and a state's rotation is applied on top of it
+    node_orientation0: list = None
     _cracks_seen: int = 0
     _tens_seen: int = 0
 
@@ -443,7 +446,7 @@ class GrainScene:
             steps=int(self.steps), time=float(self.time), node_cell=self.node_cells(), node_position=pos,
             node_displacement=pos - self.node_origin,
             node_velocity=np.array([tuple(st.vel) for st in states]).reshape(-1, 3),
-            node_rotation=np.array([_z_angle(st.ori) for st in states]),
+            node_rotation=np.array([_z_angle(st.ori * q0.conjugate()) for st, q0 in zip(states, self.node_orientation0)]),
             node_angular_velocity=np.array([st.angVel[2] for st in states]),
             bond_broken=self.broken.copy(), bond_mode=self.break_mode.copy(), bond_break_step=self.break_step.copy(),
             bond_tensile_capacity=np.array([ph.FnMax for ph in phys]),
@@ -471,8 +474,12 @@ class GrainScene:
         for n, b in enumerate(nodes):
             body = bodies[int(b)]
             st = body.state
-            st.pos = Vector3(*state.node_position[n])
-            st.ori = Quaternion(Vector3(0, 0, 1), float(state.node_rotation[n]))
+            # in-plane position from the state, the body's own out-of-plane position kept: a plane model's bodies
+            # never move in z, and where a body is a clump (an fem cell's apex sphere and its lifted ghost node)
+            # its z is the clump's centroid, not the sphere's centre another engine reports
+            x, y = state.node_position[n][:2]
+            st.pos = Vector3(float(x), float(y), st.pos[2])
+            st.ori = Quaternion(Vector3(0, 0, 1), float(state.node_rotation[n])) * self.node_orientation0[n]
             st.vel = Vector3(*state.node_velocity[n])
             st.angVel = Vector3(0, 0, float(state.node_angular_velocity[n]))
             if body.isClump:   # members follow the clump's pose (YADE moves them only in a step)
@@ -593,6 +600,7 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
                        interactions=interactions, law=law, newton=newton, model=model, cells=cells,
                        dt_critical=dt_crit)
     scene.node_origin = scene.node_positions()
+    scene.node_orientation0 = [O.bodies[int(b)].state.ori for b in scene.node_bodies()]
     if cells.BONDS_ON_FACES and params.numerics.keep_intact_joints:
         scene.drivers.append(IntactJointGuard(scene))
     return scene
