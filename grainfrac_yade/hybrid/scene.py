@@ -25,7 +25,10 @@ bonds YADE broke, in its order, each broken alone in the static state the stint 
 equilibrium restored (the static model keeps its own small-strain state and contact statuses; the stint decides
 which bonds break), then the static cascade; a held stress is then regained along the static path.  Under a held
 stress a collapse (or no equilibrium within the budget) ends the hold as the static failure rule does
-(:attr:`hold_failure`), with the broken set YADE reached.  Inertia is thus simulated only where the static path cannot go on.
+(:attr:`hold_failure`), with the broken set YADE reached.  With the platens fixed, a stint whose stress falls
+below ``ucs.stop_stress_ratio`` x the stress it started from (the UCS test's own post-peak rule) is the specimen
+failing: its state (stress, broken set) is the scene's last, and the static path does not go on
+(:attr:`dynamic_end`).  Inertia is thus simulated only where the static path cannot go on.
 
 Not bit-reproducible between processes once a stint ran (YADE sums fem node forces in an order keyed by memory
 address, docs/studies/paper_fem.md); a run without stints is the static engine's, bit for bit.  Every stint is
@@ -68,15 +71,23 @@ class HybridScene(StaticScene):
         self.path.max_cascade = params.numerics.handover_cascade_bonds or None
         #: one dict per dynamic stint: why, where, outcome, DEM steps, bonds broken in it, CPU [s]
         self.stints: list[dict] = []
+        #: why the specimen failed in a stint with the platens fixed ("" while it has not): its stress fell below
+        #: ``ucs.stop_stress_ratio`` x the stress the stint started from (the UCS test's own post-peak rule)
+        self.dynamic_end = ""
 
     # ------------------------------------------------------------------ the two solves that may hand over
     def move_to(self, closure: float) -> None:
+        if self.dynamic_end:
+            raise NumericalFailure(f"hybrid: the static path cannot go on from a specimen that failed in a dynamic "
+                                   f"stint ({self.dynamic_end})")
         for _ in range(MAX_STINTS_PER_SOLVE + 1):
             try:
                 super().move_to(closure)
                 return
             except (NumericalFailure, LargeCascade) as exc:
                 self._attempt(exc, held=False)
+                if self.dynamic_end:
+                    return
         raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static path "
                                f"a state it can go on from (closure {self.state.closure:.6g} m)")
 
@@ -139,19 +150,24 @@ class HybridScene(StaticScene):
                    stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
         log["cpu_s"] = time.process_time() - c0
         self.stints.append(log)
-        if outcome == "equilibrium" or (outcome == "budget" and not held):
+        dropped = not held and log["stress_after_pa"] < self.params.ucs.stop_stress_ratio * log["stress_pa"]
+        if outcome == "equilibrium" and not dropped or (outcome == "budget" and not held and not dropped):
             self._take_back(dyn, steps)
             log["cpu_s"] = time.process_time() - c0
-        else:
+            return
+        if held:
             self.hold_failure = (f"dynamic stint: {outcome}: YADE from the static state could not hold "
                                  f"{self.hold_target:.6g} Pa ({log['reason']})")
-            new = dyn.broken & ~self.broken
-            self.broken[new], self.break_mode[new] = True, dyn.break_mode[new]
-            self.break_step[new] = self.steps
-            # the platens as the stint left them: the run's last row shows the load the specimen kept
-            closure = self.state.closure + (ypl.axial_strain() * self.net.height)
-            self.state = dataclasses.replace(self.state, closure=closure, stress=log["stress_after_pa"])
-            self._steps_offset += int(steps)
+        else:
+            self.dynamic_end = (f"dynamic stint: with the platens fixed the stress fell from {log['stress_pa']:.6g} to "
+                                f"{log['stress_after_pa']:.6g} Pa ({log['reason']})")
+        new = dyn.broken & ~self.broken
+        self.broken[new], self.break_mode[new] = True, dyn.break_mode[new]
+        self.break_step[new] = self.steps
+        # the platens as the stint left them: the run's last row shows the load the specimen kept
+        closure = self.state.closure + (ypl.axial_strain() * self.net.height)
+        self.state = dataclasses.replace(self.state, closure=closure, stress=log["stress_after_pa"])
+        self._steps_offset += int(steps)
 
     def _relax(self, dyn, platens, start, held: bool):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
@@ -210,17 +226,20 @@ class HybridScene(StaticScene):
         return {"engine": self.engine_name, "settings_not_used": {}, "dynamic_stints": len(self.stints),
                 "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
                 "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
-                "dynamic_stint_log": list(self.stints), "engine_failure_reason": self.hold_failure}
+                "dynamic_stint_log": list(self.stints),
+                "engine_failure_reason": self.hold_failure or self.dynamic_end}
 
     def _arrays(self) -> dict:
         out = super()._arrays()
         out["hybrid_stints"] = np.str_(json.dumps(self.stints))
+        out["hybrid_dynamic_end"] = np.str_(self.dynamic_end)
         return out
 
     def restore(self, path) -> None:
         super().restore(path)
         with np.load(path) as data:
             self.stints = json.loads(str(data["hybrid_stints"])) if "hybrid_stints" in data.files else []
+            self.dynamic_end = str(data["hybrid_dynamic_end"]) if "hybrid_dynamic_end" in data.files else ""
 
 
 def build_scene(specimen, params, layout=None) -> HybridScene:
