@@ -119,3 +119,23 @@ def test_a_creep_hold_hands_a_cascade_to_yade_and_takes_its_breaks_back(tmp_path
     assert summary["broken_total"] >= stint["broken_after"]
     saved = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert saved["dynamic_stint_dem_steps"] == sum(s["dem_steps"] for s in saved["dynamic_stint_log"])
+
+
+@needs_yade
+def test_a_ucs_ends_where_a_stint_with_fixed_platens_loses_the_load(tmp_path):
+    """UCS on 4 x 8 mm (seed 3) with a cascade limit of 3 bonds: a first stint ends in equilibrium near the stress
+    it started from and the static path goes on with YADE's breaks; a later one loses the load at fixed platens
+    (below ucs.stop_stress_ratio of its start): the specimen's failure, the test's post-peak end, a UCS."""
+    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
+    p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.engine=hybrid",
+                                   "numerics.handover_cascade_bonds=3"])
+    summary = run_ucs_to_folder(p, 3, tmp_path / "run")
+    log = summary["dynamic_stint_log"]
+    assert len(log) >= 2 and all(s["held"] is False for s in log)
+    first, last = log[0], log[-1]
+    assert first["outcome"] == "equilibrium" and first.get("taken_back", True)
+    assert first["stress_after_pa"] >= p.ucs.stop_stress_ratio * first["stress_pa"]
+    assert last["stress_after_pa"] < p.ucs.stop_stress_ratio * last["stress_pa"]
+    assert summary["engine_failure_reason"].startswith("dynamic stint")
+    assert summary["numerical_failure"] is False and summary["end_reason"].startswith("post-peak")
+    assert summary["ucs_pa"] >= last["stress_pa"] > 0
