@@ -234,5 +234,20 @@ def test_resumed_from_a_checkpoint_is_identical(tmp_path):
     assert (tmp_path / "checkpoint").is_dir()
     cols2, result2, _, _ = resume_brazilian(specimen, p, tmp_path)
     assert cols2 == cols
-    for k in ("steps", "broken_total", "end_reason", "peak_reached", "loaded_arc_deg"):
+    for k in ("steps", "broken_total", "end_reason", "peak_reached", "loaded_arc_deg", "static_path_max_load_n"):
         assert result2[k] == result[k], k
+
+
+def test_path_max_load_is_the_largest_load_on_the_path():
+    """The summary's static_path_max_load_n: the largest load at a crossing (before its cascade) or a row, at least the
+    rows' largest, and its 2 P / (pi D t)."""
+    from grainfrac_yade.protocols.brazilian import run_brazilian
+    p = _params()
+    specimen = build_disc_specimen(p, 1)
+    cols, result, scene, _ = run_brazilian(specimen, p)
+    rows_max = max(cols["load_n"])
+    path_max = result["static_path_max_load_n"]
+    crossings = max(r.stress_before for r in scene.path.records) * scene.net.width * scene.net.thickness
+    assert path_max == max(rows_max, crossings) and path_max >= rows_max
+    assert result["static_path_max_tensile_stress_pa"] == pytest.approx(
+        2 * path_max / (math.pi * specimen.tessellation.diameter * specimen.thickness), rel=1e-12)

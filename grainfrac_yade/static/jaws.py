@@ -128,6 +128,7 @@ class StaticJaws(StaticPlatens):
                                                                                              -0.5 * math.pi)]
         self.cells = cells
         self.scene = scene
+        self._read_max = 0.0     # the largest load read so far [N] (path_max_load)
 
     def bind(self):
         """After the scene took the jaws' network: its sizes (D x D) as the platens' reference."""
@@ -146,19 +147,37 @@ class StaticJaws(StaticPlatens):
         return self.lateral_strain()
 
     def load(self) -> float:
-        """Mean reaction of the two jaws along the diameter (compression positive) [N]: P = platen stress x D x t."""
+        """Mean reaction of the two jaws along the diameter (compression positive) [N]: P = platen stress x D x t.
+        Each load read is kept for :meth:`path_max_load`."""
         net = self.scene.net
-        return float(self.scene.state.stress) * net.width * net.thickness
+        p = float(self.scene.state.stress) * net.width * net.thickness
+        self._read_max = max(self._read_max, p)
+        return p
+
+    def path_max_load(self) -> float:
+        """The largest jaw load on the path so far [N]: at a bond's crossing before its cascade (where the path's
+        load has its local maxima, :class:`.cascade.Record`), or where the load was read (the history's rows).  The
+        protocol's rows sample the path, so their largest load is this one or a little below it."""
+        net = self.scene.net
+        crossings = [r.stress_before * net.width * net.thickness for r in self.scene.path.records]
+        return max([self._read_max, *crossings])
+
+    def summary_keys(self) -> dict:
+        """What a run's summary records of the static jaws: the largest load on the path and its 2 P / (pi D t)."""
+        p = self.path_max_load()
+        t = self.scene.net.thickness
+        return {"static_path_max_load_n": p, "static_path_max_tensile_stress_pa": 2 * p / (math.pi * self.diameter * t)}
 
     def state_dict(self) -> dict:
         return {"velocity": self.velocity, "closure": float(self.scene.state.closure), "load_n": self.load(),
-                "lateral": self.lateral}
+                "lateral": self.lateral, "path_max_load_n": self.path_max_load()}
 
     def rebind(self, state) -> None:
-        """After a restore: the closing speed from ``state`` (:meth:`state_dict`); the closure and the load are the
-        restored scene's."""
+        """After a restore: the closing speed and the largest load so far from ``state`` (:meth:`state_dict`); the
+        closure and the load are the restored scene's."""
         if isinstance(state, dict):
             self.velocity = float(state["velocity"])
+            self._read_max = float(state.get("path_max_load_n", 0.0))
 
 
 def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws:

@@ -439,8 +439,13 @@ class StaticScene:
         self.state = self.eq.solve(self.state.closure, self.state)
 
     def summary_keys(self) -> dict:
-        """What a run's summary records of the engine: its name and the dynamic-only settings it did not use."""
-        return summary_keys(self.params)
+        """What a run's summary records of the engine: its name and the dynamic-only settings it did not use (and
+        what its drivers record, e.g. the Brazilian jaws' largest load on the path)."""
+        keys = summary_keys(self.params)
+        for d in self.drivers:
+            if hasattr(d, "summary_keys"):
+                keys.update(d.summary_keys())
+        return keys
 
     def engine_names(self) -> list:
         return [EQUILIBRIUM_NAME] + [d.name for d in self.drivers]
