@@ -27,8 +27,9 @@ import numpy as np
 from ..errors import GrainfracError
 from ..law import MODE_CORRODED, Stresses, check_finite
 from ..protocols.corrosion import BondCorrosion
-from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, build_scene, consolidate,  # noqa: F401
-                    scene_from_state)
+from ..geometry.disc import DiscTessellation
+from .jaws import DiscScene
+from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state)  # noqa: F401
 from .jaws import apply_levers as _apply_levers
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
@@ -47,10 +48,6 @@ UNSUPPORTED = {
 def version() -> str:
     """The versions of the libraries the static engine computes with (numpy, scipy)."""
     return "numpy " + importlib.metadata.version("numpy") + ", scipy " + importlib.metadata.version("scipy")
-
-
-def _refuse(what: str):
-    raise GrainfracError(UNSUPPORTED[what])
 
 
 class StaticCorrosion(BondCorrosion):
@@ -103,6 +100,13 @@ def stress_corrosion(scene: StaticScene, sc_params, saved: dict | None = None) -
         corr.load_state(saved, write=False)
     scene.drivers.append(corr)
     return corr
+
+
+def build_scene(specimen, params, layout=None) -> StaticScene:
+    """The static scene of ``specimen`` (rigid or fem cells, as ``resolution.grain_model`` builds its layout): a
+    :class:`.jaws.DiscScene` (with the Brazilian jaws) for a disc, a :class:`.scene.StaticScene` otherwise."""
+    cls = DiscScene if isinstance(specimen.tessellation, DiscTessellation) else StaticScene
+    return cls(specimen, params, layout)
 
 
 def apply_levers(scene: StaticScene, levers, seed: int) -> dict:

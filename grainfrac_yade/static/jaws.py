@@ -42,7 +42,7 @@ from ..geometry.disc import DiscTessellation
 from ..protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
-from .scene import StaticPlatens
+from .scene import StaticPlatens, StaticScene
 from .solver import Equilibrium
 
 #: Lateral conditions of the jaws (``brazilian.platen_lateral``): "fixed" u_x = 0, "free" u_x free.
@@ -197,6 +197,14 @@ def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws
     bz = scene.params.brazilian
     scene._dt = bz.record_strain_increment / bz.strain_rate
     return jaws
+
+
+class DiscScene(StaticScene):
+    """The static scene of a Brazilian disc: a :class:`.scene.StaticScene` whose ``attach_jaws`` puts the jaws of
+    this module on it (:func:`attach_jaws`)."""
+
+    def attach_jaws(self, loading_arc: float, lateral: str = "fixed") -> StaticJaws:
+        return attach_jaws(self, loading_arc, lateral)
 
 
 def set_equilibrium(scene, eq: Equilibrium) -> None:

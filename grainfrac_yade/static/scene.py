@@ -30,8 +30,8 @@ The test protocols (:mod:`grainfrac_yade.protocols`) drive it unchanged; their c
 Where no set of contact statuses settles (frictional contacts with a non-associated slip rule need not have a
 unique quasi-static equilibrium) the core raises :class:`~grainfrac_yade.errors.NumericalFailure`: the protocols
 end the run as a numerical failure with that reason.  Rough platens are not in the core yet: refused with one
-line.  The Brazilian disc's jaws (``attach_jaws``) are :mod:`.jaws`: the jaw cells as prescribed-displacement
-platens, rough or smooth.  The creep hold follows a law that changes strengths only (a law that changes the
+line.  The Brazilian disc's jaws (``attach_jaws``) are those of a disc's scene, :class:`.jaws.DiscScene`: the
+jaw cells as prescribed-displacement platens, rough or smooth.  The creep hold follows a law that changes strengths only (a law that changes the
 bonds' stiffness, the area law, is refused in one line: :data:`STIFFNESS_LAW_REFUSED`).
 """
 from __future__ import annotations
@@ -417,10 +417,9 @@ class StaticScene:
         return pl
 
     def attach_jaws(self, loading_arc: float, lateral: str = "fixed"):
-        """The Brazilian disc's jaws (:class:`.jaws.StaticJaws`): the jaw cells become the scene's platens, rough
-        (``lateral`` "fixed") or smooth ("free"), before any loading (:func:`.jaws.attach_jaws`)."""
-        from .jaws import attach_jaws
-        return attach_jaws(self, loading_arc, lateral)
+        """Refused: the Brazilian jaws go on a disc, whose scene (:class:`.jaws.DiscScene`) has them."""
+        raise GrainfracError("Brazilian test: the specimen is not a disc; fix: build it with "
+                             "grainfrac_yade.geometry.specimen.build_disc_specimen")
 
     def confine(self, stress: float) -> StaticConfinement:
         conf = StaticConfinement(self, stress)
