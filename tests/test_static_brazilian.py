@@ -21,6 +21,8 @@ TINY = ["brazilian.diameter=4e-3", "specimen.grain_size=0.5e-3", "brazilian.reco
         "numerics.engine=static"]
 #: summary.json keys that name the code or measure the machine, not the run.
 NOT_THE_RUN = ("code_version", "wall_s", "cpu_s")
+#: The resumed tests: a checkpoint before every row, to 0.3 % diametral strain (150 rows, bonds broken by then).
+RESUMED = ("numerics.checkpoint_interval=1e-9", "brazilian.max_strain=3e-3")
 #: Round-off between the static core's solve (SuperLU, its own assembly order) and the reference's spsolve:
 #: measured 1e-13 relative on the UCS specimens (tests/test_static_elastic.py); 1e-9 still catches any change of
 #: the jaws' boundary (a jaw node's lateral dof left free moves the load by more than 1e-3).
@@ -228,12 +230,13 @@ def test_resumed_from_a_checkpoint_is_identical(tmp_path):
     """A checkpoint before every history row (the static scene saved as an .npz, the jaws' speed in the state):
     resuming from the last one gives the uninterrupted test's history and result."""
     from grainfrac_yade.protocols.brazilian import resume_brazilian, run_brazilian
-    p = _params("numerics.checkpoint_interval=1e-9")
+    p = _params(*RESUMED)
     specimen = build_disc_specimen(p, 1)
     cols, result, _, _ = run_brazilian(specimen, p, checkpoint_folder=tmp_path, run_values={"seed": 1})
     assert (tmp_path / "checkpoint").is_dir()
     cols2, result2, _, _ = resume_brazilian(specimen, p, tmp_path)
     assert cols2 == cols
+    assert result["broken_total"] > 0
     for k in ("steps", "broken_total", "end_reason", "peak_reached", "loaded_arc_deg", "static_path_max_load_n"):
         assert result2[k] == result[k], k
 
@@ -251,3 +254,21 @@ def test_path_max_load_is_the_largest_load_on_the_path():
     assert path_max == max(rows_max, crossings) and path_max >= rows_max
     assert result["static_path_max_tensile_stress_pa"] == pytest.approx(
         2 * path_max / (math.pi * specimen.tessellation.diameter * specimen.thickness), rel=1e-12)
+
+
+def test_resumed_with_blocked_rotation_is_identical(tmp_path):
+    """The blocked rotation (a lever, applied before loading) comes back with the checkpoint's jaws: the resumed test
+    equals the uninterrupted one."""
+    from grainfrac_yade.protocols.brazilian import resume_brazilian, run_brazilian
+    p = _params(*RESUMED)
+    specimen = build_disc_specimen(p, 1)
+    levers = Levers(block_rotation=True)
+    cols, result, scene, _ = run_brazilian(specimen, p, levers=levers, checkpoint_folder=tmp_path,
+                                           run_values={"seed": 1})
+    cols2, result2, scene2, _ = resume_brazilian(specimen, p, tmp_path)
+    assert scene2.rotation_blocked and cols2 == cols
+    rot = scene2.net.dofs[:, 2]
+    assert np.all(scene2.state.u[rot[rot >= 0]] == 0.0)
+    assert result["broken_total"] > 0
+    for k in ("steps", "broken_total", "end_reason", "static_path_max_load_n"):
+        assert result2[k] == result[k], k

@@ -170,14 +170,21 @@ class StaticJaws(StaticPlatens):
 
     def state_dict(self) -> dict:
         return {"velocity": self.velocity, "closure": float(self.scene.state.closure), "load_n": self.load(),
-                "lateral": self.lateral, "path_max_load_n": self.path_max_load()}
+                "lateral": self.lateral, "path_max_load_n": self.path_max_load(),
+                "rotation_blocked": bool(getattr(self.scene, "rotation_blocked", False))}
 
     def rebind(self, state) -> None:
-        """After a restore: the closing speed and the largest load so far from ``state`` (:meth:`state_dict`); the
-        closure and the load are the restored scene's."""
-        if isinstance(state, dict):
-            self.velocity = float(state["velocity"])
-            self._read_max = float(state.get("path_max_load_n", 0.0))
+        """After a restore: the closing speed, the largest load so far and a blocked rotation (the lever, applied
+        before the checkpoint) from ``state`` (:meth:`state_dict`); the closure and the load are the restored
+        scene's, which the blocked rotation already holds (no solve)."""
+        if not isinstance(state, dict):
+            return
+        self.velocity = float(state["velocity"])
+        self._read_max = float(state.get("path_max_load_n", 0.0))
+        scene = self.scene
+        if state.get("rotation_blocked") and not getattr(scene, "rotation_blocked", False):
+            scene.rotation_blocked = True
+            set_equilibrium(scene, JawEquilibrium(scene.net, self.lateral == "fixed", True), solve=False)
 
 
 def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws:
@@ -207,13 +214,15 @@ class DiscScene(StaticScene):
         return attach_jaws(self, loading_arc, lateral)
 
 
-def set_equilibrium(scene, eq: Equilibrium) -> None:
-    """``eq`` as ``scene``'s equilibrium: counters and strengths carried over, the state solved again where it is."""
+def set_equilibrium(scene, eq: Equilibrium, solve: bool = True) -> None:
+    """``eq`` as ``scene``'s equilibrium: counters and strengths carried over, the state solved again where it is
+    (``solve`` False: a restored state that ``eq``'s constraints already hold is kept as it is)."""
     eq.counters = scene.eq.counters
     jt, jc = scene.path.jt, scene.path.jc
     scene.eq, scene.path = eq, Path(eq)
     scene.path.jt, scene.path.jc = jt, jc
-    scene.state = scene.path.cascade(eq.solve(scene.state.closure, scene.state))
+    if solve:
+        scene.state = scene.path.cascade(eq.solve(scene.state.closure, scene.state))
 
 
 def apply_levers(scene, levers: Levers, seed: int) -> dict:
