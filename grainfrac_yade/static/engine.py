@@ -10,8 +10,8 @@ What the protocols reach through an engine module: ``build_scene``, ``scene_from
 isotropic stage of a confined test) and ``stress_corrosion`` (the creep test's bond writer, :class:`StaticCorrosion`:
 the creep test of :mod:`grainfrac_yade.protocols.creep` runs on the static scene's held platen stress with the event
 clock; the paper clock needs dynamics and is refused).  Not in the static engine yet, each refused with one line
-naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the Brazilian jaws
-and levers, VTK series, bench.
+naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): VTK series, bench.
+The Brazilian test runs on the disc's jaws of :mod:`.jaws` (``attach_jaws``) with the levers of ``apply_levers``.
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
@@ -27,8 +27,10 @@ import numpy as np
 from ..errors import GrainfracError
 from ..law import MODE_CORRODED, Stresses, check_finite
 from ..protocols.corrosion import BondCorrosion
-from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, build_scene, consolidate,  # noqa: F401
-                    scene_from_state)
+from ..geometry.disc import DiscTessellation
+from .jaws import DiscScene
+from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state)  # noqa: F401
+from .jaws import apply_levers as _apply_levers
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
@@ -40,18 +42,12 @@ AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
 UNSUPPORTED = {
     "bench": ("the static engine has no DEM steps to time (bench measures YADE's stepping and creep runs); fix: "
               "bench with numerics.engine = \"yade\""),
-    "brazilian": ("the static engine's Brazilian test needs the disc's jaws in the static core (not built yet); "
-                  "fix: --engine yade (numerics.engine = \"yade\")"),
 }
 
 
 def version() -> str:
     """The versions of the libraries the static engine computes with (numpy, scipy)."""
     return "numpy " + importlib.metadata.version("numpy") + ", scipy " + importlib.metadata.version("scipy")
-
-
-def _refuse(what: str):
-    raise GrainfracError(UNSUPPORTED[what])
 
 
 class StaticCorrosion(BondCorrosion):
@@ -106,9 +102,17 @@ def stress_corrosion(scene: StaticScene, sc_params, saved: dict | None = None) -
     return corr
 
 
-def apply_levers(*args, **kwargs):
-    """Refused: the Brazilian levers act on a YADE disc (:data:`UNSUPPORTED`)."""
-    _refuse("brazilian")
+def build_scene(specimen, params, layout=None) -> StaticScene:
+    """The static scene of ``specimen`` (rigid or fem cells, as ``resolution.grain_model`` builds its layout): a
+    :class:`.jaws.DiscScene` (with the Brazilian jaws) for a disc, a :class:`.scene.StaticScene` otherwise."""
+    cls = DiscScene if isinstance(specimen.tessellation, DiscTessellation) else StaticScene
+    return cls(specimen, params, layout)
+
+
+def apply_levers(scene: StaticScene, levers, seed: int) -> dict:
+    """The Brazilian levers on a static scene before its loading (:func:`.jaws.apply_levers`: strength scatter and
+    slits on both grain models, blocked rotation on rigid cells); what was done, as YADE's counts."""
+    return _apply_levers(scene, levers, seed)
 
 
 

@@ -29,8 +29,9 @@ The test protocols (:mod:`grainfrac_yade.protocols`) drive it unchanged; their c
 
 Where no set of contact statuses settles (frictional contacts with a non-associated slip rule need not have a
 unique quasi-static equilibrium) the core raises :class:`~grainfrac_yade.errors.NumericalFailure`: the protocols
-end the run as a numerical failure with that reason.  Rough platens and the Brazilian jaws are not in the core
-yet: refused with one line.  The creep hold follows a law that changes strengths only (a law that changes the
+end the run as a numerical failure with that reason.  Rough platens are not in the core yet: refused with one
+line.  The Brazilian disc's jaws (``attach_jaws``) are those of a disc's scene, :class:`.jaws.DiscScene`: the
+jaw cells as prescribed-displacement platens, rough or smooth.  The creep hold follows a law that changes strengths only (a law that changes the
 bonds' stiffness, the area law, is refused in one line: :data:`STIFFNESS_LAW_REFUSED`).
 """
 from __future__ import annotations
@@ -419,8 +420,9 @@ class StaticScene:
         return pl
 
     def attach_jaws(self, loading_arc: float, lateral: str = "fixed"):
-        raise GrainfracError("static engine: the Brazilian test's jaws are not in the static core yet; fix: "
-                             "--engine yade (numerics.engine = \"yade\")")
+        """Refused: the Brazilian jaws go on a disc, whose scene (:class:`.jaws.DiscScene`) has them."""
+        raise GrainfracError("Brazilian test: the specimen is not a disc; fix: build it with "
+                             "grainfrac_yade.geometry.specimen.build_disc_specimen")
 
     def confine(self, stress: float) -> StaticConfinement:
         conf = StaticConfinement(self, stress)
@@ -439,8 +441,13 @@ class StaticScene:
         self.state = self.eq.solve(self.state.closure, self.state)
 
     def summary_keys(self) -> dict:
-        """What a run's summary records of the engine: its name and the dynamic-only settings it did not use."""
-        return summary_keys(self.params)
+        """What a run's summary records of the engine: its name and the dynamic-only settings it did not use (and
+        what its drivers record, e.g. the Brazilian jaws' largest load on the path)."""
+        keys = summary_keys(self.params)
+        for d in self.drivers:
+            if hasattr(d, "summary_keys"):
+                keys.update(d.summary_keys())
+        return keys
 
     def engine_names(self) -> list:
         return [EQUILIBRIUM_NAME] + [d.name for d in self.drivers]
