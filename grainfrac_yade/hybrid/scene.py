@@ -223,11 +223,13 @@ class HybridScene(StaticScene):
     # ------------------------------------------------------------------ records
     def summary_keys(self) -> dict:
         """The engine's name, no unused settings (the stints use the dynamic ones), and the stints' totals and log."""
-        return {"engine": self.engine_name, "settings_not_used": {}, "dynamic_stints": len(self.stints),
-                "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
-                "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
-                "dynamic_stint_log": list(self.stints),
-                "engine_failure_reason": self.hold_failure or self.dynamic_end}
+        keys = super().summary_keys()
+        keys.update({"engine": self.engine_name, "settings_not_used": {}, "dynamic_stints": len(self.stints),
+                     "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
+                     "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
+                     "dynamic_stint_log": list(self.stints),
+                     "engine_failure_reason": self.hold_failure or self.dynamic_end})
+        return keys
 
     def _arrays(self) -> dict:
         out = super()._arrays()
