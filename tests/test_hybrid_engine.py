@@ -113,7 +113,7 @@ def test_a_creep_hold_hands_a_cascade_to_yade_and_takes_its_breaks_back(tmp_path
     assert summary["engine"] == "hybrid" and summary["dynamic_stints"] >= 1
     stint = summary["dynamic_stint_log"][0]
     assert stint["held"] is True and stint["outcome"] == "equilibrium" and stint["dem_steps"] > 0
-    assert stint["broken_after"] > stint["broken_before"] and stint.get("taken_back", True)
+    assert stint["broken_after"] > stint["broken_before"] and stint["taken_back"] in ("state", "breaks")
     assert stint["stress_after_pa"] == pytest.approx(160e6, rel=p.creep.stress_tolerance)
     assert summary["lifetime_s"] > 0 and summary["numerical_failure"] is False
     assert summary["broken_total"] >= stint["broken_after"]
@@ -133,7 +133,7 @@ def test_a_ucs_ends_where_a_stint_with_fixed_platens_loses_the_load(tmp_path):
     log = summary["dynamic_stint_log"]
     assert len(log) >= 2 and all(s["held"] is False for s in log)
     first, last = log[0], log[-1]
-    assert first["outcome"] == "equilibrium" and first.get("taken_back", True)
+    assert first["outcome"] == "equilibrium" and first["taken_back"] in ("state", "breaks")
     assert first["stress_after_pa"] >= p.ucs.stop_stress_ratio * first["stress_pa"]
     assert last["stress_after_pa"] < p.ucs.stop_stress_ratio * last["stress_pa"]
     assert summary["engine_failure_reason"].startswith("dynamic stint")

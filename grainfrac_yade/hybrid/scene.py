@@ -152,7 +152,7 @@ class HybridScene(StaticScene):
         self.stints.append(log)
         dropped = not held and log["stress_after_pa"] < self.params.ucs.stop_stress_ratio * log["stress_pa"]
         if outcome == "equilibrium" and not dropped or (outcome == "budget" and not held and not dropped):
-            self._take_back(dyn, steps)
+            self._take_back(dyn, ypl, steps, log)
             log["cpu_s"] = time.process_time() - c0
             return
         if held:
@@ -202,16 +202,50 @@ class HybridScene(StaticScene):
                 return "equilibrium", done, servo
         return "budget", done, servo
 
-    def _take_back(self, dyn, dem_steps: int) -> None:
-        """What the stint broke, into the static state it started from: the bonds YADE broke, in the order it broke
-        them (ties: canonical order), each broken alone and the static equilibrium restored at the same closure
-        (:meth:`.cascade.Path.break_bond`), then the static cascade.  The static model keeps its own small-strain
-        state and contact statuses; the stint decides which bonds break.  The counters go on (steps: equilibria and
-        the stint's DEM steps)."""
+    def _take_back(self, dyn, platens, dem_steps: int, log: dict) -> None:
+        """What the stint reached, into the static scene: first YADE's relaxed state itself (:meth:`_take_state`);
+        where the static equilibrium does not settle from it, the bonds YADE broke, into the static state the stint
+        started from (:meth:`_take_breaks`).  ``log["taken_back"]`` names the way that worked.  The counters go on
+        (steps: equilibria and the stint's DEM steps; time: the load parameter, DEM time not added)."""
+        self._steps_offset += int(dem_steps)
+        saved = (self.state, self.path.jt.copy(), self.path.jc.copy(), self.broken.copy(), self.break_mode.copy(),
+                 self.break_step.copy(), self._steps_offset)
+        try:
+            self._take_state(dyn.export_state(platens))
+            log["taken_back"] = "state"
+            return
+        except (NumericalFailure, LargeCascade):
+            (self.state, self.path.jt, self.path.jc, self.broken, self.break_mode, self.break_step,
+             self._steps_offset) = saved
+        self._take_breaks(dyn)
+        log["taken_back"] = "breaks"
+
+    def _take_state(self, state: SceneState) -> None:
+        """YADE's relaxed ``state``: nodes, broken set and strengths as YADE left them, each broken contact's shear
+        reference from YADE's shear force (s_p = du_s - F_s / k_s along the static tangent,
+        :mod:`grainfrac_yade.static.contacts`), the static equilibrium solved there and its cascade.  With fem cells
+        a relaxed YADE state is a static equilibrium of the same model (the hand-over check: 2e-10), so the solve
+        starts settled; NumericalFailure where it does not settle (LargeCascade where its cascade grows)."""
+        net = self.net
+        _, tangent = self._bond_frame()
+        fs = (np.asarray(state.bond_shear_force) * tangent).sum(1)[net.order]
+        ds = net.ct @ self.displacements(state)
+        broken = np.asarray(state.bond_broken, bool)[net.order]
+        slip = np.empty(self.n_bonds)
+        slip[net.order] = np.where(broken, ds - fs / net.ks, 0.0)
+        back = dataclasses.replace(state, bond_slip=slip, steps=self.steps, time=self._time, platens=None)
+        self.apply_state(back)
+        self._take(self.path.cascade(self.state))
+        self.path.last_state = self.state
+
+    def _take_breaks(self, dyn) -> None:
+        """The bonds YADE broke, in the order it broke them (ties: canonical order), into the static state the stint
+        started from, each broken alone and the static equilibrium restored at the same closure
+        (:meth:`.cascade.Path.break_bond`), then the static cascade: the static model keeps its own state and contact
+        statuses, the stint decides which bonds break."""
         new = np.flatnonzero(dyn.broken & ~self.broken)
         order = np.lexsort((self.canon[new], dyn.break_step[new]))
         state = self.state
-        self._steps_offset += int(dem_steps)
         try:
             for k in new[order]:
                 state = self.path.break_bond(state, int(self.canon[k]), int(dyn.break_mode[k]))
