@@ -171,7 +171,9 @@ class HybridScene(StaticScene):
 
     def _relax(self, dyn, platens, start, held: bool):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
-        servo or None); outcome "equilibrium", "collapse" or "budget" (none within the relaxation budget)."""
+        servo or None); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
+        ``ucs.stop_stress_ratio`` x the stint's start, the UCS test's post-peak rule) or "budget" (none of these
+        within the relaxation budget)."""
         cp = self.params.creep
         strain = max(start.closure / self.net.height, SERVO_STRAIN_FLOOR)
         young = max(start.stress, 0.0) / strain
@@ -193,6 +195,8 @@ class HybridScene(StaticScene):
             if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
                                                   platens.axial_strain()):
                 return "collapse", done, servo
+            if not held and platens.axial_stress() < self.params.ucs.stop_stress_ratio * start.stress:
+                return "lost load", done, servo     # the UCS test's post-peak rule: nothing to relax further
             intact = np.flatnonzero(~dyn.broken)
             if held:
                 balanced = held_at_equilibrium(dyn, servo, intact, cp)
