@@ -11,7 +11,8 @@ isotropic stage of a confined test) and ``stress_corrosion`` (the creep test's b
 the creep test of :mod:`grainfrac_yade.protocols.creep` runs on the static scene's held platen stress with the event
 clock; the paper clock needs dynamics and is refused).  Not in the static engine yet, each refused with one line
 naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the Brazilian jaws
-and levers, VTK series, bench.
+and levers, bench.  VTK series are written as on any engine (:mod:`grainfrac_yade.protocols.snapshots` reads the
+scene's ``cell_motion`` and ``bond_shift``; :data:`VTK_REFUSED` is empty).
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
@@ -33,8 +34,6 @@ from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noq
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
 DYNAMIC = False
-#: Names of the strain a VTK series is timed by (as the YADE engine's; VTK output is refused here).
-AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
 
 #: Commands the static engine cannot run yet -> the one line that says so and the fix.
 UNSUPPORTED = {
@@ -109,12 +108,3 @@ def stress_corrosion(scene: StaticScene, sc_params, saved: dict | None = None) -
 def apply_levers(*args, **kwargs):
     """Refused: the Brazilian levers act on a YADE disc (:data:`UNSUPPORTED`)."""
     _refuse("brazilian")
-
-
-
-
-class StrainSeries:
-    """VTK series: not written by the static engine yet (refused with one line)."""
-
-    def __init__(self, *args, **kwargs):
-        raise GrainfracError(VTK_REFUSED)
