@@ -11,8 +11,10 @@ isotropic stage of a confined test) and ``stress_corrosion`` (the creep test's b
 the creep test of :mod:`grainfrac_yade.protocols.creep` runs on the static scene's held platen stress with the event
 clock; the paper clock needs dynamics and is refused).  Not in the static engine yet, each refused with one line
 naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): the Brazilian jaws
-and levers, bench.  VTK series are written as on any engine (:mod:`grainfrac_yade.protocols.snapshots` reads the
-scene's ``cell_motion`` and ``bond_shift``; :data:`VTK_REFUSED` is empty).
+and levers.  The timings of ``bench --static`` (:mod:`.bench_timing`: a network built and a creep hold timed per
+event, in CPU time) are reached here, as YADE's are in its engine module.  VTK series are written as on any
+engine (:mod:`grainfrac_yade.protocols.snapshots` reads the scene's ``cell_motion`` and ``bond_shift``;
+:data:`VTK_REFUSED` is empty).
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
@@ -28,6 +30,7 @@ import numpy as np
 from ..errors import GrainfracError
 from ..law import MODE_CORRODED, Stresses, check_finite
 from ..protocols.corrosion import BondCorrosion
+from .bench_timing import timed_creep_hold, timed_network  # noqa: F401
 from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, build_scene, consolidate,  # noqa: F401
                     scene_from_state)
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
@@ -37,8 +40,6 @@ DYNAMIC = False
 
 #: Commands the static engine cannot run yet -> the one line that says so and the fix.
 UNSUPPORTED = {
-    "bench": ("the static engine has no DEM steps to time (bench measures YADE's stepping and creep runs); fix: "
-              "bench with numerics.engine = \"yade\""),
     "brazilian": ("the static engine's Brazilian test needs the disc's jaws in the static core (not built yet); "
                   "fix: --engine yade (numerics.engine = \"yade\")"),
 }
