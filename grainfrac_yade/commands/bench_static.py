@@ -222,7 +222,7 @@ def static_tables(result: dict) -> str:
             r = c[name]
             lines.append(f"| {name} | {r['n_bodies']} / {r['n_bonds']} | {r['ramp_and_first_relaxation_cpu_s']:.2f} | "
                          f"{r['events']} | {r['cpu_per_event_s']:.4g} | {r['steps_per_event']:.0f} {steps} |")
-        lines += ["", f"YADE / static, CPU per event: x {c['yade_over_static_cpu_per_event']:.0f}."]
+        lines += ["", f"YADE / static, CPU per event: x {c['yade_over_static_cpu_per_event']:.1f}."]
     lines += ["", f"Per creep event against size, the static core's hold ({b['settings']['events']} events asked each):", "",
               "| specimen [mm] | dofs | bonds | build [CPU s] | ramp: CPU [s], equilibria, bonds broken | events | "
               "CPU per event [s] | equilibria per event | iterations per event | iterations per equilibrium | "
