@@ -51,10 +51,13 @@ def _check_sizes(result, settings):
 
 def test_size_series_without_yade(tmp_path):
     """The static core's holds on two tiny sizes: every key, per-event lists as long as the events, positive costs,
-    a finite exponent; the JSON written is what the function returns."""
+    a finite exponent; the JSON is rewritten after each size and at the end holds what the function returns."""
     from grainfrac_yade.commands.bench import peak_rss_mb
     out = tmp_path / "static.json"
-    result = run_static_bench(TINY, preset=FEM, peak_rss=peak_rss_mb, out=out)
+    written = []   # sizes in the JSON on disk as each size is reported: partial results survive an interruption
+    result = run_static_bench(TINY, preset=FEM, peak_rss=peak_rss_mb, out=out,
+                              progress=lambda msg: written.append(len(json.loads(out.read_text())["sizes"])))
+    assert written == [1, 2]
     assert "engines_per_event" not in result
     _check_sizes(result, TINY)
     assert json.loads(out.read_text())["sizes"][0]["dofs"] == result["sizes"][0]["dofs"]

@@ -143,10 +143,10 @@ def compare_engines(settings, preset, user_files, overrides, seed, stress, progr
     return out
 
 
-def size_series(settings, preset, user_files, overrides, seed, stress, progress, peak_rss, save) -> list:
-    """The core's creep hold on each specimen of ``settings.sizes`` (module doc, part 2); ``save()`` after each."""
+def size_series(settings, preset, user_files, overrides, seed, stress, progress, peak_rss, save, rows) -> list:
+    """The core's creep hold on each specimen of ``settings.sizes`` (module doc, part 2), appended to ``rows`` (the
+    result's list, so that ``save()`` after each size writes it)."""
     static = engine("static")
-    rows = []
     for name, width, height in settings.sizes:
         params = size_params(preset, user_files, width, height, overrides, "static")
         net, build_cpu = static.timed_network(build_specimen(params, seed), params)
@@ -155,9 +155,9 @@ def size_series(settings, preset, user_files, overrides, seed, stress, progress,
             hold.pop(key)
         rows.append({"specimen": name, "width_m": width, "height_m": height, "dofs": net.ndof, "bonds": net.n_bonds,
                      "build_cpu_s": build_cpu, **hold, "peak_rss_mb_after": peak_rss()})
+        save()
         progress(f"static core, {name} mm ({net.ndof} dofs): ramp {hold['ramp']['cpu_s']:.2f} CPU s, "
                  f"{hold['events']} events, {_num(hold['cpu_per_event_s'], '.3g')} CPU s per event")
-        save()
     return rows
 
 
@@ -199,7 +199,8 @@ def run_static_bench(settings: StaticBenchSettings, seed=1, stress=HOLD_STRESS_P
         result["engines_per_event"] = compare_engines(settings, preset, extra_files, overrides, seed, stress, progress)
         result["peak_rss_mb_after_comparison"] = peak_rss()
         save()
-    result["sizes"] = size_series(settings, preset, extra_files, overrides, seed, stress, progress, peak_rss, save)
+    result["sizes"] = []
+    size_series(settings, preset, extra_files, overrides, seed, stress, progress, peak_rss, save, result["sizes"])
     result["dofs_scaling"] = dofs_exponent(result["sizes"])
     save()
     return result
