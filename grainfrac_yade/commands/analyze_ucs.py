@@ -1,4 +1,4 @@
-"""``analyze-ucs``: table and figure of UCS tests in a study folder (resolution, size, calibration), and
+"""``analyze-ucs``: table and figure of UCS tests in a study folder (engine, resolution, size, calibration), and
 the peak-strength envelope of confined tests (Mohr-Coulomb and Hoek-Brown fits) where a model variant
 was tested at two confining stresses or more."""
 from __future__ import annotations

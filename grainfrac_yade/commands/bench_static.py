@@ -41,8 +41,10 @@ from ..params import load_parameters, require_plane
 from ..protocols.timed_creep import TimedCreepRun
 from ..runs.runio import code_version, write_json
 
+#: The checkout's root (paths in the JSON are written relative to it where they lie inside it).
+ROOT = Path(__file__).resolve().parents[2]
 #: Where ``bench --static`` writes by default, and with ``--quick``.
-STATIC_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench_static.json"
+STATIC_OUT = ROOT / "docs" / "bench_static.json"
 STATIC_QUICK_OUT = Path("results/bench_static_quick.json")
 #: The held stress [Pa]: the static engine's creep holds (docs/studies/static_engine.md) and YADE's paper-size ones.
 HOLD_STRESS_PA = 160e6
@@ -174,10 +176,11 @@ def dofs_exponent(rows) -> dict:
     return out
 
 
-def run_static_bench(settings: StaticBenchSettings, seed=1, stress=HOLD_STRESS_PA, preset=None, extra_files=(),
+def run_static_bench(settings: StaticBenchSettings, preset, seed=1, stress=HOLD_STRESS_PA, extra_files=(),
                      overrides=(), header=None, peak_rss=None, progress=None, out=None) -> dict:
-    """Every measurement of ``bench --static``, as the JSON stores it; ``header``: entries put first (the machine),
-    ``peak_rss``: the process's peak memory so far [MB], ``out``: the JSON rewritten after each part."""
+    """Every measurement of ``bench --static``, as the JSON stores it; ``preset``: the fem cells' parameter file
+    (``params/presets/fem.toml``), ``header``: entries put first (the machine), ``peak_rss``: the process's peak
+    memory so far [MB], ``out``: the JSON rewritten after each part."""
     if not stress > 0:
         raise GrainfracError(f"--creep-stress {stress / 1e6:g}: a creep stress must be positive [MPa]; fix: e.g. "
                              "--creep-stress 160")
@@ -185,7 +188,7 @@ def run_static_bench(settings: StaticBenchSettings, seed=1, stress=HOLD_STRESS_P
     t0, c0 = time.perf_counter(), time.process_time()
     result = {**(header or {}),
               "bench": {"kind": "static", "settings": asdict(settings), "seed": seed, "stress_pa": stress,
-                        "clock": CLOCK, "preset": str(preset), "overrides": list(overrides),
+                        "clock": CLOCK, "preset": _shown(preset), "overrides": list(overrides),
                         "code_version": code_version(), "argv": list(sys.argv),
                         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}}
 
@@ -244,6 +247,12 @@ def static_tables(result: dict) -> str:
                      f"{s['cpu_per_quiet_event_sizes']} sizes")
         lines += ["", text + " (least squares in log-log)."]
     return "\n".join(lines)
+
+
+def _shown(path) -> str:
+    """``path`` relative to the checkout's root where it lies inside it (a JSON that does not name this machine)."""
+    path = Path(path).resolve()
+    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
 
 
 def _num(value, fmt: str) -> str:
