@@ -12,42 +12,21 @@ counters and the break sequence's hash (to compare the fast and the direct path)
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import math
 import sys
 import time
 
-from grainfrac_yade.clocks import EventClock
 from grainfrac_yade.errors import NumericalFailure
 from grainfrac_yade.grains import layout_for
-from grainfrac_yade.law import build_law
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.static.bench_timing import counters, sequence_hash, timed_creep_hold
 from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.creep import creep_hold
-from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 
 from .static_engine_probe import specimen_arguments
-
-
-def counters(eq, cpu, records, bonds):
-    """The solver's counters and the CPU per equilibrium, per break (a record: a crossing and its cascade, as the
-    study page counts them) and per bond broken."""
-    c = eq.counters
-    d = {k: getattr(c, k) for k in vars(c)}
-    d.update(cpu_s=cpu, cpu_per_equilibrium_s=cpu / max(c.equilibria, 1),
-             equilibria_per_break=c.equilibria / max(records, 1), cpu_per_break_s=cpu / max(records, 1),
-             cpu_per_bond_s=cpu / max(bonds, 1), iterations_per_equilibrium=c.iterations / max(c.equilibria, 1))
-    return d
-
-
-def sequence_hash(records):
-    """Hash of the break sequence (canonical bond numbers in order) and its length."""
-    seq = [int(k) for r in records for k in r.bonds]
-    return hashlib.sha1(repr(seq).encode()).hexdigest()[:12], len(seq)
 
 
 def sequence(records):
@@ -92,40 +71,19 @@ def main(argv=None):
         out["path"] = {"breaks": nb, "records": len(path.records), "strain": st.closure / net.height,
                        "stress_mpa": st.stress / 1e6, "end": end, "sequence_hash": h, **counters(eq, cpu, len(path.records), nb)}
     if a.creep_stress:
-        eq2 = Equilibrium(net, **settings)
-        path2 = Path(eq2)
-        law = build_law(p.stress_corrosion)
-        clock = EventClock(p.stress_corrosion.max_strength_loss_fraction, a.time_limit)
-        ramp = {}
-        orig_hold = path2.hold
-
-        def hold(state, target, rule):      # the first call is the ramp: time it apart
-            t = time.process_time()
-            r = orig_hold(state, target, rule)
-            if not ramp:
-                ramp.update(cpu_s=time.process_time() - t, equilibria=eq2.counters.equilibria,
-                            broken=int(r[0].broken.sum()), strain=r[0].closure / net.height)
-            calls[0] += 1
-            print(json.dumps({"event": calls[0] - 1, "cpu_s": time.process_time() - t3, "creep_time_s": clock.creep_time,
-                              "broken": int(r[0].broken.sum()), "strain": r[0].closure / net.height,
-                              "equilibria": eq2.counters.equilibria}), file=sys.stderr, flush=True)
-            return r
-        calls = [0]
-        path2.hold = hold
-        t3 = time.process_time()
-        res = creep_hold(eq2, law, clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),
-                         max_events=a.events, path=path2)
-        cpu = time.process_time() - t3
-        ev_cpu = cpu - ramp.get("cpu_s", 0.0)
-        ev_eq = eq2.counters.equilibria - ramp.get("equilibria", 0)
-        h, n = sequence_hash(path2.records)
-        out["creep"] = {"stress_mpa": a.creep_stress / 1e6, "ramp": ramp, "events": res.events,
+        def progress(line):     # one JSON line per event on stderr, as before
+            print(json.dumps(line), file=sys.stderr, flush=True)
+        hold = timed_creep_hold(net, p, a.creep_stress, a.events, time_limit=a.time_limit, settings=settings,
+                                progress=progress)
+        path2, res = hold["path"], hold["result"]
+        out["creep"] = {"stress_mpa": a.creep_stress / 1e6, "ramp": hold["ramp"], "events": hold["events"],
                         "failed": res.failed, "reason": res.reason[:300], "lifetime_s": res.lifetime,
-                        "broken": res.broken, "cpu_s": cpu, "events_cpu_s": ev_cpu,
-                        "cpu_per_event_s": ev_cpu / max(res.events, 1),
-                        "equilibria_per_event": ev_eq / max(res.events, 1),
-                        "cpu_per_event_equilibrium_s": ev_cpu / max(ev_eq, 1), "sequence_hash": h,
-                        "times": res.times[:5], "counters": counters(eq2, cpu, len(path2.records), n)}
+                        "broken": res.broken, "cpu_s": hold["cpu_s"], "events_cpu_s": hold["events_cpu_s"],
+                        "cpu_per_event_s": hold["cpu_per_event_s"] or 0.0,
+                        "equilibria_per_event": hold["equilibria_per_event"] or 0.0,
+                        "cpu_per_event_equilibrium_s": hold["events_cpu_s"] / max(sum(hold["event_equilibria"]), 1),
+                        "cpu_per_quiet_event_s": hold["cpu_per_quiet_event_s"], "quiet_events": hold["quiet_events"],
+                        "sequence_hash": hold["sequence_hash"], "times": res.times[:5], "counters": hold["counters"]}
     if a.dump:
         with open(a.dump, "w") as fh:
             json.dump({"path": sequence(path.records) if a.breaks > 0 else [],

@@ -1,6 +1,7 @@
 """Collect run folders into one pandas DataFrame (one row per run; unfinished, failed and unreadable runs kept)."""
 from __future__ import annotations
 
+import copy
 import json
 from pathlib import Path
 
@@ -24,6 +25,24 @@ PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resol
                  "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")
 #: summary.json of creep runs made before the degradation laws had names: "mode" -> "law".
 _SUMMARY_LAW = RENAMED_KEYS["stress_corrosion.mode"][1]
+#: The column naming the mechanical engine that computed a run (``numerics.engine``: "yade" explicit DEM, "static"
+#: static equilibrium between bond failures), in every table that lists runs.
+ENGINE_COLUMN = "engine"
+#: The engine of a run whose params.json and summary.json predate ``numerics.engine``: YADE, the only engine there was.
+ENGINE_BEFORE_THE_KEY = "yade"
+
+
+def run_engine(params: dict | None, summary: dict | None) -> str | None:
+    """The engine that computed a run: its params.json's ``numerics.engine`` (``params``: the tree as written, before
+    :func:`~grainfrac_yade.params.migrate_tree` reads an absent key as YADE), else its summary.json's ``engine``
+    (static runs record it), else :data:`ENGINE_BEFORE_THE_KEY` for a run written before the key existed; None
+    where the folder holds neither file (nothing written yet that could say)."""
+    if params is None and summary is None:
+        return None
+    for value in (_get(params or {}, "numerics.engine"), (summary or {}).get("engine")):
+        if isinstance(value, str) and value:
+            return value
+    return ENGINE_BEFORE_THE_KEY
 
 
 def _get(tree: dict, dotted: str):
@@ -59,7 +78,7 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
     ``failed`` (no summary.json, and a failed.json holding the error line of a batch task that ended
     without one: ``problem``), ``pending`` (a SLURM row not started or without a folder yet) or
     ``unreadable`` (a JSON file that cannot be parsed; ``problem`` says which). ``folder`` is the
-    run folder's path. With ``all_params`` every parameter of params.json becomes a column
+    run folder's path; ``engine`` the mechanical engine that computed the run (:func:`run_engine`). With ``all_params`` every parameter of params.json becomes a column
     (dotted name); otherwise only :data:`PARAM_COLUMNS`.
     """
     root = Path(root)
@@ -71,10 +90,13 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
         try:
             failed = _read_json(folder / FAILED) if (folder / FAILED).exists() else None
             run = _read_json(run_json) if run_json.exists() else {k: failed.get(k) for k in ("command", "seed")}
-            row.update({"command": run.get("command"), "seed": run.get("seed"), "code_version": run.get("code_version")})
+            row.update({"command": run.get("command"), ENGINE_COLUMN: None, "seed": run.get("seed"),
+                        "code_version": run.get("code_version")})   # the engine filled in below, its place here
             params_file = folder / "params.json"
+            params = summary = written = None
             if params_file.exists():
                 params = _read_json(params_file)
+                written = copy.deepcopy(params)   # as written: migrate_tree gives an absent engine key "yade"
                 migrate_tree(params)
                 row.update(flatten(params) if all_params else {k: _get(params, k) for k in PARAM_COLUMNS})
             summary_file = folder / "summary.json"
@@ -89,6 +111,7 @@ def collect_runs(root, all_params: bool = False) -> pd.DataFrame:
                            + (f" (log {failed['log']})" if failed.get("log") else ""))
             else:
                 row["status"] = "unfinished"
+            row[ENGINE_COLUMN] = run_engine(written, summary)
         except ValueError as exc:
             row.update(status="unreadable", problem=str(exc))
         rows.append(row)

@@ -404,20 +404,20 @@ def envelope_figure(path, sigma3, sigma1, mohr_coulomb, hoek_brown, lab_ucs=None
 
 
 def confinement_lifetime_figure(path, runs: pd.DataFrame, table: pd.DataFrame, time_note: str | None = None):
-    """Creep lifetime against confining stress at fixed driving-stress ratios, one series per law and
+    """Creep lifetime against confining stress at fixed driving-stress ratios, one series per law, engine and
     ratio: each failed run (dots), runs that did not fail (open triangles at their end time: lower
     bounds) and the geometric mean of the failed ones (line)."""
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    for k, ((law, ratio), g) in enumerate(table.groupby(["law", "ratio"])):
+    for k, ((law, engine, ratio), g) in enumerate(table.groupby(["law", "engine", "ratio"])):
         colour = f"C{k}"
-        sel = (runs["law_label"] == law) & (runs["ratio"] == ratio)
+        sel = (runs["law_label"] == law) & (runs["engine_label"] == engine) & (runs["ratio"] == ratio)
         failed = runs[sel & (runs["outcome"] == "failed")]
         ax.plot(failed["confining_stress_mpa"], failed["lifetime_s"], "o", ms=4, color=colour, alpha=0.7)
         alive = runs[sel & (runs["outcome"] == "not failed")]
         ax.plot(alive["confining_stress_mpa"], alive["creep_time_end_s"], "^", mfc="none", color=colour)
         ok = g["lifetime_geomean_s"] > 0
         ax.plot(g.loc[ok, "confining_stress_mpa"], g.loc[ok, "lifetime_geomean_s"], "-", color=colour,
-                label=f"{law}, ratio {ratio:g} (geometric mean of failed runs)")
+                label=f"{law}, {engine}, ratio {ratio:g} (geometric mean of failed runs)")
     ax.set_yscale("log")
     ax.set_xlabel("confining stress sigma_3 [MPa]")
     ax.set_ylabel("lifetime [s]" + (f" ({time_note})" if time_note else ""))

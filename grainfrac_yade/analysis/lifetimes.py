@@ -24,6 +24,7 @@ import pandas as pd
 
 from ..law.hillig_charles import NAME as PAPER_LAW
 
+from .collect import ENGINE_BEFORE_THE_KEY, ENGINE_COLUMN
 from .fits import RATIO_DECIMALS
 
 #: Minimum number of failed runs at one ratio for a scatter statistic (three seeds per ratio, as the lifetime studies run).
@@ -115,15 +116,18 @@ def representatives(runs: pd.DataFrame) -> pd.DataFrame:
 
 
 #: Columns of the lifetime-against-confinement table.
-CONFINEMENT_COLUMNS = ("law", "ratio", "confining_stress_mpa", "n", "n_failed", "lifetime_geomean_s",
+CONFINEMENT_COLUMNS = ("law", "engine", "ratio", "confining_stress_mpa", "n", "n_failed", "lifetime_geomean_s",
                        "lifetime_min_s", "lifetime_max_s")
 
 
 def with_confinement_columns(runs: pd.DataFrame) -> pd.DataFrame:
     """Copy of ``runs`` with ``confining_stress_mpa`` (confinement.stress in MPa; 0 where a run's
     params.json predates the key: it was uniaxial) and ``law_label`` (stress_corrosion.law; the
-    paper's law where missing, the only one there was)."""
+    paper's law where missing, the only one there was) and ``engine_label`` (the run's engine, :data:`.collect.
+    ENGINE_COLUMN`; YADE where a table has no such column, the only engine there was)."""
     out = runs.copy()
+    engine = out[ENGINE_COLUMN] if ENGINE_COLUMN in out else pd.Series(ENGINE_BEFORE_THE_KEY, index=out.index)
+    out["engine_label"] = engine.fillna(ENGINE_BEFORE_THE_KEY)
     s3 = out["confinement.stress"] if "confinement.stress" in out else pd.Series(0.0, index=out.index)
     out["confining_stress_mpa"] = pd.to_numeric(s3, errors="coerce").fillna(0.0) / 1e6
     law = out["stress_corrosion.law"] if "stress_corrosion.law" in out else pd.Series(PAPER_LAW, index=out.index)
@@ -132,16 +136,16 @@ def with_confinement_columns(runs: pd.DataFrame) -> pd.DataFrame:
 
 
 def confinement_lifetimes(runs: pd.DataFrame) -> pd.DataFrame:
-    """Creep lifetimes per degradation law, driving-stress ratio and confining stress sigma_3 of
+    """Creep lifetimes per degradation law, engine, driving-stress ratio and confining stress sigma_3 of
     ``runs`` (with :func:`with_confinement_columns`): runs (``outcome`` failed, failed at load or not
     failed), failed ones, and the geometric mean, minimum and maximum of the failed runs' lifetimes
     (a lifetime of 0, failed at load, gives a mean of 0)."""
     usable = runs[runs["outcome"].isin(["failed", "not failed", "failed at load"]) & runs["ratio"].notna()]
     rows = []
-    for (law, ratio, s3), g in usable.groupby(["law_label", "ratio", "confining_stress_mpa"]):
+    for (law, engine, ratio, s3), g in usable.groupby(["law_label", "engine_label", "ratio", "confining_stress_mpa"]):
         failed = g[g["outcome"].isin(["failed", "failed at load"])]
         t = pd.to_numeric(failed["lifetime_s"], errors="coerce").to_numpy(float)
         geo = float(np.exp(np.mean(np.log(t)))) if len(t) and np.all(t > 0) else (0.0 if len(t) else np.nan)
-        rows.append((law, ratio, s3, len(g), len(failed), geo, t.min() if len(t) else np.nan,
+        rows.append((law, engine, ratio, s3, len(g), len(failed), geo, t.min() if len(t) else np.nan,
                      t.max() if len(t) else np.nan))
     return pd.DataFrame(rows, columns=CONFINEMENT_COLUMNS)

@@ -60,7 +60,7 @@ CRACK_COUNTS = ("Crack counts: *cracks* are broken bonds (microcracks) of the ra
                 "crack maps title each panel \"N cracks, M of them macro\" at its time.")
 
 RUN_COLUMNS = {
-    "link": ("run", ""), "seed": ("seed", ""), "variant": ("variant", ""), "driving_stress_ratio": ("ratio", ".4f"),
+    "link": ("run", ""), "engine": ("engine", ""), "seed": ("seed", ""), "variant": ("variant", ""), "driving_stress_ratio": ("ratio", ".4f"),
     "stress_mpa": ("stress [MPa]", ".1f"), "status": ("status", ""), "outcome": ("outcome", ""),
     "lifetime_s": ("lifetime [s]", ".4g"), "creep_time_end_s": ("end of creep [s]", ".4g"),
     "n_events": ("events", ".0f"), "broken_total": ("cracks", ".0f"), "broken_creep": ("creep cracks", ".0f"),
@@ -69,12 +69,13 @@ RUN_COLUMNS = {
 }
 
 CONFINEMENT_TABLE = {
-    "law": ("law", ""), "ratio": ("ratio", ".3f"), "confining_stress_mpa": ("sigma_3 [MPa]", "g"), "n": ("n", "d"),
+    "law": ("law", ""), "engine": ("engine", ""), "ratio": ("ratio", ".3f"), "confining_stress_mpa": ("sigma_3 [MPa]", "g"), "n": ("n", "d"),
     "n_failed": ("failed", "d"), "lifetime_geomean_s": ("geometric mean lifetime [s]", ".3g"),
     "lifetime_min_s": ("min [s]", ".3g"), "lifetime_max_s": ("max [s]", ".3g"),
 }
 CRACK_PHASE_TABLE = {
-    "run": ("run", ""), "seed": ("seed", ""), "driving_stress_ratio": ("ratio", ".3f"), "phase": ("phase", ""),
+    "run": ("run", ""), "engine": ("engine", ""), "seed": ("seed", ""), "driving_stress_ratio": ("ratio", ".3f"),
+    "phase": ("phase", ""),
     "cracks": ("cracks (bonds)", "d"), "tensile_share": ("tensile", ".2f"),
     "axial_share": ("axial (plane within 30 deg of the load)", ".2f"), "inter_share": ("inter-granular", ".2f"),
 }

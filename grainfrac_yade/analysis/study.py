@@ -18,7 +18,7 @@ from ..errors import GrainfracError
 from ..runs.columns import history_as_today
 from ..runs.runio import RESULT_NEUTRAL_KEYS, write_csv
 from . import crack_phases, crackmaps, figures, rescale
-from .collect import code_version_note, collect_runs, flatten
+from .collect import ENGINE_COLUMN, code_version_note, collect_runs, flatten
 from .figures import MAP_FRACTIONS, Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
@@ -34,7 +34,7 @@ VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
 CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "failed before test", "unfinished",
                   "run error")
 #: Columns of runs.csv (those present); the parameter columns are those of ucs_runs.csv that tell runs apart.
-RUN_TABLE = ("run", "folder", "command", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
+RUN_TABLE = ("run", "folder", "command", "engine", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
              "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
              "tertiary_start_s", "steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
@@ -347,13 +347,13 @@ def crack_phase_table(runs: pd.DataFrame) -> pd.DataFrame:
         bonds = _read_csv(Path(r["folder"]) / "bond_stresses_start.csv", ("inter",))
         inter = None if bonds is None else bonds["inter"].astype(str).str.lower().eq("true").to_numpy()
         block = crack_phases.crack_phases(cracks, life, inter)
-        blocks.append(block.assign(run=r["run"], seed=r.get("seed"), variant=r.get("variant"),
-                                   driving_stress_ratio=r.get("driving_stress_ratio"), lifetime_s=life))
+        blocks.append(block.assign(run=r["run"], engine=r.get(ENGINE_COLUMN), seed=r.get("seed"),
+                                   variant=r.get("variant"), driving_stress_ratio=r.get("driving_stress_ratio"),
+                                   lifetime_s=life))
+    columns = ["run", ENGINE_COLUMN, "seed", "variant", "driving_stress_ratio", "lifetime_s", *crack_phases.COLUMNS]
     if not blocks:
-        return pd.DataFrame(columns=["run", "seed", "variant", "driving_stress_ratio", "lifetime_s",
-                                     *crack_phases.COLUMNS])
-    table = pd.concat(blocks, ignore_index=True)
-    return table[["run", "seed", "variant", "driving_stress_ratio", "lifetime_s", *crack_phases.COLUMNS]]
+        return pd.DataFrame(columns=columns)
+    return pd.concat(blocks, ignore_index=True)[columns]
 
 
 def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=None,

@@ -1,4 +1,4 @@
-"""``analyze-ucs``: table and figure of UCS tests in a study folder (resolution, size, calibration), and
+"""``analyze-ucs``: table and figure of UCS tests in a study folder (engine, resolution, size, calibration), and
 the peak-strength envelope of confined tests (Mohr-Coulomb and Hoek-Brown fits) where a model variant
 was tested at two confining stresses or more."""
 from __future__ import annotations
@@ -15,6 +15,9 @@ LOADING_VARIANT = ("calibration.strength_scale", "calibration.stiffness_scale", 
                    "calibration.tensile_cohesion_ratio_scale", "calibration.inter_mineral_strength_ratio",
                    "calibration.strength_weibull_modulus", "ucs.strain_rate",
                    "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")
+#: The engine column (:data:`grainfrac_yade.analysis.collect.ENGINE_COLUMN`): runs of two engines are two variants,
+#: never averaged together; the first column of ucs_stats.
+ENGINE = "engine"
 #: The confining stress column: the envelope's abscissa.
 CONFINEMENT = "confinement.stress"
 MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "steps")
@@ -43,18 +46,18 @@ def cmd_analyze_ucs(args) -> int:
     runs = runs[runs["command"] == "ucs"]
     runs, _ = fill_missing_params(runs)   # keys that older params.json lack: the shipped defaults
     runs[CONFINEMENT] = runs[CONFINEMENT].fillna(0.0).astype(float)   # runs older than the key were uniaxial
-    by = VARIANT + tuple(k for k in LOADING_VARIANT if k in runs)
+    by = (ENGINE,) + VARIANT + tuple(k for k in LOADING_VARIANT if k in runs)
     stats = group_stats(runs, by, MEASURES)
     runs.to_csv(folder / "ucs_runs.csv", index=False)
     stats.to_csv(folder / "ucs_stats.csv", index=False)
-    varying = [k for k in by[len(VARIANT):] if stats[k].astype(str).nunique() > 1]
-    lines = ["| cells | spheres/cell | grain [mm] | specimen [mm] | sigma_3 [MPa] | " + ("variant | " if varying else "")
+    varying = [k for k in by[1 + len(VARIANT):] if stats[k].astype(str).nunique() > 1]
+    lines = ["| engine | cells | spheres/cell | grain [mm] | specimen [mm] | sigma_3 [MPa] | " + ("variant | " if varying else "")
              + "n | peak [MPa] | E [GPa] | Poisson | CI/peak | CD/peak | DEM steps | wall [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if varying else "")]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if varying else "")]
     for _, r in stats.iterrows():
         variant = (", ".join(f"{k.split('.', 1)[1]} {_cell(r[k])}" for k in varying) + " | ") if varying else ""
         lines.append(
-            f"| {cells_label(r['resolution.grain_model'], r['resolution.nodes_per_face'])} "
+            f"| {r[ENGINE]} | {cells_label(r['resolution.grain_model'], r['resolution.nodes_per_face'])} "
             f"| {r[VARIANT[0]]:.0f} | {r[VARIANT[1]] * 1e3:.2f} "
             f"| {r[VARIANT[2]] * 1e3:.1f} x {r[VARIANT[3]] * 1e3:.1f} | {r[CONFINEMENT] / 1e6:g} | {variant}"
             f"{r['ucs_pa_count']:.0f} | {_mean_sd(r['ucs_pa_mean'], r['ucs_pa_std'], 1e6)} "
@@ -82,9 +85,10 @@ def envelopes(runs, folder) -> list:
     from ..analysis.figures import envelope_figure
     from ..analysis.labdata import lab_property
     done = runs[(runs["status"] == "finished") & runs["ucs_pa"].notna()]
-    others = [v for v in VARIANT if v != CONFINEMENT] + [k for k in LOADING_VARIANT if k in runs]
+    others = [ENGINE] + [v for v in VARIANT if v != CONFINEMENT] + [k for k in LOADING_VARIANT if k in runs]
     rows, lines = [], []
-    for key, group in done.groupby(others, dropna=False):
+    for values, group in done.groupby(others, dropna=False):
+        key = dict(zip(others, values))
         if group[CONFINEMENT].nunique() < 2:
             continue
         s3, s1 = group[CONFINEMENT].to_numpy(float), group["ucs_pa"].to_numpy(float)
@@ -94,9 +98,10 @@ def envelopes(runs, folder) -> list:
         except GrainfracError as exc:
             hb, hb_note = None, str(exc)
         k = len(rows) + 1
-        label = (f"{cells_label(key[4], key[5])} cells, spheres per cell {key[0]:.0f}, {key[2] * 1e3:.1f} x {key[3] * 1e3:.1f} mm, "
-                 f"grain {key[1] * 1e3:.2f} mm")
-        rows.append({"variant": label, "n_tests": len(group), "sigma3_max_pa": s3.max(),
+        label = (f"{key[ENGINE]} engine, {cells_label(key['resolution.grain_model'], key['resolution.nodes_per_face'])} "
+                 f"cells, spheres per cell {key['resolution.spheres_per_cell']:.0f}, {key['specimen.width'] * 1e3:.1f} x "
+                 f"{key['specimen.height'] * 1e3:.1f} mm, grain {key['specimen.grain_size'] * 1e3:.2f} mm")
+        rows.append({"variant": label, ENGINE: key[ENGINE], "n_tests": len(group), "sigma3_max_pa": s3.max(),
                      "mc_unconfined_strength_pa": mc.unconfined_strength, "mc_passive_coefficient": mc.passive_coefficient,
                      "mc_friction_angle_deg": mc.friction_angle_deg, "mc_cohesion_pa": mc.cohesion, "mc_r2": mc.line.r2,
                      "hb_sigma_ci_pa": hb.sigma_ci if hb else None, "hb_m_i": hb.m_i if hb else None,

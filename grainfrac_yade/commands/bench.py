@@ -28,6 +28,10 @@ a few events of the event clock are timed, and the scene is measured at the held
 Unless ``--quick``: creep to failure with the event and with the paper clock at 1 sphere per cell,
 same specimen and load, one run each (DEM steps, wall time, lifetime).
 
+``--static``: the static engine's part instead (:mod:`.bench_static`): static against YADE CPU per creep event,
+static CPU per event against specimen size and its exponent in the dofs, events, equilibria and active-set
+iterations per event, CPU per quiet event, peak memory.
+
 No number here is comparable with another run's: the machine is shared and noisy.  Ratios are
 only formed between windows of the same run.
 """
@@ -44,6 +48,7 @@ from pathlib import Path
 
 from ..engines.registry import ENGINE_NAMES, engine, engine_for
 from ..protocols.timed_creep import TimedCreepRun
+from .bench_static import HOLD_STRESS_PA, STATIC_OUT, STATIC_QUICK_OUT, run_static_bench, settings_for, static_tables
 
 #: Where the full bench writes by default.
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
@@ -111,15 +116,44 @@ def register(sub, common):
                         f"{FEM_SIZES_OUT.relative_to(FEM_SIZES_OUT.parents[1])}; about 5 CPU min)")
     p.add_argument("--creep-stress", type=float, metavar="MPA",
                    help="with --fem-sizes: also one paper-size creep run to failure at this stress [MPa] "
-                        "(seed 1, event clock), with its CPU time and relaxation steps per event")
+                        "(seed 1, event clock), with its CPU time and relaxation steps per event; with --static: the "
+                        f"held stress (default {HOLD_STRESS_PA / 1e6:g})")
+    p.add_argument("--static", action="store_true",
+                   help="only the static engine's part: static against YADE CPU per creep event (fem cells, 10 x 20 "
+                        "mm), static CPU per event on 10 x 20, 20 x 40 and 31.7 x 63.4 mm and its exponent in the dofs, "
+                        "events, equilibria and iterations per event, CPU per quiet event, peak memory (default out: "
+                        f"{STATIC_OUT.relative_to(STATIC_OUT.parents[1])}; with --quick tiny specimens, "
+                        f"{STATIC_QUICK_OUT}; about 5 CPU min, seconds with --quick)")
+    p.add_argument("--static-large", action="store_true",
+                   help="with --static: also the 63.4 x 126.8 mm specimen (~142,500 dofs, its ramp several CPU min)")
     p.set_defaults(func=cmd_bench)
 
 
 def cmd_bench(args) -> int:
     from ..errors import GrainfracError
     from ..runs.runio import write_json
+    if args.static_large and not args.static:
+        raise GrainfracError("--static-large belongs to the static engine's bench; fix: add --static")
+    if args.static and args.fem_sizes:
+        raise GrainfracError("--static and --fem-sizes are two benches; fix: run them one at a time")
+    if args.static:
+        out = Path(args.out or (STATIC_QUICK_OUT if args.quick else STATIC_OUT))
+        out.parent.mkdir(parents=True, exist_ok=True)
+        stress = HOLD_STRESS_PA if args.creep_stress is None else args.creep_stress * 1e6
+        load_start = os.getloadavg()[0]
+        header = {"machine": machine()}
+        result = run_static_bench(settings_for(args.quick, args.static_large), seed=args.seed, stress=stress,
+                                  preset=FEM_PRESET, extra_files=args.params, overrides=args.overrides, header=header,
+                                  peak_rss=peak_rss_mb, progress=print, out=out)
+        result["machine"]["load_average_1min"] = f"{load_start:.2f} at the start, {os.getloadavg()[0]:.2f} at the end"
+        result["bench"]["quick"] = bool(args.quick)
+        write_json(out, result)
+        print(static_tables(result))
+        print(f"written: {out}")
+        return 0
     if args.creep_stress is not None and not args.fem_sizes:
-        raise GrainfracError("--creep-stress belongs to the finite-element size comparison; fix: add --fem-sizes")
+        raise GrainfracError("--creep-stress belongs to the finite-element size comparison or the static bench; fix: "
+                             "add --fem-sizes or --static")
     if args.fem_sizes:
         out = Path(args.out or FEM_SIZES_OUT)
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -8,7 +8,7 @@ Importing this module does not import YADE: the first stint does.
 """
 from __future__ import annotations
 
-from ..static.engine import (AXIAL_STRAIN, DIAMETRAL_STRAIN, VTK_REFUSED, StrainSeries,  # noqa: F401
+from ..static.engine import (VTK_REFUSED,  # noqa: F401
                              apply_levers, consolidate, stress_corrosion)
 from ..static.engine import UNSUPPORTED as STATIC_UNSUPPORTED
 from ..static.engine import version as static_version

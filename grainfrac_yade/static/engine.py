@@ -10,8 +10,12 @@ What the protocols reach through an engine module: ``build_scene``, ``scene_from
 isotropic stage of a confined test) and ``stress_corrosion`` (the creep test's bond writer, :class:`StaticCorrosion`:
 the creep test of :mod:`grainfrac_yade.protocols.creep` runs on the static scene's held platen stress with the event
 clock; the paper clock needs dynamics and is refused).  Not in the static engine yet, each refused with one line
-naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): VTK series, bench.
+naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): none at present.
 The Brazilian test runs on the disc's jaws of :mod:`.jaws` (``attach_jaws``) with the levers of ``apply_levers``.
+The timings of ``bench --static`` (:mod:`.bench_timing`: a network built and a creep hold timed per event, in CPU
+time) are reached here, as YADE's are in its engine module.  VTK series are written as on any engine
+(:mod:`grainfrac_yade.protocols.snapshots` reads the scene's ``cell_motion`` and ``bond_shift``; :data:`VTK_REFUSED`
+is empty).
 
 Settings that only a dynamic engine reads (:data:`DYNAMIC_ONLY`: damping, mass scaling, the servo, wave
 crossings, relaxation budgets) do not stop a static run: one given on the command line with ``--set`` gets a
@@ -28,20 +32,17 @@ from ..errors import GrainfracError
 from ..law import MODE_CORRODED, Stresses, check_finite
 from ..protocols.corrosion import BondCorrosion
 from ..geometry.disc import DiscTessellation
+from .bench_timing import timed_creep_hold, timed_network  # noqa: F401
 from .jaws import DiscScene
-from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state)  # noqa: F401
 from .jaws import apply_levers as _apply_levers
+from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state)  # noqa: F401
 from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
 DYNAMIC = False
-#: Names of the strain a VTK series is timed by (as the YADE engine's; VTK output is refused here).
-AXIAL_STRAIN, DIAMETRAL_STRAIN = "axial", "diametral"
 
 #: Commands the static engine cannot run yet -> the one line that says so and the fix.
 UNSUPPORTED = {
-    "bench": ("the static engine has no DEM steps to time (bench measures YADE's stepping and creep runs); fix: "
-              "bench with numerics.engine = \"yade\""),
 }
 
 
@@ -113,12 +114,3 @@ def apply_levers(scene: StaticScene, levers, seed: int) -> dict:
     """The Brazilian levers on a static scene before its loading (:func:`.jaws.apply_levers`: strength scatter and
     slits on both grain models, blocked rotation on rigid cells); what was done, as YADE's counts."""
     return _apply_levers(scene, levers, seed)
-
-
-
-
-class StrainSeries:
-    """VTK series: not written by the static engine yet (refused with one line)."""
-
-    def __init__(self, *args, **kwargs):
-        raise GrainfracError(VTK_REFUSED)

@@ -26,6 +26,9 @@ The test protocols (:mod:`grainfrac_yade.protocols`) drive it unchanged; their c
   strengths, counters): the run goes on bit for bit.
 * **export_state / scene_from_state**: :class:`grainfrac_yade.engines.SceneState`; the static engine keeps each
   broken contact's shear reference s_p (its plastic slip) in ``bond_slip`` and the closure in the platens' dict.
+* **cell_motion / bond_shift** (what the VTK series of :mod:`grainfrac_yade.protocols.snapshots` draw): the cells
+  and bonds moved by the solved displacements (rigid cells: translation and rotation of their node; fem cells: the
+  least-squares rigid motion of their spheres), as YADE's scene draws its bodies.
 
 Where no set of contact statuses settles (frictional contacts with a non-associated slip rule need not have a
 unique quasi-static equilibrium) the core raises :class:`~grainfrac_yade.errors.NumericalFailure`: the protocols
@@ -44,6 +47,7 @@ from ..engines import SceneState
 from ..errors import GrainfracError, NumericalFailure
 from ..grains import layout_for
 from ..layout import bond_properties
+from ..vtkio import cluster_rigid_motion
 from . import contacts as cl
 from .cascade import Path
 from .failure import FailureRule
@@ -79,8 +83,10 @@ MAX_UNLOAD_STEPS = 50
 STIFFNESS_LAW_REFUSED = ("static engine: the creep hold follows laws that lower strengths only; this law changes the "
                          "bonds' stiffness (the area law); fix: stress_corrosion.law = \"hillig_charles\", or "
                          "--engine yade")
-#: The one line that refuses a VTK series on the static engine.
-VTK_REFUSED = "static engine: VTK series (--vtk-every) are not written yet; fix: leave out --vtk-every, or --engine yade"
+#: What the command line refuses of a VTK series on the static engine: nothing ("": the series are written, the
+#: cells and bonds drawn from the solved displacements by :meth:`StaticScene.cell_motion` and :meth:`StaticScene.
+#: bond_shift`, read by :mod:`grainfrac_yade.protocols.snapshots` as on any engine).
+VTK_REFUSED = ""
 
 
 class StaticPlatens:
@@ -402,13 +408,40 @@ class StaticScene:
         out = np.column_stack([mean, np.full(n_cells, 0.5 * self.specimen.thickness)])
         return out if cells is None else out[np.asarray(cells, np.int64)]
 
+    def _nodes_are_cells(self) -> bool:
+        """True where every node is a whole cell (rigid cells: one node per cell, with a rotation); False where the
+        nodes are the layout's spheres (fem cells: several translating nodes per cell)."""
+        cell = self.net.node_cell
+        return len(cell) == self.specimen.n_cells and bool(np.array_equal(cell, np.arange(len(cell))))
+
     def cell_motion(self) -> tuple:
-        """Refused: the VTK series are not written for the static engine yet (one line)."""
-        raise GrainfracError(VTK_REFUSED)
+        """((n, 2) positions [m] of the cell centroids, (n,) rotations about z [rad]) from the solved displacements
+        (small displacements, as the core solves them): rigid cells their node's translation and rotation dof;
+        fem cells the least-squares rigid motion of their spheres weighted by their lumped areas (as YADE's fem
+        scene draws them, :func:`grainfrac_yade.vtkio.cluster_rigid_motion`)."""
+        net, tess = self.net, self.specimen.tessellation
+        pos = self.node_positions()
+        if self._nodes_are_cells():
+            rot = net.dofs[:, 2]
+            angle = np.where(rot >= 0, self.state.u[np.maximum(rot, 0)], 0.0)
+            return pos, angle
+        lay = self.layout
+        weights = getattr(lay, "sphere_area", None)
+        weights = np.ones(lay.n_spheres) if weights is None else weights
+        return cluster_rigid_motion(lay.sphere_center, pos, lay.sphere_cell, weights, tess.cell_centroid)
 
     def bond_shift(self, positions) -> np.ndarray:
-        """Refused, as :meth:`cell_motion`."""
-        raise GrainfracError(VTK_REFUSED)
+        """(b, 2) displacement [m] drawn for each bond (layout order): the mean of its two nodes' displacements, i.e.
+        of its two cells' translations (rigid cells, read off ``positions`` of :meth:`cell_motion` as YADE's rigid
+        scene does) or of its two spheres' (fem cells)."""
+        lay = self.layout
+        if self._nodes_are_cells():
+            cells = lay.sphere_cell[lay.bond_spheres]
+            disp = np.asarray(positions)[:, :2] - self.specimen.tessellation.cell_centroid[:, :2]
+        else:
+            cells = lay.bond_spheres
+            disp = self.node_positions() - self.net.node_pos[:, :2]
+        return 0.5 * (disp[cells[:, 0]] + disp[cells[:, 1]])
 
     def attach_platens(self, lateral: str = "free") -> StaticPlatens:
         if lateral != "free":
