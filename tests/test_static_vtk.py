@@ -9,7 +9,7 @@ import pytest
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.protocols.cracks import bond_segments
-from grainfrac_yade.vtkio import BOND_STATE_NAMES, read_pvd, read_vtp
+from grainfrac_yade.vtkio import BOND_STATE_NAMES, read_vtp
 
 pytest.importorskip("vtkmodules")
 
@@ -33,18 +33,9 @@ def _root():
 
 
 def _series(folder, name, n_items, time_name):
-    """Every file of series ``name`` read back (VTK's XML reader): ``n_items`` items each, at its .pvd timestep."""
-    entries = read_pvd(folder / f"{name}.pvd")
-    times = [t for t, _ in entries]
-    assert len(entries) >= 2 and all(b > a for a, b in zip(times, times[1:]))
-    out = []
-    for t, path in entries:
-        assert path.is_file() and path.parent == folder
-        d = read_vtp(path)
-        assert len(d["cells"]) == n_items
-        assert d["field_data"]["TimeValue"][0] == t and d["field_data"]["time_name"] == [time_name]
-        out.append((t, d))
-    return out
+    """Every file of series ``name`` read back at its .pvd timestep (the YADE runs' check, tests/test_vtkio.py)."""
+    from test_vtkio import _check_series
+    return _check_series(folder, name, n_items, time_name)
 
 
 def _ucs_with_series(tmp_path, every, *extra):

@@ -39,6 +39,20 @@ class Levers:
         return asdict(self)
 
 
+def lever_draws(levers: Levers, seed: int, n_bonds: int) -> tuple:
+    """The levers' random draws for ``n_bonds`` bonds, from the stream (``seed``, :data:`LEVER_STREAM`) in the order
+    every engine takes them: (per-bond strength factors, lognormal of mean 1 and coefficient of variation
+    ``strength_cv``, or None; the sorted bonds to slit, ``slit_fraction`` of them, or None)."""
+    rng = np.random.default_rng([int(seed), LEVER_STREAM])
+    factor = slits = None
+    if levers.strength_cv > 0:
+        s2 = math.log1p(levers.strength_cv ** 2)
+        factor = rng.lognormal(-0.5 * s2, math.sqrt(s2), n_bonds)
+    if levers.slit_fraction > 0:
+        slits = np.sort(rng.choice(n_bonds, int(round(levers.slit_fraction * n_bonds)), replace=False))
+    return factor, slits
+
+
 def new_breaks(scene) -> np.ndarray:
     """(n_bonds,) True for bonds broken during the test (tension or shear), not slits."""
     return scene.broken & (scene.break_mode != PRE_EXISTING)

@@ -39,7 +39,7 @@ import numpy as np
 
 from ..errors import GrainfracError
 from ..geometry.disc import DiscTessellation
-from ..protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers
+from ..protocols.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
 from .scene import StaticPlatens, StaticScene
@@ -235,16 +235,12 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         raise GrainfracError("levers: the scene has already been loaded; fix: apply levers right after build_scene")
     if levers.block_rotation and not (scene.net.dofs[:, 2] >= 0).any():
         raise GrainfracError(BLOCK_ROTATION_REFUSED)
-    rng = np.random.default_rng([int(seed), LEVER_STREAM])
-    n = scene.n_bonds
-    if levers.strength_cv > 0:
-        s2 = math.log1p(levers.strength_cv ** 2)
-        factor = rng.lognormal(-0.5 * s2, math.sqrt(s2), n)
+    factor, slits = lever_draws(levers, seed, scene.n_bonds)
+    if factor is not None:
         jt, jc = scene.bond_strengths()
-        scene.write_bond_strengths(np.arange(n), jt * factor, jc * factor)
+        scene.write_bond_strengths(np.arange(scene.n_bonds), jt * factor, jc * factor)
         done["strength_factor_mean"] = float(factor.mean())
-    if levers.slit_fraction > 0:
-        slits = np.sort(rng.choice(n, int(round(levers.slit_fraction * n)), replace=False))
+    if slits is not None:
         scene.break_bonds(slits, PRE_EXISTING)
         done["n_slits"] = int(len(slits))
     if levers.block_rotation:

@@ -25,12 +25,11 @@ Random draws use their own stream, seeded by the specimen's seed: the specimen i
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from ..errors import GrainfracError
-from ..protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers, new_breaks  # noqa: F401
+from ..protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers, lever_draws, new_breaks  # noqa: F401
 
 def apply_levers(scene, levers: Levers, seed: int) -> dict:
     """Apply ``levers`` to ``scene`` (before its first step); return what was done (counts)."""
@@ -41,18 +40,14 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         raise GrainfracError("levers: the scene has already run; fix: apply levers right after build_scene")
     if scene.model.name != "rigid":
         raise GrainfracError("levers: built for rigid cells; fix: use resolution.grain_model = \"rigid\"")
-    rng = np.random.default_rng([int(seed), LEVER_STREAM])
-    n = scene.n_bonds
-    if levers.strength_cv > 0:
-        s2 = math.log1p(levers.strength_cv ** 2)
-        factor = rng.lognormal(-0.5 * s2, math.sqrt(s2), n)
+    factor, slits = lever_draws(levers, seed, scene.n_bonds)
+    if factor is not None:
         for k, inter in enumerate(scene.interactions):
             ph = inter.phys
             ph.FnMax = float(ph.FnMax * factor[k])
             ph.FsMax = float(ph.FsMax * factor[k])
         done["strength_factor_mean"] = float(factor.mean())
-    if levers.slit_fraction > 0:
-        slits = np.sort(rng.choice(n, int(round(levers.slit_fraction * n)), replace=False))
+    if slits is not None:
         scene.break_bonds(slits, PRE_EXISTING)
         done["n_slits"] = int(len(slits))
     if levers.block_rotation:
