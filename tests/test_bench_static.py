@@ -56,8 +56,10 @@ def test_size_series_without_yade(tmp_path):
     out = tmp_path / "static.json"
     written = []   # sizes in the JSON on disk as each size is reported: partial results survive an interruption
     result = run_static_bench(TINY, preset=FEM, peak_rss=peak_rss_mb, out=out,
-                              progress=lambda msg: written.append(len(json.loads(out.read_text())["sizes"])))
-    assert written == [1, 2]
+                              progress=lambda msg: written.append((msg, len(json.loads(out.read_text())["sizes"]))
+                                                                  if out.exists() else (msg, 0)))
+    assert [n for msg, n in written if "CPU s per event" in msg] == [1, 2]
+    assert any("event 0:" in msg for msg, _ in written) and any("ramp to 160 MPa" in msg for msg, _ in written)
     assert "engines_per_event" not in result
     _check_sizes(result, TINY)
     assert json.loads(out.read_text())["sizes"][0]["dofs"] == result["sizes"][0]["dofs"]

@@ -125,7 +125,8 @@ def register(sub, common):
                         f"{STATIC_OUT.relative_to(STATIC_OUT.parents[1])}; with --quick tiny specimens, "
                         f"{STATIC_QUICK_OUT}; about 5 CPU min, seconds with --quick)")
     p.add_argument("--static-large", action="store_true",
-                   help="with --static: also the 63.4 x 126.8 mm specimen (~142,500 dofs, its ramp several CPU min)")
+                   help="with --static: also the 63.4 x 126.8 mm specimen (~142,500 dofs; its hold did not "
+                        "finish in 36 CPU min: docs/studies/static_bench.md)")
     p.set_defaults(func=cmd_bench)
 
 

@@ -50,7 +50,10 @@ STATIC_QUICK_OUT = Path("results/bench_static_quick.json")
 HOLD_STRESS_PA = 160e6
 #: The clock of every hold: the event clock (the static engine has no dynamics for the paper's clock, Eq. 8).
 CLOCK = "event"
-#: The largest specimen (name, width [m], height [m]): ~142,500 dofs, its ramp alone several CPU minutes.
+#: Events between two progress lines of a size's hold (event 0: the end of its ramp) [1].
+EVENT_LINES = 5
+#: The largest specimen (name, width [m], height [m]): ~142,500 dofs; its hold of 20 events did not finish in 36 CPU
+#: minutes (docs/studies/static_bench.md).
 LARGE_SIZE = ("63.4x126.8", 63.4e-3, 126.8e-3)
 
 
@@ -152,7 +155,14 @@ def size_series(settings, preset, user_files, overrides, seed, stress, progress,
     for name, width, height in settings.sizes:
         params = size_params(preset, user_files, width, height, overrides, "static")
         net, build_cpu = static.timed_network(build_specimen(params, seed), params)
-        hold = static.timed_creep_hold(net, params, stress, settings.events)
+        progress(f"static core, {name} mm ({net.ndof} dofs): network built in {build_cpu:.2f} CPU s, ramp to "
+                 f"{stress / 1e6:g} MPa")
+
+        def event_line(e, name=name):   # where a long hold stands: its ramp, then every EVENT_LINES-th event
+            if e["event"] % EVENT_LINES == 0:
+                progress(f"  {name} mm, event {e['event']}: {e['cpu_s']:.1f} CPU s, {e['equilibria']} equilibria, "
+                         f"{e['broken']} bonds broken")
+        hold = static.timed_creep_hold(net, params, stress, settings.events, progress=event_line)
         for key in ("path", "result", "times"):
             hold.pop(key)
         rows.append({"specimen": name, "width_m": width, "height_m": height, "dofs": net.ndof, "bonds": net.n_bonds,
