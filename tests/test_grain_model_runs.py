@@ -141,7 +141,7 @@ def fake_scene(specimen, layout):
     n = layout.n_bonds
     return SimpleNamespace(specimen=specimen, layout=layout, n_bonds=n, broken=np.zeros(n, bool),
                            break_step=np.full(n, -1), break_mode=np.zeros(n, int), bond_is_inter=np.zeros(n, bool),
-                           steps=1000, sliding_erasures=lambda: 0)
+                           steps=1000, sliding_erasures=lambda: 0, summary_keys=lambda: {})
 
 
 def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem):

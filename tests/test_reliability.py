@@ -252,7 +252,7 @@ def stand_in_run(tiny, rows, failed=False, numerical=False, reason=""):
     broken[:2] = True
     scene = SimpleNamespace(specimen=specimen, layout=layout, n_bonds=n, broken=broken, break_step=np.full(n, -1),
                             break_mode=np.where(broken, 1, 0), bond_is_inter=np.zeros(n, bool),
-                            steps=1234, sliding_erasures=lambda: 0)
+                            steps=1234, sliding_erasures=lambda: 0, summary_keys=lambda: {})
     return SimpleNamespace(rows=rows, ramp_broken=2, failed=failed, failure_reason=reason, failed_on_loading=False,
                            failed_before_test=False,
                            numerical_failure=numerical, n_events=0, scene=scene, vtk_written=[],
