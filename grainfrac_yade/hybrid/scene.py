@@ -189,6 +189,7 @@ class HybridScene(StaticScene):
         if cp.relaxation_damping > 0:
             dyn.relaxation_damping(cp.relaxation_damping)
         done = 0
+        min_steps = self.params.numerics.stint_min_crossings * budget.crossing_steps
         while done < budget.max_relaxation_steps:
             dyn.run(cp.check_period)
             done += cp.check_period
@@ -202,7 +203,7 @@ class HybridScene(StaticScene):
                 balanced = held_at_equilibrium(dyn, servo, intact, cp)
             else:
                 balanced = dyn.unbalanced(mean_bond_force(dyn, intact))[1] < cp.equilibrium_tolerance
-            if balanced:
+            if balanced and done >= min_steps:
                 return "equilibrium", done, servo
         return "budget", done, servo
 

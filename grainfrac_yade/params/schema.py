@@ -120,6 +120,9 @@ class NumericsParams:
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")
+    stint_min_crossings: float = _spec("1", "nonnegative", "hybrid engine: elastic wave crossings a dynamic stint runs "
+                                       "before its equilibrium check may end it (the time the released energy needs "
+                                       "to reach the whole specimen); 0 = the check from the first period on")
     damping: float = _spec("1", "unit_interval_open", "Cundall non-viscous damping")
     timestep_safety: float = _spec("1", "unit_interval_open", "fraction of the critical time step")
     density_scale: float = _spec("1", "positive", "mass scaling factor for quasi-static runs")

@@ -15,7 +15,7 @@ DYNAMIC_ONLY = ("numerics.damping", "numerics.timestep_safety", "numerics.densit
                 "numerics.step_floor_quantile", "numerics.verlet_fraction", "numerics.verlet_radius_quantile",
                 "creep.servo_response_steps", "creep.servo_max_strain_rate", "creep.servo_response_crossings",
                 "creep.check_period", "creep.max_relaxation_steps", "creep.max_relaxation_crossings",
-                "creep.relaxation_damping", "numerics.handover_cascade_bonds")
+                "creep.relaxation_damping", "numerics.handover_cascade_bonds", "numerics.stint_min_crossings")
 
 
 def _value(params, key: str):
