@@ -139,3 +139,21 @@ def test_a_ucs_ends_where_a_stint_with_fixed_platens_loses_the_load(tmp_path):
     assert summary["engine_failure_reason"].startswith("dynamic stint")
     assert summary["numerical_failure"] is False and summary["end_reason"].startswith("post-peak")
     assert summary["ucs_pa"] >= last["stress_pa"] > 0
+
+
+@needs_yade
+def test_a_stint_runs_its_minimum_wave_crossings_before_equilibrium_may_end_it(tmp_path):
+    """numerics.stint_min_crossings: a stint that ends in equilibrium has run at least that many elastic wave
+    crossings (its log names the DEM steps), where the default ends it at the first check that passes (4,550 DEM
+    steps here, 33 crossings of 137 steps: 50 crossings lie beyond it)."""
+    from grainfrac_yade.protocols.creep_output import run_creep_to_folder
+    logs = {}
+    for crossings in (0, 50):
+        p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.engine=hybrid",
+                                       "numerics.handover_cascade_bonds=2", f"numerics.stint_min_crossings={crossings}"])
+        ucs = p.calibration.reference_ucs
+        logs[crossings] = run_creep_to_folder(p, 3, tmp_path / str(crossings), 160e6, 160e6 / ucs, ucs)["dynamic_stint_log"]
+    first0, first1 = logs[0][0], logs[50][0]
+    assert first0["min_dem_steps"] == 0 and first1["min_dem_steps"] > 0
+    assert first1["outcome"] == "equilibrium" and first1["dem_steps"] >= first1["min_dem_steps"]
+    assert first0["dem_steps"] < first1["min_dem_steps"]

@@ -145,8 +145,9 @@ class HybridScene(StaticScene):
             modes = mode[self.canon[pending]]
             for m in np.unique(modes):
                 dyn.break_bonds(pending[modes == m], int(m))
-        outcome, steps, servo = self._relax(dyn, ypl, start, held)
-        log.update(outcome=outcome, dem_steps=int(steps), broken_after=int(dyn.broken.sum()),
+        outcome, steps, servo, min_steps = self._relax(dyn, ypl, start, held)
+        log.update(outcome=outcome, dem_steps=int(steps), min_dem_steps=int(math.ceil(min_steps)),
+                   broken_after=int(dyn.broken.sum()),
                    stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
         log["cpu_s"] = time.process_time() - c0
         self.stints.append(log)
@@ -171,7 +172,8 @@ class HybridScene(StaticScene):
 
     def _relax(self, dyn, platens, start, held: bool):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
-        servo or None); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
+        servo or None, the DEM steps before the equilibrium check may end it: ``numerics.stint_min_crossings`` wave
+        crossings); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
         ``ucs.stop_stress_ratio`` x the stint's start, the UCS test's post-peak rule) or "budget" (none of these
         within the relaxation budget)."""
         cp = self.params.creep
@@ -195,17 +197,17 @@ class HybridScene(StaticScene):
             done += cp.check_period
             if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
                                                   platens.axial_strain()):
-                return "collapse", done, servo
+                return "collapse", done, servo, min_steps
             if not held and platens.axial_stress() < self.params.ucs.stop_stress_ratio * start.stress:
-                return "lost load", done, servo     # the UCS test's post-peak rule: nothing to relax further
+                return "lost load", done, servo, min_steps     # the UCS test's post-peak rule: nothing to relax further
             intact = np.flatnonzero(~dyn.broken)
             if held:
                 balanced = held_at_equilibrium(dyn, servo, intact, cp)
             else:
                 balanced = dyn.unbalanced(mean_bond_force(dyn, intact))[1] < cp.equilibrium_tolerance
             if balanced and done >= min_steps:
-                return "equilibrium", done, servo
-        return "budget", done, servo
+                return "equilibrium", done, servo, min_steps
+        return "budget", done, servo, min_steps
 
     def _take_back(self, dyn, platens, dem_steps: int, log: dict) -> None:
         """What the stint reached, into the static scene: first YADE's relaxed state itself (:meth:`_take_state`);
