@@ -157,3 +157,37 @@ def test_a_stint_runs_its_minimum_wave_crossings_before_equilibrium_may_end_it(t
     assert first0["min_dem_steps"] == 0 and first1["min_dem_steps"] > 0
     assert first1["outcome"] == "equilibrium" and first1["dem_steps"] >= first1["min_dem_steps"]
     assert first0["dem_steps"] < first1["min_dem_steps"]
+
+
+@needs_yade
+def test_a_hybrid_creep_killed_after_a_stint_resumes_to_the_uninterrupted_run(tmp_path, monkeypatch):
+    """Checkpoints at every safe point; the run killed at the first checkpoint after its first stint and resumed:
+    history (but wall times), events, failure, break times and the stint log as the uninterrupted run's (rigid
+    cells: YADE's stints repeat bit for bit)."""
+    import grainfrac_yade.protocols.checkpoints as checkpoints
+    from grainfrac_yade.protocols.creep import resume_creep, run_creep
+    p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.engine=hybrid",
+                                   "numerics.handover_cascade_bonds=2", "numerics.checkpoint_interval=1e-9"])
+    whole = run_creep(build_specimen(p, 3), p, 160e6, checkpoint_folder=tmp_path / "whole", run_values={"seed": 3})
+    assert len(whole.scene.stints) >= 1
+    write = checkpoints.Checkpointer.write
+
+    def killed_after_a_stint(self, run, *args, **kwargs):
+        write(self, run, *args, **kwargs)
+        if run.scene.stints:
+            raise KeyboardInterrupt
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", killed_after_a_stint)
+    with pytest.raises(KeyboardInterrupt):
+        run_creep(build_specimen(p, 3), p, 160e6, checkpoint_folder=tmp_path / "cut", run_values={"seed": 3})
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
+    resumed = resume_creep(build_specimen(p, 3), p, 160e6, tmp_path / "cut")
+    assert resumed.resumes
+
+    def rows(run):
+        return [{k: v for k, v in r.items() if k != "wall_s"} for r in run.rows]
+    assert rows(resumed) == rows(whole)
+    assert (resumed.n_events, resumed.failed, resumed.failure_reason) == (whole.n_events, whole.failed,
+                                                                          whole.failure_reason)
+    assert np.array_equal(resumed.break_time, whole.break_time, equal_nan=True)
+    strip = [{k: v for k, v in s.items() if k != "cpu_s"} for s in whole.scene.stints]
+    assert [{k: v for k, v in s.items() if k != "cpu_s"} for s in resumed.scene.stints] == strip
