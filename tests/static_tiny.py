@@ -39,3 +39,15 @@ def tension_pair(**kw):
     """Two nodes one above the other, on the bottom and top platens, one bond with a horizontal face (normal +y):
     opening the platens pulls it (width x thickness = area, so platen stress = -sigma)."""
     return network([[0.0, 0.0], [0.0, 1e-3]], [[0, 1]], [[0.0, 1.0]], top=[1], bottom=[0], **kw)
+
+
+def assert_resumed_as_whole(resumed, whole):
+    """A creep run resumed from a checkpoint against the uninterrupted one: the history (but wall times), events,
+    failure and break times equal (helper of the kill-and-resume tests of the static and hybrid engines)."""
+    def rows(run):
+        return [{k: v for k, v in r.items() if k != "wall_s"} for r in run.rows]
+    assert resumed.resumes
+    assert rows(resumed) == rows(whole)
+    assert (resumed.n_events, resumed.failed, resumed.failure_reason) == (whole.n_events, whole.failed,
+                                                                          whole.failure_reason)
+    assert np.array_equal(resumed.break_time, whole.break_time, equal_nan=True)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
+from static_tiny import assert_resumed_as_whole
 
 from grainfrac_yade.engines import Scene
 from grainfrac_yade.engines.registry import ENGINE_NAMES, engine, engine_for
@@ -181,13 +182,6 @@ def test_a_hybrid_creep_killed_after_a_stint_resumes_to_the_uninterrupted_run(tm
         run_creep(build_specimen(p, 3), p, 160e6, checkpoint_folder=tmp_path / "cut", run_values={"seed": 3})
     monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
     resumed = resume_creep(build_specimen(p, 3), p, 160e6, tmp_path / "cut")
-    assert resumed.resumes
-
-    def rows(run):
-        return [{k: v for k, v in r.items() if k != "wall_s"} for r in run.rows]
-    assert rows(resumed) == rows(whole)
-    assert (resumed.n_events, resumed.failed, resumed.failure_reason) == (whole.n_events, whole.failed,
-                                                                          whole.failure_reason)
-    assert np.array_equal(resumed.break_time, whole.break_time, equal_nan=True)
+    assert_resumed_as_whole(resumed, whole)
     strip = [{k: v for k, v in s.items() if k != "cpu_s"} for s in whole.scene.stints]
     assert [{k: v for k, v in s.items() if k != "cpu_s"} for s in resumed.scene.stints] == strip
