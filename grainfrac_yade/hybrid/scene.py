@@ -56,6 +56,11 @@ from ..yade_adapter import engine as dynamic_engine
 #: new broken set; where statics give out again at once, three stints in a row say that the hand-back does not
 #: settle (a state the static model cannot hold in any status set).
 MAX_STINTS_PER_SOLVE = 3
+#: Elastic wave crossings a stint runs at least, per stint in a row whose state the static path could not go on from
+#: [1]: a short stint leaves a state the static statuses do not settle in unchanged (at
+#: paper size 50 DEM steps: the same unsettled closure three times), so each retry gives the dynamics one crossing
+#: more to move away from it.
+RETRY_CROSSINGS = 1.0
 #: Smallest axial strain taken for the secant modulus that sets the servo's gain and the wave-crossing budget [1]
 #: (the creep protocol's floor, so that a hand-over at zero strain still has a finite modulus).
 SERVO_STRAIN_FLOOR = 1e-6
@@ -74,6 +79,8 @@ class HybridScene(StaticScene):
         #: why the specimen failed in a stint with the platens fixed ("" while it has not): its stress fell below
         #: ``ucs.stop_stress_ratio`` x the stress the stint started from (the UCS test's own post-peak rule)
         self.dynamic_end = ""
+        #: stints in a row whose state the static path could not go on from (each next stint runs longer)
+        self.unsettled_hand_backs = 0
 
     # ------------------------------------------------------------------ the two solves that may hand over
     def move_to(self, closure: float) -> None:
@@ -83,6 +90,7 @@ class HybridScene(StaticScene):
         for _ in range(MAX_STINTS_PER_SOLVE + 1):
             try:
                 super().move_to(closure)
+                self.unsettled_hand_backs = 0
                 return
             except (NumericalFailure, LargeCascade) as exc:
                 self._attempt(exc, held=False)
@@ -96,6 +104,7 @@ class HybridScene(StaticScene):
             pending = self.hold_pending.copy()
             try:
                 super().hold(n_steps)
+                self.unsettled_hand_backs = 0
                 return
             except (NumericalFailure, LargeCascade) as exc:
                 self.hold_pending = pending
@@ -116,14 +125,17 @@ class HybridScene(StaticScene):
         settle: the bonds taken back so far stay broken, and the caller's next solve goes on from there."""
         before = len(self.stints)
         try:
-            self._stint(exc, held)
+            self._stint(exc, held, self.unsettled_hand_backs)
         except (NumericalFailure, LargeCascade):
             if len(self.stints) == before:    # no stint ran: nothing to start it from
                 raise
             self.stints[-1]["taken_back"] = False
+            self.unsettled_hand_backs += 1
+            return
+        self.unsettled_hand_backs = 0
 
     # ------------------------------------------------------------------ the dynamic stint
-    def _stint(self, exc, held: bool) -> None:
+    def _stint(self, exc, held: bool, retry: int = 0) -> None:
         """Relax YADE's scene from the state where statics gave out (module doc); the static scene takes the
         outcome back.  NumericalFailure if there is no converged state to start from (a NaN, not a status cycle)."""
         start = exc.state if isinstance(exc, LargeCascade) else self.path.last_state
@@ -145,7 +157,7 @@ class HybridScene(StaticScene):
             modes = mode[self.canon[pending]]
             for m in np.unique(modes):
                 dyn.break_bonds(pending[modes == m], int(m))
-        outcome, steps, servo, min_steps = self._relax(dyn, ypl, start, held)
+        outcome, steps, servo, min_steps = self._relax(dyn, ypl, start, held, retry)
         log.update(outcome=outcome, dem_steps=int(steps), min_dem_steps=int(math.ceil(min_steps)),
                    broken_after=int(dyn.broken.sum()),
                    stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
@@ -170,10 +182,10 @@ class HybridScene(StaticScene):
         self.state = dataclasses.replace(self.state, closure=closure, stress=log["stress_after_pa"])
         self._steps_offset += int(steps)
 
-    def _relax(self, dyn, platens, start, held: bool):
+    def _relax(self, dyn, platens, start, held: bool, retry: int = 0):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
         servo or None, the DEM steps before the equilibrium check may end it: ``numerics.stint_min_crossings`` wave
-        crossings); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
+        crossings, or :data:`RETRY_CROSSINGS` per ``retry`` where more); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
         ``ucs.stop_stress_ratio`` x the stint's start, the UCS test's post-peak rule) or "budget" (none of these
         within the relaxation budget)."""
         cp = self.params.creep
@@ -191,7 +203,7 @@ class HybridScene(StaticScene):
         if cp.relaxation_damping > 0:
             dyn.relaxation_damping(cp.relaxation_damping)
         done = 0
-        min_steps = self.params.numerics.stint_min_crossings * budget.crossing_steps
+        min_steps = max(self.params.numerics.stint_min_crossings, retry * RETRY_CROSSINGS) * budget.crossing_steps
         while done < budget.max_relaxation_steps:
             dyn.run(cp.check_period)
             done += cp.check_period
