@@ -20,10 +20,12 @@ the servo saturated while the axial strain grows by ``creep.collapse_strain_incr
 ``creep.check_period`` DEM steps within the hold's relaxation budget (``creep.max_relaxation_steps`` /
 ``_crossings``).  Bonds the creep law had handed over and the cascade had not yet broken are broken in YADE first.
 
-At equilibrium (or, with the platens fixed, at the end of the budget) what the stint broke comes back: the
-bonds YADE broke, in its order, each broken alone in the static state the stint started from with the static
-equilibrium restored (the static model keeps its own small-strain state and contact statuses; the stint decides
-which bonds break), then the static cascade; a held stress is then regained along the static path.  Under a held
+At equilibrium (or, with the platens fixed, at the end of the budget) what the stint reached comes back: YADE's
+relaxed state itself (nodes, broken set, each broken contact's shear reference from YADE's shear force), the static
+equilibrium solved there; where that does not settle, the bonds YADE broke, in its order, each broken alone in the
+static state the stint started from (:meth:`HybridScene._take_back`); then the static cascade, and a held stress is
+regained along the static path.  A stint after such unsettled hand-backs runs :data:`RETRY_CROSSINGS` wave crossings
+more per one in a row.  Under a held
 stress a collapse (or no equilibrium within the budget) ends the hold as the static failure rule does
 (:attr:`hold_failure`), with the broken set YADE reached.  With the platens fixed, a stint whose stress falls
 below ``ucs.stop_stress_ratio`` x the stress it started from (the UCS test's own post-peak rule) is the specimen
@@ -46,7 +48,7 @@ import numpy as np
 from ..engines import SceneState
 from ..errors import NumericalFailure
 from ..protocols.creep_loops import CollapseWatch, collapsing
-from ..protocols.loading import held_at_equilibrium, mean_bond_force
+from ..protocols.loading import held_at_equilibrium, relaxed
 from ..static.cascade import LargeCascade
 from ..static.scene import StaticScene
 from ..wave import hold_budget, scene_density
@@ -110,15 +112,10 @@ class HybridScene(StaticScene):
                 self.hold_pending = pending
                 self._attempt(exc, held=True)
                 if self.hold_failure:
-                    servo = self._servo()
-                    if servo is not None:
-                        servo.count(n_steps)
+                    super().hold(n_steps)     # a lost load: nothing solved, the servo counts its saturated steps
                     return
         raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static hold "
                                f"a state it can go on from (stress {self.state.stress:.6g} Pa)")
-
-    def _servo(self):
-        return next((d for d in self.drivers if hasattr(d, "closing_clipped_steps")), None)
 
     def _attempt(self, exc, held: bool) -> None:
         """A stint from where ``exc`` left the static path; its take-back may itself meet a status set that does not
@@ -138,7 +135,7 @@ class HybridScene(StaticScene):
     def _stint(self, exc, held: bool, retry: int = 0) -> None:
         """Relax YADE's scene from the state where statics gave out (module doc); the static scene takes the
         outcome back.  NumericalFailure if there is no converged state to start from (a NaN, not a status cycle)."""
-        start = exc.state if isinstance(exc, LargeCascade) else self.path.last_state
+        start = exc.state if isinstance(exc, LargeCascade) else self.path.last_converged
         if start is None or not (math.isfinite(start.stress) and np.all(np.isfinite(start.fn))):
             raise exc
         c0 = time.process_time()
@@ -213,10 +210,7 @@ class HybridScene(StaticScene):
             if not held and platens.axial_stress() < self.params.ucs.stop_stress_ratio * start.stress:
                 return "lost load", done, servo, min_steps     # the UCS test's post-peak rule: nothing to relax further
             intact = np.flatnonzero(~dyn.broken)
-            if held:
-                balanced = held_at_equilibrium(dyn, servo, intact, cp)
-            else:
-                balanced = dyn.unbalanced(mean_bond_force(dyn, intact))[1] < cp.equilibrium_tolerance
+            balanced = held_at_equilibrium(dyn, servo, intact, cp) if held else relaxed(dyn, intact, cp)
             if balanced and done >= min_steps:
                 return "equilibrium", done, servo, min_steps
         return "budget", done, servo, min_steps
@@ -255,7 +249,6 @@ class HybridScene(StaticScene):
         back = dataclasses.replace(state, bond_slip=slip, steps=self.steps, time=self._time, platens=None)
         self.apply_state(back)
         self._take(self.path.cascade(self.state))
-        self.path.last_state = self.state
 
     def _take_breaks(self, dyn) -> None:
         """The bonds YADE broke, in the order it broke them (ties: canonical order), into the static state the stint
@@ -271,7 +264,6 @@ class HybridScene(StaticScene):
             state = self.path.cascade(state)
         finally:
             self._take(state)
-        self.path.last_state = self.state
 
     # ------------------------------------------------------------------ records
     def summary_keys(self) -> dict:

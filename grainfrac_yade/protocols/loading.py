@@ -35,15 +35,20 @@ def mean_bond_force(scene, bonds) -> float:
     return float(np.mean(np.hypot(fn, fs))) if len(sample) else 0.0
 
 
-def held_at_equilibrium(scene, servo, bonds, creep_params) -> bool:
-    """A stress servo (the platens' ``hold_stress``) holds its target at equilibrium: the scene's unbalanced
-    force (:meth:`~grainfrac_yade.engines.Scene.unbalanced`: mean resultant force on the bodies the platens do
-    not drive) over the mean force of ``bonds`` below ``creep.equilibrium_tolerance``, and the held stress
-    within ``creep.stress_tolerance`` x the target.  NumericalFailure if a force or the stress is not finite."""
+def relaxed(scene, bonds, creep_params) -> bool:
+    """The scene's unbalanced force (:meth:`~grainfrac_yade.engines.Scene.unbalanced`: mean resultant force on the
+    bodies the platens do not drive) over the mean force of ``bonds`` is below ``creep.equilibrium_tolerance``."""
     _, rel = scene.unbalanced(mean_bond_force(scene, bonds))
+    return rel < creep_params.equilibrium_tolerance
+
+
+def held_at_equilibrium(scene, servo, bonds, creep_params) -> bool:
+    """A stress servo (the platens' ``hold_stress``) holds its target at equilibrium: the scene :func:`relaxed`,
+    and the held stress within ``creep.stress_tolerance`` x the target.  NumericalFailure if a force or the stress
+    is not finite."""
+    balanced = relaxed(scene, bonds, creep_params)
     check_value("held axial stress", servo.stress, scene.steps)
-    return rel < creep_params.equilibrium_tolerance and \
-        abs(servo.stress - servo.target) < creep_params.stress_tolerance * servo.target
+    return balanced and abs(servo.stress - servo.target) < creep_params.stress_tolerance * servo.target
 
 
 class LoadingTest:

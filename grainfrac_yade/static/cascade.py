@@ -70,8 +70,10 @@ class Path:
         self.jt, self.jc = eq.net.tensile_strength.copy(), eq.net.cohesion.copy()
         self.records: list[Record] = []
         self.steps = 0
-        #: the last converged state the path stood on (a hand-over starts from it if a solve gives out)
+        #: the state :meth:`run_closure` stood on before its last step (what a caller reports after a failure)
         self.last_state = None
+        #: the last converged state a step or a break started from (a hand-over starts from it if a solve gives out)
+        self.last_converged = None
         #: bonds one cascade may break before :class:`LargeCascade` is raised; None: no limit (the static engine)
         self.max_cascade = None
 
@@ -115,7 +117,7 @@ class Path:
         :class:`LargeCascade` after :attr:`max_cascade` bonds if that is set."""
         broken = 0
         while True:
-            self.last_state = state
+            self.last_converged = state
             if self.max_cascade is not None and broken >= self.max_cascade and (first is not None or
                                                                                self.over(state).any()):
                 raise LargeCascade(state, broken)
@@ -146,7 +148,7 @@ class Path:
         stress, or to ``max_closure``.  Returns (new state, what: "break" / "target" / "end" / "none");
         "none": nothing lies ahead (no crossing, no target reachable, no closure limit)."""
         n = self.net
-        self.last_state = state
+        self.last_converged = state
         v, fn1, fs1, p1 = self.eq.response(state)
         x = cl.crossing_increment(state.fn, state.fs, fn1, fs1, n.area, self.jt, self.jc, n.tan_friction)
         x = np.where(state.broken, np.inf, x)
@@ -223,7 +225,6 @@ class Path:
         """Regain the platen stress ``target`` [Pa] from ``state`` along the path: (state, failure reason or None)."""
         start, quiet = state.closure, 0
         while True:
-            self.last_state = state
             if state.stress >= target * (1 - self.bracket_tol) and not self.over(state).any():
                 return state, None
             state, what = self.step(state, target)
