@@ -115,6 +115,9 @@ def test_a_creep_hold_hands_a_cascade_to_yade_and_takes_its_breaks_back(tmp_path
     stint = summary["dynamic_stint_log"][0]
     assert stint["held"] is True and stint["outcome"] == "equilibrium" and stint["dem_steps"] > 0
     assert stint["broken_after"] > stint["broken_before"] and stint["taken_back"] in ("state", "breaks")
+    # the bonds YADE broke, per elastic wave crossing of the stint: one entry per crossing begun, summing to the total
+    assert len(stint["broken_per_crossing"]) >= 1 and all(n >= 0 for n in stint["broken_per_crossing"])
+    assert sum(stint["broken_per_crossing"]) == stint["broken_after"] - stint["broken_before"]
     assert stint["stress_after_pa"] == pytest.approx(160e6, rel=p.creep.stress_tolerance)
     assert summary["lifetime_s"] > 0 and summary["numerical_failure"] is False
     assert summary["broken_total"] >= stint["broken_after"]

@@ -154,8 +154,10 @@ class HybridScene(StaticScene):
             modes = mode[self.canon[pending]]
             for m in np.unique(modes):
                 dyn.break_bonds(pending[modes == m], int(m))
-        outcome, steps, servo, min_steps = self._relax(dyn, ypl, start, held, retry)
+        crossings = []
+        outcome, steps, servo, min_steps = self._relax(dyn, ypl, start, held, retry, crossings)
         log.update(outcome=outcome, dem_steps=int(steps), min_dem_steps=int(math.ceil(min_steps)),
+                   broken_per_crossing=crossings,
                    broken_after=int(dyn.broken.sum()),
                    stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
         log["cpu_s"] = time.process_time() - c0
@@ -179,12 +181,14 @@ class HybridScene(StaticScene):
         self.state = dataclasses.replace(self.state, closure=closure, stress=log["stress_after_pa"])
         self._steps_offset += int(steps)
 
-    def _relax(self, dyn, platens, start, held: bool, retry: int = 0):
+    def _relax(self, dyn, platens, start, held: bool, retry: int = 0, crossings=None):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
         servo or None, the DEM steps before the equilibrium check may end it: ``numerics.stint_min_crossings`` wave
         crossings, or :data:`RETRY_CROSSINGS` per ``retry`` where more); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
         ``ucs.stop_stress_ratio`` x the stint's start, the UCS test's post-peak rule) or "budget" (none of these
-        within the relaxation budget)."""
+        within the relaxation budget).  ``crossings`` (a list) receives the bonds YADE broke in each elastic wave
+        crossing of the stint, read at the first check past each crossing's end (the last entry: the part-crossing
+        the stint ended in)."""
         cp = self.params.creep
         strain = max(start.closure / self.net.height, SERVO_STRAIN_FLOOR)
         young = max(start.stress, 0.0) / strain
@@ -201,19 +205,32 @@ class HybridScene(StaticScene):
             dyn.relaxation_damping(cp.relaxation_damping)
         done = 0
         min_steps = max(self.params.numerics.stint_min_crossings, retry * RETRY_CROSSINGS) * budget.crossing_steps
-        while done < budget.max_relaxation_steps:
+        crossings = [] if crossings is None else crossings
+        counted = int(dyn.broken.sum())
+        while True:
+            if done >= budget.max_relaxation_steps:
+                outcome = "budget"
+                break
             dyn.run(cp.check_period)
             done += cp.check_period
+            if done >= (len(crossings) + 1) * budget.crossing_steps:
+                now = int(dyn.broken.sum())
+                crossings.append(now - counted)
+                counted = now
             if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
                                                   platens.axial_strain()):
-                return "collapse", done, servo, min_steps
+                outcome = "collapse"
+                break
             if not held and platens.axial_stress() < self.params.ucs.stop_stress_ratio * start.stress:
-                return "lost load", done, servo, min_steps     # the UCS test's post-peak rule: nothing to relax further
+                outcome = "lost load"     # the UCS test's post-peak rule: nothing to relax further
+                break
             intact = np.flatnonzero(~dyn.broken)
             balanced = held_at_equilibrium(dyn, servo, intact, cp) if held else relaxed(dyn, intact, cp)
             if balanced and done >= min_steps:
-                return "equilibrium", done, servo, min_steps
-        return "budget", done, servo, min_steps
+                outcome = "equilibrium"
+                break
+        crossings.append(int(dyn.broken.sum()) - counted)
+        return outcome, done, servo, min_steps
 
     def _take_back(self, dyn, platens, dem_steps: int, log: dict) -> None:
         """What the stint reached, into the static scene: first YADE's relaxed state itself (:meth:`_take_state`);
