@@ -31,6 +31,7 @@ from .. import __version__
 from ..atomic import write_atomically, write_text_atomically
 from ..errors import GrainfracError
 from ..params import flatten, load_parameters, migrate_tree
+from ..repeatable import process_is_repeatable
 
 #: Files whose presence marks a folder as holding a finished or running run.
 RUN_MARKERS = ("run.json",)
@@ -180,6 +181,7 @@ def prepare_run_dir(out, command: str, params, seed, overwrite: bool = False, ar
         write_json(where / "run.json", {
             "command": command, "argv": list(sys.argv if argv is None else argv), "seed": seed,
             "code_version": code_version(), "python": sys.version.split()[0], "platform": platform.platform(),
+            "repeatable_process": process_is_repeatable(),
             "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         })
     except OSError as exc:
