@@ -150,11 +150,18 @@ class TangentPattern:
 
 class LowRankSolver:
     """Solves with a tangent K' = K + U V^T on the reference factor of K (Woodbury), refined against K' (module doc).
-    ``coef`` per contact: (a_nn, a_sn, a_ss, broken) of the reference; ``free`` its free dofs."""
+    ``coef`` per contact: (a_nn, a_sn, a_ss, broken) of the reference; ``free`` its free dofs.
+
+    The K^-1 U columns are kept per contact and status as n x 2 blocks and never concatenated into one n x 2r
+    array: the capacitance I + V^T Z reads only the rows of Z that V^T touches (a few per contact), and Z s in a
+    solve is a sum over the blocks.  The columns of the contacts met for the first time in a :meth:`prepare` are
+    computed by one back-substitution of all their U columns together."""
 
     def __init__(self, net, lu, coef, free, max_contacts=MAX_LOW_RANK_CONTACTS):
         self.net, self.lu, self.coef, self.free, self.max_contacts = net, lu, coef, free, max_contacts
-        self._z = {}            # (contact, coefficients) -> (U columns, K^-1 U columns), free dofs
+        self._z = {}            # (contact, coefficients) -> K^-1 U columns (n x 2, free dofs)
+        #: Columns back-substituted on the reference factor (each U column counts one, whether solved alone or
+        #: in a block with others; each solve of a right-hand side counts one).
         self.back_substitutions = 0
         self.direct_residual = 0.0  # the largest relative residual of a direct solve on this factor
         cols = np.flatnonzero(free)
@@ -163,11 +170,12 @@ class LowRankSolver:
         self._rows = sp.vstack([net.cn, net.ct, net.gn, net.gt]).tocsc()[:, cols].tocsr()
         self._m = m
 
-    def _columns(self, i, new):
-        key = (int(i),) + tuple(float(x) for x in new[:3]) + (bool(new[3]),)
-        hit = self._z.get(key)
-        if hit is not None:
-            return hit
+    @staticmethod
+    def _key(i, new):
+        return (int(i),) + tuple(float(x) for x in new[:3]) + (bool(new[3]),)
+
+    def _u(self, i, new):
+        """The two U columns (w_n, w_t) of contact i going from its reference coefficients to ``new``."""
         old = tuple(c[i] for c in self.coef)
         m = self._m
         dense = self._rows[[i, m + i, 2 * m + i, 3 * m + i]].toarray()
@@ -178,11 +186,22 @@ class LowRankSolver:
         gn0, gt0 = rows(old[3])
         wn = new[0] * gn1 + new[1] * gt1 - old[0] * gn0 - old[1] * gt0
         wt = new[2] * gt1 - old[2] * gt0
-        u = np.stack([wn, wt], axis=1)
-        z = self.lu.solve(u)
-        self.back_substitutions += 2
-        self._z[key] = (u, z)
-        return u, z
+        return wn, wt
+
+    def _columns(self, contacts, coefs):
+        """The K^-1 U blocks (n x 2) of these contacts at these coefficients: cached ones as they are, the others
+        by one back-substitution of all their U columns (n x 2k) on the reference factor, then cached."""
+        keys = [self._key(i, c) for i, c in zip(contacts, coefs)]
+        miss = [j for j, k in enumerate(keys) if k not in self._z]
+        if miss:
+            u = np.empty((self.lu.shape[0], 2 * len(miss)), order="F")
+            for q, j in enumerate(miss):
+                u[:, 2 * q], u[:, 2 * q + 1] = self._u(contacts[j], coefs[j])
+            z = self.lu.solve(u)
+            self.back_substitutions += u.shape[1]
+            for q, j in enumerate(miss):
+                self._z[keys[j]] = z[:, 2 * q:2 * q + 2]
+        return [self._z[k] for k in keys]
 
     def prepare(self, coef_new):
         """The low-rank operator for the new coefficients, or None where it is not worth it (too many changes)."""
@@ -193,14 +212,20 @@ class LowRankSolver:
             return None
         if not len(changed):
             return _Woodbury(self, None, None, None)
-        zs = [self._columns(i, (a_nn[i], a_sn[i], a_ss[i], b[i])) for i in changed]
-        z = np.concatenate([q[1] for q in zs], axis=1)
+        blocks = self._columns(changed, [(a_nn[i], a_sn[i], a_ss[i], b[i]) for i in changed])
         # V's columns per contact are (c_n, c_t), interleaved to match U's (w_n, w_t) per contact
         r = len(changed)
         order = np.empty(2 * r, int)
         order[0::2], order[1::2] = changed, self._m + changed
         vt = self._rows[order]
-        cap = np.eye(2 * r) + vt @ z
+        # V^T Z on the rows of Z that V^T touches: the same stored entries in the same order, so the same sums
+        used, local = np.unique(vt.indices, return_inverse=True)
+        zg = np.empty((len(used), 2 * r))
+        for j, zj in enumerate(blocks):
+            zg[:, 2 * j:2 * j + 2] = zj[used]
+        vt_used = sp.csr_matrix((vt.data, local.reshape(-1).astype(vt.indices.dtype), vt.indptr),
+                                shape=(2 * r, len(used)))
+        cap = np.eye(2 * r) + vt_used @ zg
         try:
             with warnings.catch_warnings():     # a singular capacitance (a mechanism) is refused just below
                 warnings.simplefilter("ignore", sla.LinAlgWarning)
@@ -209,19 +234,22 @@ class LowRankSolver:
             return None
         if not np.all(np.isfinite(lu_cap[0])) or np.abs(np.diag(lu_cap[0])).min() == 0.0:
             return None
-        return _Woodbury(self, z, vt, lu_cap)
+        return _Woodbury(self, blocks, vt, lu_cap)
 
 
 class _Woodbury:
     def __init__(self, owner, z, vt, lu_cap):
-        self.owner, self.z, self.vt, self.lu_cap = owner, z, vt, lu_cap
+        self.owner, self.z, self.vt, self.lu_cap = owner, z, vt, lu_cap    # z: the K^-1 U blocks (n x 2 each)
 
     def apply(self, rhs):
         y = self.owner.lu.solve(rhs)
         self.owner.back_substitutions += 1
         if self.z is None:
             return y
-        return y - self.z @ sla.lu_solve(self.lu_cap, self.vt @ y)
+        s = sla.lu_solve(self.lu_cap, self.vt @ y)
+        for j, zj in enumerate(self.z):     # y - Z s, block by block (no n x 2r copy)
+            y -= zj @ s[2 * j:2 * j + 2]
+        return y
 
     def direct(self, kff, rhs):
         """The plain solve on the reference factor (``kff`` is its tangent); its residual is recorded."""
