@@ -11,13 +11,14 @@ keeps the randomised process.
 import os
 import sys
 
+from grainfrac_yade.repeatable import repeatable_environment
+
 DEBIAN_PYTHON = "/usr/bin/python3"
 
 
 def _reexec():
     if os.environ.get("GRAINFRAC_NO_REEXEC"):
         return
-    from grainfrac_yade.repeatable import repeatable_environment
     env = repeatable_environment()
     python = sys.executable
     if os.path.exists(DEBIAN_PYTHON) and os.path.realpath(python) != os.path.realpath(DEBIAN_PYTHON):
