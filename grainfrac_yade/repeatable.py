@@ -48,10 +48,10 @@ def repeatable_environment(environ=None) -> dict | None:
     (default: this process's) with the fixed hash seed; None where that cannot be done (not Linux, the call
     refused) or was declined (``GRAINFRAC_REPEATABLE=0``) or is already so (nothing to re-execute)."""
     env = dict(os.environ if environ is None else environ)
-    if env.get(OPT_OUT) == "0" or process_is_repeatable():
-        return None
     flags = _personality()
-    if flags is None:
+    if env.get(OPT_OUT) == "0" or flags is None:
+        return None
+    if flags & ADDR_NO_RANDOMIZE and env.get("PYTHONHASHSEED") == HASH_SEED:
         return None
     if not flags & ADDR_NO_RANDOMIZE:
         name = ctypes.util.find_library("c")

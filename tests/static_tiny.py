@@ -1,7 +1,9 @@
 """Tiny static networks with closed-form answers (helpers of tests/test_static_*.py; no YADE)."""
 import numpy as np
+import pytest
 
 from grainfrac_yade.elastic import Network
+from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.static.network import from_network
 
 #: Bond stiffnesses [N/m] and strengths [Pa] of the tiny networks: Table 2's orders of magnitude.
@@ -51,3 +53,26 @@ def assert_resumed_as_whole(resumed, whole):
     assert (resumed.n_events, resumed.failed, resumed.failure_reason) == (whole.n_events, whole.failed,
                                                                           whole.failure_reason)
     assert np.array_equal(resumed.break_time, whole.break_time, equal_nan=True)
+
+
+def run_killed_and_resumed(tmp_path, monkeypatch, params, seed, stress, killed_when):
+    """The creep run of ``params`` (``seed``, held ``stress`` [Pa]) uninterrupted, and the same run killed (a
+    KeyboardInterrupt) at the first checkpoint after which ``killed_when(run, checkpoints written)`` holds, then
+    resumed from it: (whole, resumed) (helper of the kill-and-resume tests of the static and hybrid engines)."""
+    import grainfrac_yade.protocols.checkpoints as checkpoints
+    from grainfrac_yade.protocols.creep import resume_creep, run_creep
+    whole = run_creep(build_specimen(params, seed), params, stress, checkpoint_folder=tmp_path / "whole",
+                      run_values={"seed": seed})
+    write, written = checkpoints.Checkpointer.write, []
+
+    def killed(self, run, *args, **kwargs):
+        write(self, run, *args, **kwargs)
+        written.append(1)
+        if killed_when(run, len(written)):
+            raise KeyboardInterrupt
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", killed)
+    with pytest.raises(KeyboardInterrupt):
+        run_creep(build_specimen(params, seed), params, stress, checkpoint_folder=tmp_path / "cut",
+                  run_values={"seed": seed})
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
+    return whole, resume_creep(build_specimen(params, seed), params, stress, tmp_path / "cut")

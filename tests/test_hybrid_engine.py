@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
-from static_tiny import assert_resumed_as_whole
+from static_tiny import assert_resumed_as_whole, run_killed_and_resumed
 
 from grainfrac_yade.engines import Scene
 from grainfrac_yade.engines.registry import ENGINE_NAMES, engine, engine_for
@@ -168,23 +168,11 @@ def test_a_hybrid_creep_killed_after_a_stint_resumes_to_the_uninterrupted_run(tm
     """Checkpoints at every safe point; the run killed at the first checkpoint after its first stint and resumed:
     history (but wall times), events, failure, break times and the stint log as the uninterrupted run's (rigid
     cells: YADE's stints repeat bit for bit)."""
-    import grainfrac_yade.protocols.checkpoints as checkpoints
-    from grainfrac_yade.protocols.creep import resume_creep, run_creep
     p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.engine=hybrid",
                                    "numerics.handover_cascade_bonds=2", "numerics.checkpoint_interval=1e-9"])
-    whole = run_creep(build_specimen(p, 3), p, 160e6, checkpoint_folder=tmp_path / "whole", run_values={"seed": 3})
+    whole, resumed = run_killed_and_resumed(tmp_path, monkeypatch, p, 3, 160e6,
+                                            lambda run, written: bool(run.scene.stints))
     assert len(whole.scene.stints) >= 1
-    write = checkpoints.Checkpointer.write
-
-    def killed_after_a_stint(self, run, *args, **kwargs):
-        write(self, run, *args, **kwargs)
-        if run.scene.stints:
-            raise KeyboardInterrupt
-    monkeypatch.setattr(checkpoints.Checkpointer, "write", killed_after_a_stint)
-    with pytest.raises(KeyboardInterrupt):
-        run_creep(build_specimen(p, 3), p, 160e6, checkpoint_folder=tmp_path / "cut", run_values={"seed": 3})
-    monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
-    resumed = resume_creep(build_specimen(p, 3), p, 160e6, tmp_path / "cut")
     assert_resumed_as_whole(resumed, whole)
     strip = [{k: v for k, v in s.items() if k != "cpu_s"} for s in whole.scene.stints]
     assert [{k: v for k, v in s.items() if k != "cpu_s"} for s in resumed.scene.stints] == strip

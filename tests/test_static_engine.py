@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import needs_yade
-from static_tiny import assert_resumed_as_whole
+from static_tiny import assert_resumed_as_whole, run_killed_and_resumed
 
 from grainfrac_yade.engines import Scene
 from grainfrac_yade.engines.registry import engine, engine_for
@@ -238,23 +238,8 @@ def test_creep_with_a_law_that_changes_stiffness_is_one_line():
 def test_creep_killed_and_resumed_gives_the_uninterrupted_run(tmp_path, monkeypatch):
     """Checkpoints at every safe point (ramp, events, relaxations), the run killed after the sixth and resumed from
     it: history (but for wall times), events, failure and break times as the uninterrupted run's."""
-    import grainfrac_yade.protocols.checkpoints as checkpoints
-    from grainfrac_yade.protocols.creep import resume_creep, run_creep
     p = _params("specimen.width=4e-3", "specimen.height=8e-3", "numerics.checkpoint_interval=1e-9")
-    whole = run_creep(build_specimen(p, 1), p, 160e6, checkpoint_folder=tmp_path / "whole",
-                      run_values={"seed": 1})
-    write, written = checkpoints.Checkpointer.write, []
-
-    def killed_after_six(self, *args, **kwargs):
-        write(self, *args, **kwargs)
-        written.append(1)
-        if len(written) == 6:
-            raise KeyboardInterrupt
-    monkeypatch.setattr(checkpoints.Checkpointer, "write", killed_after_six)
-    with pytest.raises(KeyboardInterrupt):
-        run_creep(build_specimen(p, 1), p, 160e6, checkpoint_folder=tmp_path / "cut", run_values={"seed": 1})
-    monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
-    resumed = resume_creep(build_specimen(p, 1), p, 160e6, tmp_path / "cut")
+    whole, resumed = run_killed_and_resumed(tmp_path, monkeypatch, p, 1, 160e6, lambda run, written: written == 6)
     assert whole.n_events > 1
     assert_resumed_as_whole(resumed, whole)
     assert np.array_equal(resumed.scene.broken, whole.scene.broken)
