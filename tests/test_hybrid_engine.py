@@ -12,6 +12,7 @@ from grainfrac_yade.engines.registry import ENGINE_NAMES, engine, engine_for
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.params.schema import NumericsParams
+from grainfrac_yade.wave import steps_for
 
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
 FEM = "params/presets/fem.toml"
@@ -119,6 +120,11 @@ def test_a_creep_hold_hands_a_cascade_to_yade_and_takes_its_breaks_back(tmp_path
     assert len(stint["broken_per_crossing"]) >= 1 and all(n >= 0 for n in stint["broken_per_crossing"])
     assert sum(stint["broken_per_crossing"]) == stint["broken_after"] - stint["broken_before"]
     assert stint["stress_after_pa"] == pytest.approx(160e6, rel=p.creep.stress_tolerance)
+    # the budget the stint ran under, in YADE's DEM steps (a crossing at YADE's step, not the static scene's)
+    assert stint["wave_crossing_steps"] > 0 and stint["servo_response_steps"] == steps_for(
+        p.creep.servo_response_steps, p.creep.servo_response_crossings, stint["wave_crossing_steps"])
+    assert stint["max_relaxation_steps"] == steps_for(p.creep.max_relaxation_steps, p.creep.max_relaxation_crossings,
+                                                      stint["wave_crossing_steps"])
     assert summary["lifetime_s"] > 0 and summary["numerical_failure"] is False
     assert summary["broken_total"] >= stint["broken_after"]
     saved = json.loads((tmp_path / "run" / "summary.json").read_text())

@@ -34,7 +34,10 @@ failing: its state (stress, broken set) is the scene's last, and the static path
 
 Not bit-reproducible between processes once a stint ran (YADE sums fem node forces in an order keyed by memory
 address, docs/studies/paper_fem.md); a run without stints is the static engine's, bit for bit.  Every stint is
-logged (:attr:`stints`) and summarised in summary.json (:meth:`summary_keys`).
+logged (:attr:`stints`) and summarised in summary.json (:meth:`summary_keys`); its log names the budget it ran
+under in YADE's DEM steps (one wave crossing, the servo's response, the relaxation budget): the summary's
+``wave_crossing_steps``, ``servo_response_steps_used`` and ``max_relaxation_steps_used`` are the creep protocol's,
+counted in the static scene's load increments, not YADE's.
 """
 from __future__ import annotations
 
@@ -155,8 +158,11 @@ class HybridScene(StaticScene):
             for m in np.unique(modes):
                 dyn.break_bonds(pending[modes == m], int(m))
         crossings = []
-        outcome, steps, servo, min_steps = self._relax(dyn, ypl, start, held, retry, crossings)
+        outcome, steps, servo, min_steps, budget = self._relax(dyn, ypl, start, held, retry, crossings)
         log.update(outcome=outcome, dem_steps=int(steps), min_dem_steps=int(math.ceil(min_steps)),
+                   wave_crossing_steps=float(budget.crossing_steps),
+                   servo_response_steps=int(budget.servo_response_steps) if held else None,
+                   max_relaxation_steps=int(budget.max_relaxation_steps),
                    broken_per_crossing=crossings,
                    broken_after=int(dyn.broken.sum()),
                    stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
@@ -184,7 +190,8 @@ class HybridScene(StaticScene):
     def _relax(self, dyn, platens, start, held: bool, retry: int = 0, crossings=None):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
         servo or None, the DEM steps before the equilibrium check may end it: ``numerics.stint_min_crossings`` wave
-        crossings, or :data:`RETRY_CROSSINGS` per ``retry`` where more); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
+        crossings, or :data:`RETRY_CROSSINGS` per ``retry`` where more, and the stint's
+        :class:`~grainfrac_yade.wave.HoldBudget` in YADE's DEM steps); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
         ``ucs.stop_stress_ratio`` x the stint's start, the UCS test's post-peak rule) or "budget" (none of these
         within the relaxation budget).  ``crossings`` (a list) receives the bonds YADE broke in each elastic wave
         crossing of the stint, read at the first check past each crossing's end (the last entry: the part-crossing
@@ -230,7 +237,7 @@ class HybridScene(StaticScene):
                 outcome = "equilibrium"
                 break
         crossings.append(int(dyn.broken.sum()) - counted)
-        return outcome, done, servo, min_steps
+        return outcome, done, servo, min_steps, budget
 
     def _take_back(self, dyn, platens, dem_steps: int, log: dict) -> None:
         """What the stint reached, into the static scene: first YADE's relaxed state itself (:meth:`_take_state`);
