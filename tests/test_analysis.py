@@ -16,6 +16,7 @@ from grainfrac_yade.analysis import classify_runs, collect_runs, fit_lifetimes, 
 from grainfrac_yade.analysis.crackmaps import crack_segments, cracks_at
 from grainfrac_yade.analysis.labdata import paper_reference, read_lab_csv
 from grainfrac_yade.errors import GrainfracError
+from grainfrac_yade.analysis.study import first_creep_crack
 
 PYTHON = "/usr/bin/python3"
 A_TRUE, B_TRUE = 32.0, 28.0          # ln t = a - b r of the synthetic model runs
@@ -519,3 +520,17 @@ def test_a_run_that_failed_on_loading_is_its_own_outcome():
     assert outcome(dict(base, lifetime_s=0.0, failed_on_loading=True)) == "failed at load"
     assert outcome(dict(base, lifetime_s=0.0)) == "failed at load"          # older runs without the key
     assert outcome(dict(base, lifetime_s=12.5, failed_on_loading=False)) == "failed"
+
+
+def test_first_creep_crack_is_the_earliest_bond_broken_at_the_held_load(tmp_path):
+    """Ramp cracks (phase ramp, empty creep time) do not count; the time factor of a rescaled study applies; a run
+    without creep cracks or without cracks.csv has none (NaN)."""
+    cols = "bond,creep_time_s,phase,mode,kind,x_m,y_m,face_normal_angle_deg\n"
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "cracks.csv").write_text(cols + "0,,ramp,tensile,inter,0,0,0\n1,2.5,creep,shear,intra,0,0,0\n"
+                                               "2,0.75,creep,tensile,inter,0,0,0\n")
+    assert first_creep_crack(tmp_path / "a") == 0.75
+    assert first_creep_crack(tmp_path / "a", time_factor=4.0) == 3.0
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "cracks.csv").write_text(cols + "0,,ramp,tensile,inter,0,0,0\n")
+    assert np.isnan(first_creep_crack(tmp_path / "b")) and np.isnan(first_creep_crack(tmp_path / "c"))

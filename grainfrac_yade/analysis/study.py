@@ -35,10 +35,10 @@ CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure",
                   "run error")
 #: Columns of runs.csv (those present); the parameter columns are those of ucs_runs.csv that tell runs apart.
 RUN_TABLE = ("run", "folder", "command", "engine", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
-             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
+             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "first_creep_crack_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
-             "tertiary_start_s", "steps", "wall_s", "specimen.width", "specimen.height", "specimen.grain_size",
-             "resolution.grain_model", "calibration.strength_scale", "calibration.stiffness_scale",
+             "tertiary_start_s", "steps", "wall_s", "cpu_s", "specimen.width", "specimen.height", "specimen.grain_size",
+             "resolution.grain_model", "resolution.nodes_per_face", "calibration.strength_scale", "calibration.stiffness_scale",
              "stress_corrosion.beta1", "stress_corrosion.beta2", "specimen.min_edge_fraction", "creep.ramp_strain_rate",
              "numerics.density_scale", "study", "beta1_run", "time_factor", "code_version", "problem")
 #: Decades of lifetime scatter that count as "orders of magnitude" when comparing with the lab.
@@ -137,6 +137,8 @@ def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
                                  "no summary.json (running, stopped or crashed)") + reach
     for i in runs.index[runs["outcome"].isin(("numerical failure", "failed before test"))]:
         runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else runs.at[i, "outcome"]
+    runs["first_creep_crack_s"] = [first_creep_crack(f, tf) if o in CREEP_OUTCOMES else np.nan
+                                   for f, tf, o in zip(runs["folder"], runs["time_factor"], runs["outcome"])]
     runs.attrs["filled"] = filled
     return runs
 
@@ -201,6 +203,16 @@ def read_cracks(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
         from .crack_phases import RAMP_TIME
         cracks["creep_time_s"] = cracks["creep_time_s"].where(cracks["phase"] != "ramp", RAMP_TIME)
     return rescale.scale_times(cracks, time_factor, rescale.CRACK_TIME_COLUMNS)
+
+
+def first_creep_crack(folder, time_factor: float = 1.0) -> float:
+    """Creep time [s] of a run's first creep crack (the first bond broken at the held load; the paper's first
+    microcrack at 0.26 s, section 4.1) from its cracks.csv; NaN without cracks.csv or without creep cracks."""
+    cracks = read_cracks(folder, time_factor)
+    if cracks is None:
+        return np.nan
+    creep = cracks["creep_time_s"][cracks["creep_time_s"] >= 0]
+    return float(creep.min()) if len(creep) else np.nan
 
 
 def lifetime_sets(runs: pd.DataFrame) -> list:
