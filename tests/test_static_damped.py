@@ -66,3 +66,34 @@ def test_relax_held_ends_on_the_plain_static_hold():
 def test_anchor_must_be_positive():
     with pytest.raises(ValueError):
         AnchoredEquilibrium(chain(), 0.0)
+
+
+def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
+    """A plain regain that gives out (made to fail once here) is relaxed from the last converged state and ends on
+    the plain static hold's state; a regain that does not give out is the plain one's, bit for bit."""
+    from grainfrac_yade.errors import NumericalFailure
+    from grainfrac_yade.static.damped import RelaxingPath
+
+    net = chain(jt=1e12, jc=1e12)
+    target = 50e6
+    plain, _ = Path(Equilibrium(net)).hold(Equilibrium(net).initial(0.0), target, FailureRule(1e-3))
+    eq = Equilibrium(net)
+    rp = RelaxingPath(eq, AnchoredEquilibrium(net, 1.0))
+    same, reason = rp.hold(eq.initial(0.0), target, FailureRule(1e-3))
+    assert reason is None and np.array_equal(same.u, plain.u) and not rp.relaxations
+    calls = {"n": 0}
+    original = Path.hold
+
+    def fails_once(self, *args, **kw):
+        calls["n"] += 1
+        if calls["n"] == 1:
+            self.last_converged = args[0]
+            raise NumericalFailure("static equilibrium: contact statuses did not settle (made to fail)")
+        return original(self, *args, **kw)
+    monkeypatch.setattr(Path, "hold", fails_once)
+    eq = Equilibrium(net)
+    rp = RelaxingPath(eq, AnchoredEquilibrium(net, 1.0))
+    state, reason = rp.hold(eq.initial(0.0), target, FailureRule(1e-3))
+    assert reason is None and len(rp.relaxations) == 1 and rp.relaxations[0].steps >= 1
+    assert state.stress == pytest.approx(plain.stress, rel=1e-9)
+    assert np.allclose(state.u, plain.u, rtol=1e-9, atol=1e-9 * np.abs(plain.u).max())

@@ -27,7 +27,8 @@ time as in :mod:`.cascade`) with attempts of the plain static regain from the st
 * after ``max_steps`` steps without either: :class:`~grainfrac_yade.errors.NumericalFailure` (a solver that gives
   out is never a failure of the specimen).
 
-Not yet plugged into a scene (docs/studies/static_engine.md, "Overdamped relaxation").
+:class:`RelaxingPath` is the static path whose held-load regains relax so where the plain ones give out.  Not yet
+plugged into a scene (docs/studies/static_engine.md, "Overdamped relaxation").
 """
 from __future__ import annotations
 
@@ -121,8 +122,8 @@ def relax_held(path: Path, anchored: AnchoredEquilibrium, state: State, target: 
             out.failure = reason or COLLAPSE
             return out
         out.static_attempts += 1
-        try:
-            held, reason = path.hold(path.cascade(path.eq.solve(state.closure, state)), target, rule)
+        try:    # the plain static regain (Path's own, not a subclass's relaxing one)
+            held, reason = Path.hold(path, Path.cascade(path, path.eq.solve(state.closure, state)), target, rule)
         except NumericalFailure:
             continue
         out.state, out.broken = held, int(held.broken.sum()) - broken0
@@ -130,3 +131,40 @@ def relax_held(path: Path, anchored: AnchoredEquilibrium, state: State, target: 
         return out
     raise NumericalFailure(f"overdamped relaxation: no static equilibrium at the held load after {max_steps} "
                            f"pseudo-time steps (closure {state.closure:.6g} m)")
+
+
+class RelaxingPath(Path):
+    """The static path whose held-load regain (:meth:`hold`, and a cascade before it) relaxes by
+    :func:`relax_held` where the plain static solve gives out; every relaxation is kept in :attr:`relaxations`."""
+
+    def __init__(self, eq: Equilibrium, anchored: AnchoredEquilibrium, bracket_tol=None,
+                 max_steps: int = MAX_RELAXATION_STEPS):
+        super().__init__(eq, *(() if bracket_tol is None else (bracket_tol,)))
+        self.anchored, self.max_steps = anchored, int(max_steps)
+        self.relaxations: list[Relaxation] = []
+        self._unsettled = None      # the last converged state of a cascade that gave out, for the next hold
+        self._in_hold = False       # inside a regain: a cascade that gives out is the regain's to handle
+
+    def cascade(self, state, first=None, record=None):
+        if self._in_hold:
+            return super().cascade(state, first, record)
+        try:
+            return super().cascade(state, first, record)
+        except NumericalFailure:
+            self._unsettled = self.last_converged
+            return self.last_converged
+
+    def hold(self, state, target, rule):
+        start, self._unsettled = self._unsettled, None
+        self._in_hold = True
+        try:
+            if start is None:
+                try:
+                    return super().hold(state, target, rule)
+                except NumericalFailure:
+                    start = self.last_converged
+            out = relax_held(self, self.anchored, start, target, rule, self.max_steps)
+        finally:
+            self._in_hold = False
+        self.relaxations.append(out)
+        return out.state, out.failure

@@ -1,0 +1,62 @@
+"""A static creep hold whose regains relax by overdamped implicit steps where the static statuses do not settle
+(grainfrac_yade.static.damped): one JSON line (no YADE).
+
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.damped_relaxation_probe --params params/presets/fem.toml \
+        --width 10e-3 --height 20e-3 --seed 1 --creep-stress 160e6 [--alpha 1.0] [--plain]
+
+``--plain``: the plain static path (a status set that does not settle ends the hold as a numerical failure).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+from grainfrac_yade.clocks import EventClock
+from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.grains import layout_for
+from grainfrac_yade.law import build_law
+from grainfrac_yade.params import load_parameters
+from grainfrac_yade.static.cascade import Path
+from grainfrac_yade.static.creep import creep_hold
+from grainfrac_yade.static.damped import AnchoredEquilibrium, RelaxingPath
+from grainfrac_yade.static.failure import FailureRule
+from grainfrac_yade.static.network import build_static_network
+from grainfrac_yade.static.solver import Equilibrium
+
+from .static_engine_probe import specimen_arguments
+
+
+def main(argv=None):
+    ap = specimen_arguments(argparse.ArgumentParser())
+    ap.add_argument("--alpha", type=float, default=1.0, help="anchor stiffness / each dof's intact stiffness")
+    ap.add_argument("--max-steps", type=int, default=200, help="pseudo-time steps of one relaxation")
+    ap.add_argument("--events", type=int, default=10**6)
+    ap.add_argument("--plain", action="store_true", help="the plain static path, no relaxation")
+    a = ap.parse_args(argv)
+    p = load_parameters(extra_files=a.params,
+                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
+    t0 = time.process_time()
+    s = build_specimen(p, a.seed)
+    net = build_static_network(s, p, layout_for(s, p))
+    eq = Equilibrium(net)
+    path = Path(eq) if a.plain else RelaxingPath(eq, AnchoredEquilibrium(net, a.alpha), max_steps=a.max_steps)
+    sc = p.stress_corrosion
+    clock = EventClock(sc.max_strength_loss_fraction, sc.creep_time_limit)
+    res = creep_hold(eq, build_law(sc), clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),
+                     max_events=a.events, path=path)
+    rel = getattr(path, "relaxations", [])
+    print(json.dumps({
+        "seed": a.seed, "width": a.width, "height": a.height, "dofs": net.ndof, "bonds": net.n_bonds,
+        "alpha": None if a.plain else a.alpha, "stress_pa": a.creep_stress, "events": res.events,
+        "failed": res.failed, "numerical_failure": res.numerical_failure, "end": res.reason,
+        "creep_time_s": res.lifetime, "broken": res.broken,
+        "strain_end": res.strains[-1] if res.strains else None, "cpu_s": time.process_time() - t0,
+        "relaxations": len(rel), "relaxation_steps": [r.steps for r in rel],
+        "relaxation_broken": [r.broken for r in rel],
+        "relaxation_failure": [r.failure for r in rel],
+        "equilibria": eq.counters.equilibria}))
+
+
+if __name__ == "__main__":
+    main()
