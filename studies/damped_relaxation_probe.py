@@ -10,21 +10,18 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 
 from grainfrac_yade.clocks import EventClock
-from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.grains import layout_for
 from grainfrac_yade.law import build_law
-from grainfrac_yade.params import load_parameters
 from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.creep import creep_hold
 from grainfrac_yade.static.damped import AnchoredEquilibrium, RelaxingPath
 from grainfrac_yade.static.failure import FailureRule
-from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
 
-from .static_engine_probe import specimen_arguments
+from .static_engine_probe import specimen_arguments, specimen_network
 
 
 def main(argv=None):
@@ -34,13 +31,21 @@ def main(argv=None):
     ap.add_argument("--events", type=int, default=10**6)
     ap.add_argument("--plain", action="store_true", help="the plain static path, no relaxation")
     a = ap.parse_args(argv)
-    p = load_parameters(extra_files=a.params,
-                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
     t0 = time.process_time()
-    s = build_specimen(p, a.seed)
-    net = build_static_network(s, p, layout_for(s, p))
+    p, net = specimen_network(a)
     eq = Equilibrium(net)
-    path = Path(eq) if a.plain else RelaxingPath(eq, AnchoredEquilibrium(net, a.alpha), max_steps=a.max_steps)
+    anchored = AnchoredEquilibrium(net, a.alpha)
+    path = Path(eq) if a.plain else RelaxingPath(eq, anchored, max_steps=a.max_steps)
+    solve = anchored.solve
+
+    def counted(closure, base, release=None):     # a progress line every 100 anchored solves, to stderr
+        out = solve(closure, base, release)
+        if anchored.counters.equilibria % 100 == 0:
+            print(f"anchored solves {anchored.counters.equilibria}: closure {closure:.6g} m, stress {out.stress:.6g} "
+                  f"Pa, broken {int(out.broken.sum())}, CPU {time.process_time() - t0:.1f} s", file=sys.stderr,
+                  flush=True)
+        return out
+    anchored.solve = counted
     sc = p.stress_corrosion
     clock = EventClock(sc.max_strength_loss_fraction, sc.creep_time_limit)
     res = creep_hold(eq, build_law(sc), clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),

@@ -60,6 +60,14 @@ def specimen_arguments(ap):
     return ap
 
 
+def specimen_network(a):
+    """(parameters, static network) of the parsed ``specimen_arguments`` (files, size, seed, --set)."""
+    p = load_parameters(extra_files=a.params,
+                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
+    s = build_specimen(p, a.seed)
+    return p, build_static_network(s, p, layout_for(s, p))
+
+
 def main(argv=None):
     ap = specimen_arguments(argparse.ArgumentParser())
     ap.add_argument("--max-strain", type=float)
