@@ -41,7 +41,7 @@ from ..errors import NumericalFailure
 from . import contacts as cl
 from .cascade import Path
 from .failure import COLLAPSE, FailureRule
-from .solver import Equilibrium, State
+from .solver import Equilibrium, State, own_stiffness
 
 #: Anchor stiffness alpha relative to each dof's own intact stiffness [1] in the first step of a relaxation.
 ANCHOR_RATIO = 1.0
@@ -50,17 +50,10 @@ MAX_RELAXATION_STEPS = 200
 
 
 def intact_diagonal(eq: Equilibrium) -> np.ndarray:
-    """(ndof,) each dof's own stiffness in the intact tangent [N/m or N m/rad], the median of its kind where it has
-    none (as the solver's ground springs)."""
-    n = eq.net
-    m = n.n_bonds
-    k = Equilibrium.tangent(eq, np.full(m, cl.INTACT), np.ones(m), np.zeros(m))
-    d = np.abs(k.diagonal())
-    for col in range(3):
-        idx = n.dofs[:, col][n.dofs[:, col] >= 0]
-        if len(idx) and (d[idx] > 0).any():
-            d[idx] = np.where(d[idx] > 0, d[idx], np.median(d[idx][d[idx] > 0]))
-    return d
+    """(ndof,) each dof's own stiffness in the intact tangent [N/m or N m/rad] (:func:`.solver.own_stiffness`, as the
+    solver's ground springs)."""
+    m = eq.net.n_bonds
+    return own_stiffness(Equilibrium.tangent(eq, np.full(m, cl.INTACT), np.ones(m), np.zeros(m)), eq.net.dofs)
 
 
 class AnchoredEquilibrium(Equilibrium):

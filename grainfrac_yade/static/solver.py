@@ -213,13 +213,8 @@ class Equilibrium:
         a_nn, a_ns, a_sn, a_ss, b_n, b_s = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
         gn, gt = self.force_rows(status != cl.INTACT)
         k = n.k_grain + gn.T @ sp.diags(a_nn) @ n.cn + gt.T @ (sp.diags(a_sn) @ n.cn + sp.diags(a_ss) @ n.ct)
-        if self._ground is None:      # each dof's own intact stiffness, once (its kind's median where it has none)
-            d = np.abs(k.diagonal())
-            for col in range(3):
-                idx = n.dofs[:, col][n.dofs[:, col] >= 0]
-                if len(idx) and (d[idx] > 0).any():
-                    d[idx] = np.where(d[idx] > 0, d[idx], np.median(d[idx][d[idx] > 0]))
-            self._ground = sp.diags(GROUND_REGULARISATION * d)
+        if self._ground is None:      # each dof's own intact stiffness, once
+            self._ground = sp.diags(GROUND_REGULARISATION * own_stiffness(k, n.dofs))
         return (k + self._ground).tocsc() if ground else k.tocsc()
 
     def fixed_dofs(self, status):
@@ -513,6 +508,17 @@ class Equilibrium:
         base = State(closure, np.zeros(self.net.ndof), np.zeros(m, bool), np.full(m, cl.INTACT), np.ones(m), z,
                      z, z, 0.0, np.zeros(m, int))
         return self.solve(closure, base)
+
+
+def own_stiffness(k, dofs) -> np.ndarray:
+    """(ndof,) each dof's own stiffness |K_ii| of the tangent ``k``, its kind's median (translations x, y,
+    rotations: the columns of ``dofs``) where it has none."""
+    d = np.abs(k.diagonal())
+    for col in range(3):
+        idx = dofs[:, col][dofs[:, col] >= 0]
+        if len(idx) and (d[idx] > 0).any():
+            d[idx] = np.where(d[idx] > 0, d[idx], np.median(d[idx][d[idx] > 0]))
+    return d
 
 
 def net_tri_edges(net: StaticNetwork):
