@@ -2,7 +2,7 @@
 (grainfrac_yade.static.damped): one JSON line (no YADE).
 
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.damped_relaxation_probe --params params/presets/fem.toml \
-        --width 10e-3 --height 20e-3 --seed 1 --creep-stress 160e6 [--alpha 1.0] [--plain]
+        --width 10e-3 --height 20e-3 --seed 1 --creep-stress 160e6 [--plain]
 
 ``--plain``: the plain static path (a status set that does not settle ends the hold as a numerical failure).
 """
@@ -17,7 +17,7 @@ from grainfrac_yade.clocks import EventClock
 from grainfrac_yade.law import build_law
 from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.creep import creep_hold
-from grainfrac_yade.static.damped import AnchoredEquilibrium, RelaxingPath
+from grainfrac_yade.static.damped import REST_TOLERANCE, AnchoredEquilibrium, RelaxingPath
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
@@ -26,16 +26,16 @@ from .static_engine_probe import specimen_arguments, specimen_network
 
 def main(argv=None):
     ap = specimen_arguments(argparse.ArgumentParser())
-    ap.add_argument("--alpha", type=float, default=1.0, help="anchor stiffness / each dof's intact stiffness")
     ap.add_argument("--max-steps", type=int, default=200, help="pseudo-time steps of one relaxation")
+    ap.add_argument("--tolerance", type=float, default=REST_TOLERANCE, help="relative unbalanced force at rest")
     ap.add_argument("--events", type=int, default=10**6)
     ap.add_argument("--plain", action="store_true", help="the plain static path, no relaxation")
     a = ap.parse_args(argv)
     t0 = time.process_time()
     p, net = specimen_network(a)
     eq = Equilibrium(net)
-    anchored = AnchoredEquilibrium(net, a.alpha)
-    path = Path(eq) if a.plain else RelaxingPath(eq, anchored, max_steps=a.max_steps)
+    anchored = AnchoredEquilibrium(net)
+    path = Path(eq) if a.plain else RelaxingPath(eq, anchored, a.tolerance, max_steps=a.max_steps)
     solve = anchored.solve
 
     def counted(closure, base, release=None):     # a progress line every 100 anchored solves, to stderr
@@ -53,13 +53,15 @@ def main(argv=None):
     rel = getattr(path, "relaxations", [])
     print(json.dumps({
         "seed": a.seed, "width": a.width, "height": a.height, "dofs": net.ndof, "bonds": net.n_bonds,
-        "alpha": None if a.plain else a.alpha, "stress_pa": a.creep_stress, "events": res.events,
+        "relaxing": not a.plain, "tolerance": None if a.plain else a.tolerance, "stress_pa": a.creep_stress, "events": res.events,
         "failed": res.failed, "numerical_failure": res.numerical_failure, "end": res.reason,
         "creep_time_s": res.lifetime, "broken": res.broken,
         "strain_end": res.strains[-1] if res.strains else None, "cpu_s": time.process_time() - t0,
         "relaxations": len(rel), "relaxation_steps": [r.steps for r in rel],
         "relaxation_broken": [r.broken for r in rel],
         "relaxation_failure": [r.failure for r in rel],
+        "relaxation_unsettled": [r.unsettled for r in rel],
+        "relaxation_closure_growth_m": [r.state.closure - r.start_closure for r in rel],
         "equilibria": eq.counters.equilibria}))
 
 

@@ -4,10 +4,11 @@ import pytest
 
 from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.damped import AnchoredEquilibrium, intact_diagonal, relax_held
+from grainfrac_yade.static.failure import NO_EQUILIBRIUM
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, network
+from static_tiny import KN, network, shear_pair
 
 
 def chain(**kw):
@@ -48,19 +49,72 @@ def test_fixed_point_is_the_static_equilibrium():
     assert np.abs(eq.unbalanced(again)).max() <= 1e-9 * np.abs(plain.fn).max()
 
 
-def test_relax_held_ends_on_the_plain_static_hold():
-    """Where the plain hold settles, a relaxation ends at its first attempt on the same state as the plain hold."""
+def test_set_alpha_is_a_fresh_anchored_equilibrium():
+    """Changing the anchor in place gives the solve of an equilibrium built with that anchor (fast path), to 1e-12."""
+    net = chain(jt=1e12, jc=1e12)
+    state = Equilibrium(net).initial(1e-9)
+    state.u[net.dofs[1, 1]] = 2e-8
+    moved, fresh = AnchoredEquilibrium(net, 1.0), AnchoredEquilibrium(net, 10.0)
+    moved.solve(1e-9, state)            # a factor kept at the old anchor must not be reused
+    moved.set_alpha(10.0)
+    for eq in (moved, fresh):
+        eq.u_ref = state.u.copy()
+    a, b = moved.solve(1e-9, state), fresh.solve(1e-9, state)
+    assert moved.alpha == 10.0 and np.allclose(a.u, b.u, rtol=1e-12, atol=1e-12 * np.abs(b.u).max())
+
+
+def test_relax_held_halves_the_anchor_until_the_load_rests():
+    """The chain's free node, offset by u_0 at the held load, relaxes through steps of anchor ratios 1, 1/2, 1/4, ...
+    (pseudo-transient continuation): u_k = prod_j (a_j / (1 + a_j)) u_0, the relative unbalanced force
+    a_k (u_{k-1} - u_k) 2 k_n / mean bond force; it stops at the first step below the tolerance, on the plain hold's
+    state within that tolerance."""
     net = chain(jt=1e12, jc=1e12)
     eq = Equilibrium(net)
-    path = Path(eq)
     target = 50e6
-    plain, reason = path.hold(eq.initial(0.0), target, FailureRule(1e-3))
+    plain, reason = Path(eq).hold(eq.initial(0.0), target, FailureRule(1e-3))
     assert reason is None
-    start = eq.initial(0.0)
-    out = relax_held(Path(eq), AnchoredEquilibrium(net, 1.0), start, target, FailureRule(1e-3))
-    assert out.failure is None and out.steps == 1 and out.static_attempts == 1
-    assert out.state.stress == pytest.approx(plain.stress, rel=1e-9)
-    assert out.state.closure == pytest.approx(plain.closure, rel=1e-9)
+    dof, u0 = net.dofs[1, 1], 2e-8
+    start = plain.copy()
+    start.u[dof] += u0
+    out = relax_held(Path(eq), AnchoredEquilibrium(net), start, target, FailureRule(1e-3), tolerance=1e-6)
+    assert out.failure is None and out.unsettled == 0 and out.steps == len(out.alphas)
+    assert out.alphas == [2.0 ** -k for k in range(out.steps)]
+    u, u_expected = [], u0
+    for a in out.alphas:
+        u.append(u_expected)
+        u_expected *= a / (1 + a)
+    assert out.state.u[dof] - plain.u[dof] == pytest.approx(u_expected, rel=1e-9, abs=1e-22)
+    bond_force = np.abs(plain.fn).mean()
+    # the node's force over the mean force of the two bonds; the closed form's unbalanced force after the last step
+    last = 2 * KN * out.alphas[-1] * (u[-1] - u_expected)
+    assert out.unbalanced[-1] == pytest.approx(last / bond_force, rel=1e-6)
+    assert out.unbalanced[-1] < 1e-6 <= out.unbalanced[-2]
+
+
+def test_relax_held_rest_tolerance_moves_the_state_only_within_it():
+    """Two tolerances, 1e-6 and 1e-9: the same failure verdict and broken set, states within the looser one."""
+    net = chain(jt=1e12, jc=1e12)
+    eq = Equilibrium(net)
+    start, _ = Path(eq).hold(eq.initial(0.0), 50e6, FailureRule(1e-3))
+    start.u[net.dofs[1, 1]] += 2e-8
+    loose, tight = (relax_held(Path(eq), AnchoredEquilibrium(net), start, 50e6, FailureRule(1e-3), tolerance=t)
+                    for t in (1e-6, 1e-9))
+    assert loose.failure is tight.failure is None and tight.steps > loose.steps
+    assert np.array_equal(loose.state.broken, tight.state.broken)
+    assert np.abs(loose.state.fn - tight.state.fn).max() <= 1e-5 * np.abs(tight.state.fn).max()
+
+
+def test_relax_held_ends_in_the_failure_rule_of_a_held_load():
+    """A broken face that slides at sigma tan(phi_r) below the held shear stress: the anchored path has no
+    equilibrium ahead, the relaxation's verdict is the static rule's (no equilibrium), never a numerical failure."""
+    sigma, tau = 20e6, 35e6
+    net = shear_pair()
+    eq = Equilibrium(net, confinement=sigma)
+    path = Path(eq)
+    state = path.cascade(eq.initial(0.0), first=0)      # the bond has corroded through
+    assert state.broken.all()
+    out = relax_held(path, AnchoredEquilibrium(net, confinement=sigma), state, tau, FailureRule(1e-3), 1e-6)
+    assert out.failure == NO_EQUILIBRIUM
 
 
 def test_anchor_must_be_positive():
@@ -97,3 +151,38 @@ def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
     assert reason is None and len(rp.relaxations) == 1 and rp.relaxations[0].steps >= 1
     assert state.stress == pytest.approx(plain.stress, rel=1e-9)
     assert np.allclose(state.u, plain.u, rtol=1e-9, atol=1e-9 * np.abs(plain.u).max())
+
+
+def _fem_creep(*extra):
+    """The 4 x 8 mm fem creep at 160 MPa of seed 4 on the static engine: the plain path's regain gives out (a status
+    cycle) at its 14th event."""
+    from grainfrac_yade.geometry.specimen import build_specimen
+    from grainfrac_yade.params import load_parameters
+    from grainfrac_yade.protocols.creep import run_creep
+    p = load_parameters(extra_files=["params/presets/fem.toml"],
+                        overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
+    return run_creep(build_specimen(p, 4), p, 160e6)
+
+
+def test_creep_hold_relaxes_past_a_status_cycle_whatever_the_rest_tolerance(monkeypatch):
+    """Through the protocol: the plain static engine ends that hold as a numerical failure; with
+    ``numerics.static_relaxation = "overdamped"`` the regain relaxes and the hold goes on to the time limit.  The
+    rest tolerance 1e-6 or 1e-9 gives the same events, the same broken bonds at the same creep times and the same
+    end (the relaxed states differ within the tolerance: strains to 1e-4 relative)."""
+    import grainfrac_yade.static.damped as damped
+    plain = _fem_creep()
+    assert plain.numerical_failure and "did not settle" in plain.failure_reason
+    runs = []
+    for tol in (1e-6, 1e-9):
+        monkeypatch.setattr(damped, "REST_TOLERANCE", tol)
+        runs.append(_fem_creep("numerics.static_relaxation=overdamped"))
+    a, b = runs
+    for run in runs:
+        assert not run.numerical_failure and run.scene.path.tally[0] >= 1
+        assert run.scene.summary_keys()["static_relaxations"] == run.scene.path.tally[0]
+    assert b.scene.path.tally[1] > a.scene.path.tally[1]        # the tighter tolerance took more steps
+    assert (a.n_events, a.failed, a.failure_reason) == (b.n_events, b.failed, b.failure_reason)
+    assert a.rows[-1]["creep_time_s"] == a.params.stress_corrosion.creep_time_limit > plain.rows[-1]["creep_time_s"]
+    assert np.array_equal(a.break_time, b.break_time, equal_nan=True)
+    sa, sb = (np.array([r["axial_strain"] for r in run.rows]) for run in runs)
+    assert np.allclose(sa, sb, rtol=1e-4, atol=0)

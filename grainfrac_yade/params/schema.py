@@ -117,6 +117,11 @@ class NumericsParams:
                         "explicit DEM with dynamic relaxation; static = static equilibrium between bond failures (grainfrac_yade.static: "
                         "no inertia, no loading rate); hybrid = static, with YADE's dynamics where the static "
                         "equilibrium gives out or a cascade grows (grainfrac_yade.hybrid)", ("yade", "static", "hybrid"))
+    static_relaxation: str = _spec("", "choice", "static and hybrid engines: what a held-load regain does where no "
+                                   "static status set settles: none = the engine gives out (static: a numerical "
+                                   "failure; hybrid: YADE's dynamics take over); overdamped = implicit overdamped "
+                                   "relaxation to rest or to the failure rule (grainfrac_yade.static.damped), and only "
+                                   "then the engine gives out", ("none", "overdamped"))
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")

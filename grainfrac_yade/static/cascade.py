@@ -221,6 +221,17 @@ class Path:
                 return state
         return state
 
+    def summary_keys(self) -> dict:
+        """What a run's summary records of the path beyond the engine's counters: nothing for the plain path."""
+        return {}
+
+    def saved_arrays(self) -> dict:
+        """Arrays a scene's save keeps of the path's own bookkeeping (none for the plain path)."""
+        return {}
+
+    def restore_arrays(self, arrays: dict) -> None:
+        """Take back what :meth:`saved_arrays` gave (nothing for the plain path)."""
+
     def hold(self, state: State, target: float, rule: FailureRule):
         """Regain the platen stress ``target`` [Pa] from ``state`` along the path: (state, failure reason or None)."""
         start, quiet = state.closure, 0

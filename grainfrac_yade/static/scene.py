@@ -49,7 +49,7 @@ from ..grains import layout_for
 from ..layout import bond_properties
 from ..vtkio import cluster_rigid_motion
 from . import contacts as cl
-from .cascade import Path
+from .damped import path_for
 from .failure import FailureRule
 from .network import build_static_network
 from .settings import summary_keys
@@ -219,7 +219,7 @@ class StaticScene:
         self.canon[self.net.order] = np.arange(m)
         self.confinement_stress = 0.0
         self.eq = Equilibrium(self.net)
-        self.path = Path(self.eq)
+        self.path = path_for(self.eq, params.numerics.static_relaxation)
         self.drivers = []
         self._dt = load_increment(params)
         self._time = 0.0
@@ -468,15 +468,17 @@ class StaticScene:
         counters = self.eq.counters
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
         self.eq.counters = counters
-        jt, jc = self.path.jt, self.path.jc
-        self.path = Path(self.eq)
+        jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
+        self.path = path_for(self.eq, self.params.numerics.static_relaxation, self.confinement_stress)
         self.path.jt, self.path.jc = jt, jc
+        self.path.restore_arrays(kept)
         self.state = self.eq.solve(self.state.closure, self.state)
 
     def summary_keys(self) -> dict:
         """What a run's summary records of the engine: its name and the dynamic-only settings it did not use (and
         what its drivers record, e.g. the Brazilian jaws' largest load on the path)."""
         keys = summary_keys(self.params)
+        keys.update(self.path.summary_keys())
         for d in self.drivers:
             if hasattr(d, "summary_keys"):
                 keys.update(d.summary_keys())
@@ -499,6 +501,7 @@ class StaticScene:
                    confinement=np.float64(self.confinement_stress), n_bonds=np.int64(self.n_bonds),
                    hold_target=np.float64(math.nan if self.hold_target is None else self.hold_target),
                    hold_failure=np.str_(self.hold_failure), hold_pending=self.hold_pending)
+        out.update(self.path.saved_arrays())
         return out
 
     def save(self, path) -> None:
@@ -526,6 +529,7 @@ class StaticScene:
         self.state = State(**values)
         self.eq.forget_factor()
         self.path.jt, self.path.jc = a["jt"].copy(), a["jc"].copy()
+        self.path.restore_arrays(a)
         self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()
         self._time = float(a["time"])
         self._steps_offset = int(a["steps"]) - self.eq.counters.equilibria

@@ -187,6 +187,9 @@ class Equilibrium:
         self.reuse_factor, self.max_low_rank_contacts = bool(reuse_factor), int(max_low_rank_contacts)
         self._pattern = TangentPattern(net) if self.reuse_factor else None
         self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
+        #: halvings of a step whose active set cycles before NumericalFailure (a caller with another way past a
+        #: status cycle, :class:`.damped.RelaxingPath`, gives up sooner)
+        self.max_split_depth = MAX_SPLIT_DEPTH
 
     def forget_factor(self):
         """Drop the kept factor (and with it the low-rank history): the next solve factorises afresh, as a new
@@ -440,7 +443,7 @@ class Equilibrium:
         try:
             return self._active_set(closure, base, None if release is None else (1.0 - lam1) * release)
         except _Cycling as exc:
-            if depth >= MAX_SPLIT_DEPTH:
+            if depth >= self.max_split_depth:
                 raise NumericalFailure(f"static equilibrium: contact statuses did not settle ({exc}) even in "
                                        f"{2 ** depth} sub-steps at closure {closure:.6g} m") from None
         self.counters.splits += 1
