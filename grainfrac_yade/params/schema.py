@@ -122,6 +122,8 @@ class NumericsParams:
                                    "failure; hybrid: YADE's dynamics take over); overdamped = implicit overdamped "
                                    "relaxation to rest or to the failure rule (grainfrac_yade.static.damped), and only "
                                    "then the engine gives out", ("none", "overdamped"))
+    static_relaxation_steps: int = _spec("1", "positive_int", "static_relaxation = overdamped: pseudo-time steps one "
+                                         "relaxation may take before the engine gives out there")
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")

@@ -219,7 +219,7 @@ class StaticScene:
         self.canon[self.net.order] = np.arange(m)
         self.confinement_stress = 0.0
         self.eq = Equilibrium(self.net)
-        self.path = path_for(self.eq, params.numerics.static_relaxation)
+        self.path = path_for(self.eq, params.numerics)
         self.drivers = []
         self._dt = load_increment(params)
         self._time = 0.0
@@ -469,7 +469,7 @@ class StaticScene:
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
-        self.path = path_for(self.eq, self.params.numerics.static_relaxation, self.confinement_stress)
+        self.path = path_for(self.eq, self.params.numerics, self.confinement_stress)
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)
         self.state = self.eq.solve(self.state.closure, self.state)
