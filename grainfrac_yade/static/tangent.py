@@ -76,6 +76,8 @@ class TangentPattern:
     #: The six (force row, kinematic row, coefficient) terms: intact bonds through G, broken contacts through C.
     TERMS = (("gn", "cn", "nn"), ("gt", "cn", "sn"), ("gt", "ct", "ss"),
              ("cn", "cn", "nn"), ("ct", "cn", "sn"), ("ct", "ct", "ss"))
+    #: The force rows of broken contacts: their terms are summed over the broken contacts' columns alone.
+    BROKEN_ROWS = ("cn", "ct")
 
     def __init__(self, net):
         self.net, n = net, net.ndof
@@ -95,20 +97,27 @@ class TangentPattern:
         off = len(kg.row)
         self.base = np.bincount(inv[:off], weights=kg.data.astype(float), minlength=self.nnz).astype(float)
         self.maps = []
-        for r, c, v, w in trip:
+        for (g, _, _), (r, c, v, w) in zip(self.TERMS, trip):
             pos = inv[off:off + len(r)]
             off += len(r)
-            self.maps.append(sp.csr_matrix((v.astype(float), (pos, w)), shape=(self.nnz, net.n_bonds)))
+            mp = sp.csr_matrix((v.astype(float), (pos, w)), shape=(self.nnz, net.n_bonds))
+            self.maps.append(mp.tocsc() if g in self.BROKEN_ROWS else mp)
         self._free_cache = {}
 
     def data(self, a_nn, a_sn, a_ss, broken):
-        """The pattern's values at these per-contact coefficients (``broken``: rows C instead of G)."""
+        """The pattern's values at these per-contact coefficients (``broken``: rows C instead of G).  Each term is
+        the map times the coefficients of the contacts it holds (intact or broken); the broken contacts' terms are
+        summed over their own columns (CSC), the same products in the same order as over all columns, less the
+        exact zeros of the intact ones."""
         intact = ~broken
+        sel = np.flatnonzero(broken)
         coef = {"nn": a_nn, "sn": a_sn, "ss": a_ss}
         d = self.base.copy()
         for (g, _, name), mp in zip(self.TERMS, self.maps):
-            w = np.where(broken, coef[name], 0.0) if g in ("cn", "ct") else np.where(intact, coef[name], 0.0)
-            d += mp @ w
+            if g in self.BROKEN_ROWS:
+                d += mp[:, sel] @ coef[name][sel]
+            else:
+                d += mp @ np.where(intact, coef[name], 0.0)
         return d
 
     def full(self, data) -> sp.csc_matrix:
