@@ -44,6 +44,10 @@ MAX_REFINEMENT = 4
 #: paper size"): 10 x 20 mm path to 0.8 % strain 18.4 / 15.8 / 16.0 CPU s at 16 / 48 / 128; paper-size creep at
 #: 160 MPa, events 1-200: 132.8 s at 48, 101.5 s at 128 (12 factorisations for 2,727 tangents).
 MAX_LOW_RANK_CONTACTS = 128
+#: Contacts changed since the last assembly up to which only the pattern's entries they touch are summed again
+#: (:meth:`TangentPattern.data`) [1]: an active-set iteration changes a few; a full assembly costs about as much as
+#: summing the entries of ~1,000 contacts again (a few tens each, against the whole pattern).
+INCREMENTAL_CONTACTS = 1000
 
 
 def _outer_triplets(g: sp.csr_matrix, c: sp.csr_matrix):
@@ -76,8 +80,6 @@ class TangentPattern:
     #: The six (force row, kinematic row, coefficient) terms: intact bonds through G, broken contacts through C.
     TERMS = (("gn", "cn", "nn"), ("gt", "cn", "sn"), ("gt", "ct", "ss"),
              ("cn", "cn", "nn"), ("ct", "cn", "sn"), ("ct", "ct", "ss"))
-    #: The force rows of broken contacts: their terms are summed over the broken contacts' columns alone.
-    BROKEN_ROWS = ("cn", "ct")
 
     def __init__(self, net):
         self.net, n = net, net.ndof
@@ -97,27 +99,48 @@ class TangentPattern:
         off = len(kg.row)
         self.base = np.bincount(inv[:off], weights=kg.data.astype(float), minlength=self.nnz).astype(float)
         self.maps = []
-        for (g, _, _), (r, c, v, w) in zip(self.TERMS, trip):
+        for r, c, v, w in trip:
             pos = inv[off:off + len(r)]
             off += len(r)
-            mp = sp.csr_matrix((v.astype(float), (pos, w)), shape=(self.nnz, net.n_bonds))
-            self.maps.append(mp.tocsc() if g in self.BROKEN_ROWS else mp)
+            self.maps.append(sp.csr_matrix((v.astype(float), (pos, w)), shape=(self.nnz, net.n_bonds)))
+        # the pattern's entries each contact touches (in any term): a contact's column of the union of the maps
+        touch = sum(abs(mp) for mp in self.maps).tocsc()
+        self._touch = (touch.indptr, touch.indices)
         self._free_cache = {}
+        self._last = None       # (coefficients, base, values) of the last assembly
 
     def data(self, a_nn, a_sn, a_ss, broken):
-        """The pattern's values at these per-contact coefficients (``broken``: rows C instead of G).  Each term is
-        the map times the coefficients of the contacts it holds (intact or broken); the broken contacts' terms are
-        summed over their own columns (CSC), the same products in the same order as over all columns, less the
-        exact zeros of the intact ones."""
+        """The pattern's values at these per-contact coefficients (``broken``: rows C instead of G).
+
+        Every entry is base + sum over the six terms of (map row . its coefficients), in that order.  Where at
+        most :data:`INCREMENTAL_CONTACTS` contacts differ from the last assembly (on the same base) only the entries
+        they touch are summed again, by the same rows in the same order: the values are those of a full
+        assembly, bit for bit."""
+        coef = (a_nn, a_sn, a_ss, broken)
+        last = self._last
+        changed = None
+        if last is not None and last[1] is self.base:
+            changed = np.flatnonzero(np.any([x != y for x, y in zip(coef, last[0])], axis=0))
+        if changed is None or len(changed) > INCREMENTAL_CONTACTS:
+            d = self._sum(None, *coef)
+        else:
+            d = last[2].copy()
+            indptr, indices = self._touch
+            rows = np.unique(np.concatenate([indices[indptr[i]:indptr[i + 1]] for i in changed] + [indices[:0]]))
+            d[rows] = self._sum(rows, *coef)
+        self._last = (tuple(np.array(x, copy=True) for x in coef), self.base, d)
+        return d
+
+    def _sum(self, rows, a_nn, a_sn, a_ss, broken):
+        """The values of the pattern's entries ``rows`` (sorted; None: all of them): base, then each term's rows
+        times its coefficients (intact bonds through G, broken contacts through C)."""
+        full = rows is None
         intact = ~broken
-        sel = np.flatnonzero(broken)
         coef = {"nn": a_nn, "sn": a_sn, "ss": a_ss}
-        d = self.base.copy()
+        d = self.base.copy() if full else self.base[rows]
         for (g, _, name), mp in zip(self.TERMS, self.maps):
-            if g in self.BROKEN_ROWS:
-                d += mp[:, sel] @ coef[name][sel]
-            else:
-                d += mp @ np.where(intact, coef[name], 0.0)
+            w = np.where(broken, coef[name], 0.0) if g in ("cn", "ct") else np.where(intact, coef[name], 0.0)
+            d += (mp if full else mp[rows]) @ w
         return d
 
     def full(self, data) -> sp.csc_matrix:
