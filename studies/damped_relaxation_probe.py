@@ -5,13 +5,22 @@
         --width 10e-3 --height 20e-3 --seed 1 --creep-stress 160e6 [--plain]
 
 ``--plain``: the plain static path (a status set that does not settle ends the hold as a numerical failure).
+
+What a change of the core must keep is in the line's hashes: ``break_sha256`` of the bonds broken, in order, with
+the count reached after each event, and ``creep_times_sha256`` of the events' creep times to full precision;
+``cpu_per_event_blocks`` is the mean CPU per event [s] over each block of :data:`CPU_BLOCK` events (the cascade and
+the regain after the law's step).
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import sys
 import time
+from dataclasses import asdict
+
+import numpy as np
 
 from grainfrac_yade.clocks import EventClock
 from grainfrac_yade.law import build_law
@@ -22,6 +31,30 @@ from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
 from .static_engine_probe import specimen_arguments, specimen_network
+
+#: Events per block of the CPU-per-event list [1].
+CPU_BLOCK = 50
+
+
+def recorded(path):
+    """(bonds broken, CPU at the end of each regain): ``path``'s breaks and regains (the ramp's first) recorded."""
+    bonds, cpu = [], []
+    breaking, holding = path.break_bond, path.hold
+
+    def break_bond(state, bond, mode):
+        bonds.append(int(bond))
+        return breaking(state, bond, mode)
+
+    def hold(state, target, rule):
+        out = holding(state, target, rule)
+        cpu.append(time.process_time())
+        return out
+    path.break_bond, path.hold = break_bond, hold
+    return bonds, cpu
+
+
+def sha256(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def main(argv=None):
@@ -46,11 +79,13 @@ def main(argv=None):
                   flush=True)
         return out
     anchored.solve = counted
+    bonds, cpu = recorded(path)
     sc = p.stress_corrosion
     clock = EventClock(sc.max_strength_loss_fraction, sc.creep_time_limit)
     res = creep_hold(eq, build_law(sc), clock, a.creep_stress, FailureRule(p.creep.collapse_strain_increment),
                      max_events=a.events, path=path)
     rel = getattr(path, "relaxations", [])
+    per = np.diff(cpu)      # the events' CPU: from the end of one regain to the end of the next
     print(json.dumps({
         "seed": a.seed, "width": a.width, "height": a.height, "dofs": net.ndof, "bonds": net.n_bonds,
         "relaxing": not a.plain, "tolerance": None if a.plain else a.tolerance, "stress_pa": a.creep_stress, "events": res.events,
@@ -62,7 +97,11 @@ def main(argv=None):
         "relaxation_failure": [r.failure for r in rel],
         "relaxation_unsettled": [r.unsettled for r in rel],
         "relaxation_closure_growth_m": [r.state.closure - r.start_closure for r in rel],
-        "equilibria": eq.counters.equilibria}))
+        "equilibria": eq.counters.equilibria,
+        "break_sha256": sha256(json.dumps([bonds, res.broken_counts])),
+        "creep_times_sha256": sha256(" ".join(repr(t) for t in res.times)),
+        "cpu_per_event_blocks": [float(np.mean(per[i:i + CPU_BLOCK])) for i in range(0, len(per), CPU_BLOCK)],
+        "counters": asdict(eq.counters)}))
 
 
 if __name__ == "__main__":

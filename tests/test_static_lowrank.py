@@ -69,3 +69,38 @@ def test_low_rank_solve_equals_a_direct_solve_of_the_changed_tangent():
         assert xr is not None
         assert np.abs(xr - x_direct).max() <= AGREEMENT * np.abs(x_direct).max()
     assert np.any(status == cl.SLIP) and np.any(status == cl.STICK)
+
+
+def test_incremental_assembly_equals_a_full_one_bit_for_bit():
+    """The tangent's values re-summed only where the contacts changed since the last assembly touch the pattern
+    equal a full assembly of the same statuses bit for bit, over a sequence of random status changes of a few
+    contacts (open, stick, slip of either sign, intact) and then of every contact."""
+    net, eq, state = _equilibrium()
+    pattern = eq._pattern
+    rng = np.random.default_rng(5)
+    status, sign, s_p = state.status.copy(), state.sign.copy(), state.s_p.copy()
+    for size in (1, 3, 7, 2, len(status)):
+        pick = rng.choice(len(status), size, replace=False)
+        status[pick] = rng.integers(cl.INTACT, cl.SLIP + 1, size)
+        sign[pick] = rng.choice([-1.0, 1.0], size)
+        coef = _coef(net, status, sign, s_p)
+        kept = pattern.data(*coef)
+        assert np.array_equal(kept.view(np.int64), pattern._sum(None, *coef).view(np.int64))
+
+
+def test_groups_of_fixed_dofs_are_the_connected_node_groups():
+    """The groups that fixed_dofs holds or pins, solved on the graph of cells, are the connected components of the
+    nodes joined by the grain stiffness and by the closed contacts (the same partition), with some contacts open."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from grainfrac_yade.static.solver import net_tri_edges
+    net, eq, state = _equilibrium()
+    rng = np.random.default_rng(7)
+    closed = rng.random(net.n_bonds) > 0.4
+    ea, eb = net_tri_edges(net)
+    a, b = np.concatenate([net.bond_nodes[closed, 0], ea]), np.concatenate([net.bond_nodes[closed, 1], eb])
+    nn = len(net.node_pos)
+    _, label = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(nn, nn)), directed=False)
+    groups = eq._groups(closed)
+    pairs = np.unique(np.stack([label, groups]), axis=1)      # one group for every component and back
+    assert len(np.unique(pairs[0])) == len(np.unique(pairs[1])) == pairs.shape[1]

@@ -119,7 +119,9 @@ class AnchoredEquilibrium(Equilibrium):
         new = alpha * (self.anchor / self.alpha)
         if self._pattern is not None:
             diag = np.flatnonzero(self._pattern.row == self._pattern.col)
-            self._pattern.base[diag] += (new - self.anchor)[self._pattern.row[diag]]
+            base = self._pattern.base.copy()        # a new array: the pattern's last assembly is keyed by it
+            base[diag] += (new - self.anchor)[self._pattern.row[diag]]
+            self._pattern.base = base
         self.alpha, self.anchor = float(alpha), new
         self.forget_factor()
 

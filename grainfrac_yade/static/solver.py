@@ -181,9 +181,14 @@ class Equilibrium:
         self.counters = Counters()
         self._ground = None
         self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
-        tri = net_tri_edges(net)
-        self._tri_edges = tri
-        self._order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
+        ea, eb = net_tri_edges(net)
+        nn = len(net.node_pos)
+        self._n_cells, self._cell_of_node = connected_components(
+            sp.coo_matrix((np.ones(len(ea)), (ea, eb)), shape=(nn, nn)), directed=False)
+        order_pin = np.lexsort((net.node_pos[:, 0], net.node_pos[:, 1]))
+        self._platen_order = order_pin[self.platen_nodes[order_pin]]
+        self._rows_kinematic = all(g is c or (g.shape == c.shape and (g != c).nnz == 0)
+                                   for g, c in ((net.gn, net.cn), (net.gt, net.ct)))
         self.reuse_factor, self.max_low_rank_contacts = bool(reuse_factor), int(max_low_rank_contacts)
         self._pattern = TangentPattern(net) if self.reuse_factor else None
         self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
@@ -210,6 +215,12 @@ class Equilibrium:
             hit = self._rows_cache[key] = self.net.force_rows(broken)
         return hit
 
+    def summed_rows(self, broken):
+        """Force rows for sums over bonds (G^T f): the network's own where its force rows equal its kinematic rows
+        in value (fem cells), as then :meth:`force_rows` differs from them only by stored zeros; else
+        :meth:`force_rows`."""
+        return (self.net.gn, self.net.gt) if self._rows_kinematic else self.force_rows(broken)
+
     def tangent(self, status, sign, s_p, ground=False):
         """Tangent stiffness (ndof x ndof) of the affine law at these statuses."""
         n = self.net
@@ -233,12 +244,7 @@ class Equilibrium:
 
     def _fixed_dofs(self, closed):
         n = self.net
-        a, b = n.bond_nodes[closed, 0], n.bond_nodes[closed, 1]
-        ea, eb = self._tri_edges
-        nn = len(n.node_pos)
-        g = sp.coo_matrix((np.ones(len(a) + len(ea)), (np.concatenate([a, ea]), np.concatenate([b, eb]))),
-                          shape=(nn, nn))
-        _, label = connected_components(g, directed=False)
+        label = self._groups(closed)
         anchored = np.zeros(label.max() + 1, bool)
         anchored[label[self.platen_nodes]] = True
         fixed = self.platen_fixed.copy()
@@ -247,14 +253,20 @@ class Equilibrium:
         held = held[held >= 0]
         fixed[held] = True
         # one lateral pin per anchored group: its lowest (then leftmost) platen node, as elastic pins the specimen
-        pins = 0
-        seen = np.zeros(label.max() + 1, bool)
-        for node in self._order_pin:
-            if self.platen_nodes[node] and not seen[label[node]]:
-                seen[label[node]] = True
-                fixed[n.dofs[node, 0]] = True
-                pins += 1
-        return fixed, int(len(held)), pins
+        _, first = np.unique(label[self._platen_order], return_index=True)
+        fixed[n.dofs[self._platen_order[first], 0]] = True
+        return fixed, int(len(held)), len(first)
+
+    def _groups(self, closed) -> np.ndarray:
+        """(nodes,) the connected group of every node: its cell's nodes (held together by the grain stiffness,
+        :func:`net_tri_edges`) joined by the ``closed`` contacts, solved on the graph of those cells."""
+        n = self.net
+        cell = self._cell_of_node
+        a, b = cell[n.bond_nodes[closed, 0]], cell[n.bond_nodes[closed, 1]]
+        nc = self._n_cells
+        g = sp.coo_matrix((np.ones(len(a)), (a, b)), shape=(nc, nc))
+        _, label = connected_components(g, directed=False)
+        return label[cell]
 
     def _factor(self, status, sign, s_p):
         key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
@@ -422,7 +434,7 @@ class Equilibrium:
     def platen_stress(self, u, fn, fs, broken, constant=True):
         """Platen stress [Pa, compression positive] of the internal forces (as ``elastic.solve_uniaxial``)."""
         n = self.net
-        gn, gt = self.force_rows(broken)
+        gn, gt = self.summed_rows(broken)
         r = n.k_grain @ u + gn.T @ fn + gt.T @ fs
         if constant:
             r = r - self.f_ext
@@ -454,15 +466,16 @@ class Equilibrium:
 
     def release_force(self, state: State, broken_now: State) -> np.ndarray:
         """(ndof,) what the bonds broken between ``state`` (intact there) and ``broken_now`` (the same displacement,
-        those bonds broken) carried beyond their broken-contact forces, as a generalised force on the nodes."""
+        those bonds broken) carried beyond their broken-contact forces, as a generalised force on the nodes.
+        Summed over those bonds' rows alone: the other rows add exact zeros."""
         n = self.net
-        new = broken_now.broken & ~state.broken
-        dn, ds = n.cn @ state.u, n.ct @ state.u
-        fn_b, fs_b = cl.forces(dn, ds, broken_now.status, broken_now.sign, broken_now.s_p, n.kn, n.ks, n.tan_residual)
-        gn, gt = self.force_rows(state.broken)
-        gnb, gtb = self.force_rows(broken_now.broken)
-        w = new.astype(float)
-        return -(gn.T @ (w * state.fn) + gt.T @ (w * state.fs) - gnb.T @ (w * fn_b) - gtb.T @ (w * fs_b))
+        new = np.flatnonzero(broken_now.broken & ~state.broken)
+        dn, ds = n.cn[new] @ state.u, n.ct[new] @ state.u
+        fn_b, fs_b = cl.forces(dn, ds, broken_now.status[new], broken_now.sign[new], broken_now.s_p[new], n.kn[new],
+                               n.ks[new], n.tan_residual[new])
+        gn, gt = (rows[new] for rows in self.summed_rows(state.broken))
+        gnb, gtb = (rows[new] for rows in self.summed_rows(broken_now.broken))
+        return -(gn.T @ state.fn[new] + gt.T @ state.fs[new] - gnb.T @ fn_b - gtb.T @ fs_b)
 
     def _converged(self, closure, base, status, sign, u, it) -> State:
         n = self.net
