@@ -107,21 +107,23 @@ class AnchoredEquilibrium(Equilibrium):
         self.anchor = self.alpha * intact_diagonal(self)
         #: where the anchor springs are anchored: the last step's displacements [m]
         self.u_ref = np.zeros(net.ndof)
-        if self._pattern is not None:       # the fast path's constant part gains the anchor on its diagonal
+        self._shift_base(self.anchor)
+
+    def _shift_base(self, delta: np.ndarray) -> None:
+        """Add ``delta`` [N/m or N m/rad] to the diagonal of the fast path's constant part, as a new array (the
+        pattern's last assembly is keyed by it)."""
+        if self._pattern is not None:
             diag = np.flatnonzero(self._pattern.row == self._pattern.col)
-            self._pattern.base = self._pattern.base.copy()
-            self._pattern.base[diag] += self.anchor[self._pattern.row[diag]]
+            base = self._pattern.base.copy()
+            base[diag] += delta[self._pattern.row[diag]]
+            self._pattern.base = base
 
     def set_alpha(self, alpha: float) -> None:
         """A new anchor ratio ``alpha`` > 0 [1]; the kept factor (and its low-rank history) is dropped."""
         if not alpha > 0:
             raise ValueError(f"alpha must be > 0 (got {alpha!r})")
         new = alpha * (self.anchor / self.alpha)
-        if self._pattern is not None:
-            diag = np.flatnonzero(self._pattern.row == self._pattern.col)
-            base = self._pattern.base.copy()        # a new array: the pattern's last assembly is keyed by it
-            base[diag] += (new - self.anchor)[self._pattern.row[diag]]
-            self._pattern.base = base
+        self._shift_base(new - self.anchor)
         self.alpha, self.anchor = float(alpha), new
         self.forget_factor()
 
