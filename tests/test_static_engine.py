@@ -293,3 +293,34 @@ def test_static_state_hands_over_to_yade(model, tol):
     intact = ~static.broken
     fs, fy = static.bond_forces()[0], yade.bond_forces()[0]
     assert np.abs(fs[intact] - fy[intact]).max() <= tol * np.abs(fs).max()
+
+
+def test_creep_resumed_through_the_command_line(capsys, tmp_path, monkeypatch):
+    """`creep --resume DIR` on a static run killed after its first checkpoint: the checkpoint's scene (the static
+    engine's npz, not a YADE gzip) passes the pre-load check (a truncated one is named in one line), and the run
+    ends with the uninterrupted run's lifetime, events, breaks and cracks."""
+    import grainfrac_yade.protocols.checkpoints as checkpoints
+    whole = _creep_cli(capsys, tmp_path / "whole")
+    write = checkpoints.Checkpointer.write
+
+    def killed(self, *args, **kwargs):
+        write(self, *args, **kwargs)
+        raise KeyboardInterrupt
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", killed)
+    rc, _ = _cli(capsys, "creep", *CREEP_ROW, "--out", str(tmp_path / "cut"))
+    assert rc == 130                # the command's own report of an interrupt
+    monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
+    assert not (tmp_path / "cut" / "summary.json").exists()
+    import shutil
+    shutil.copytree(tmp_path / "cut", tmp_path / "broken")
+    scene = tmp_path / "broken" / "checkpoint" / "scene.yade.gz"
+    scene.write_bytes(scene.read_bytes()[:200])           # a truncated npz: one line, nothing written
+    rc, out = _cli(capsys, "creep", "--resume", str(tmp_path / "broken"))
+    assert rc == 2 and out.err.count("\n") == 1 and "static scene is unreadable" in out.err and "fix:" in out.err
+    assert not (tmp_path / "broken" / "summary.json").exists()
+    rc, out = _cli(capsys, "creep", "--resume", str(tmp_path / "cut"))
+    assert rc == 0, out.err
+    resumed = json.loads((tmp_path / "cut" / "summary.json").read_text())
+    for k in ("lifetime_s", "n_events", "failed", "broken_total", "failure_reason"):
+        assert resumed[k] == whole[k], k
+    assert (tmp_path / "cut" / "cracks.csv").read_bytes() == (tmp_path / "whole" / "cracks.csv").read_bytes()

@@ -53,6 +53,8 @@ CHECKPOINT_TMP, CHECKPOINT_OLD = CHECKPOINT + ".tmp", CHECKPOINT + ".old"
 SCENE_FILE = "scene.yade.gz"
 #: Per-bond arrays of the driver.
 ARRAYS_FILE = "arrays.npz"
+#: The first bytes of a zip archive (numpy's npz: the static engines' saved scene in SCENE_FILE).
+ZIP_MAGIC = b"PK\x03\x04"
 
 
 @functools.lru_cache(maxsize=None)
@@ -330,7 +332,8 @@ def run_digest(params, run_values: dict) -> str:
 
 def check_files(where) -> None:
     """GrainfracError (one line naming the file) if checkpoint folder ``where`` has a state file that is not JSON,
-    an arrays file that numpy cannot read whole, or a scene that is not a complete gzip stream (truncated): checked
+    an arrays file that numpy cannot read whole, or a scene that is neither a complete gzip stream (YADE's) nor an npz
+    numpy can read whole (the static engines'): checked
     before YADE is loaded and before anything is written.  Reads every file once (the scene's gzip stream to its
     end: about a second per 100 MB)."""
     where = Path(where)
@@ -350,10 +353,25 @@ def check_files(where) -> None:
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise GrainfracError(f"{where / ARRAYS_FILE}: the checkpoint's arrays are unreadable "
                              f"(truncated or not numpy's npz; {type(exc).__name__}: {exc}); {fix}") from None
+    scene = where / SCENE_FILE
     try:
-        with gzip.open(where / SCENE_FILE, "rb") as fh:
+        with open(scene, "rb") as fh:
+            npz = fh.read(len(ZIP_MAGIC)) == ZIP_MAGIC
+    except OSError:
+        npz = False         # a missing or unreadable file: the check below names it
+    if npz:                 # a static engine's scene: numpy's npz (zip), read whole as the arrays are
+        try:
+            with np.load(scene) as data:
+                for k in data.files:
+                    data[k]
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+            raise GrainfracError(f"{scene}: the checkpoint's static scene is unreadable (truncated npz; "
+                                 f"{type(exc).__name__}: {exc}); {fix}") from None
+        return
+    try:
+        with gzip.open(scene, "rb") as fh:
             while fh.read(1 << 24):
                 pass
     except (OSError, EOFError, zlib.error) as exc:
-        raise GrainfracError(f"{where / SCENE_FILE}: the checkpoint's scene is unreadable (truncated "
+        raise GrainfracError(f"{scene}: the checkpoint's scene is unreadable (truncated "
                              f"gzip or not a YADE scene; {type(exc).__name__}: {exc}); {fix}") from None
