@@ -23,10 +23,11 @@ anchored path (bonds broken one at a time as in :mod:`.cascade`, the platen stre
 after a step whose statuses settle the anchor is halved (the steps grow towards the plain static solve, alpha -> 0),
 after one whose statuses do not settle it is stiffened four-fold and the step taken again.  It ends
 
-* **at equilibrium**: the creep protocol's own criterion of a relaxed held load (the YADE engine's too,
+* **at rest**: the creep protocol's measure of a relaxed held load (the YADE engine's too,
   :func:`grainfrac_yade.protocols.loading.relaxed`): the mean unbalanced force on the free nodes over the mean
-  intact bond force below ``creep.equilibrium_tolerance``.  The state is that anchored step's: its unbalanced
-  force is what the criterion measured, its statuses consistent; the static path goes on from it;
+  intact bond force, below :data:`REST_TOLERANCE` (1e-6; YADE's ``creep.equilibrium_tolerance`` of 1e-3 calls a
+  sliding mechanism at rest).  The state is that anchored step's: its unbalanced force is what the measure read,
+  its statuses consistent; the static path goes on from it;
 * **failing**: the failure rule of :mod:`.failure` measured from where the regain began (collapse: the closure grew
   by more than ``creep.collapse_strain_increment`` of the height while the load was regained); or
 * after ``max_steps`` steps, or with the anchor stiffened beyond :data:`MAX_ANCHOR_RATIO`, without either:
@@ -107,29 +108,21 @@ class AnchoredEquilibrium(Equilibrium):
         self.anchor = self.alpha * intact_diagonal(self)
         #: where the anchor springs are anchored: the last step's displacements [m]
         self.u_ref = np.zeros(net.ndof)
-        self._shift_base(self.anchor)
-
-    def _shift_base(self, delta: np.ndarray) -> None:
-        """Add ``delta`` [N/m or N m/rad] to the diagonal of the fast path's constant part, as a new array (the
-        pattern's last assembly is keyed by it)."""
-        if self._pattern is not None:
-            diag = np.flatnonzero(self._pattern.row == self._pattern.col)
-            base = self._pattern.base.copy()
-            base[diag] += delta[self._pattern.row[diag]]
-            self._pattern.base = base
+        if self._pattern is not None:       # the fast path's constant part gains the anchor on its diagonal
+            self._pattern.shift_diagonal(self.anchor)
 
     def set_alpha(self, alpha: float) -> None:
         """A new anchor ratio ``alpha`` > 0 [1]; the kept factor (and its low-rank history) is dropped."""
         if not alpha > 0:
             raise ValueError(f"alpha must be > 0 (got {alpha!r})")
         new = alpha * (self.anchor / self.alpha)
-        self._shift_base(new - self.anchor)
+        if self._pattern is not None:
+            self._pattern.shift_diagonal(new - self.anchor)
         self.alpha, self.anchor = float(alpha), new
         self.forget_factor()
 
     def tangent(self, status, sign, s_p, ground=False):
         return (super().tangent(status, sign, s_p, ground) + sp.diags(self.anchor)).tocsc()
-
 
     def displacements(self, closure, status, sign, s_p, held_u, extra=None):
         pull = self.anchor * self.u_ref

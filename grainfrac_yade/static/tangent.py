@@ -108,28 +108,37 @@ class TangentPattern:
         touch = sum(abs(mp) for mp in self.maps).tocsc()
         self._touch = (touch.indptr, touch.indices)
         self._free_cache = {}
-        self._last = None       # (coefficients, base, values) of the last assembly
+        self._last = None       # (coefficients, values) of the last assembly
+
+    def shift_diagonal(self, delta: np.ndarray) -> None:
+        """Add ``delta`` (ndof,) to the diagonal of the constant part (every later assembly's values); the last
+        assembly, which :meth:`data` would otherwise update from, is forgotten."""
+        diag = np.flatnonzero(self.row == self.col)
+        self.base = self.base.copy()
+        self.base[diag] += delta[self.row[diag]]
+        self._last = None
 
     def data(self, a_nn, a_sn, a_ss, broken):
         """The pattern's values at these per-contact coefficients (``broken``: rows C instead of G).
 
         Every entry is base + sum over the six terms of (map row . its coefficients), in that order.  Where at
-        most :data:`INCREMENTAL_CONTACTS` contacts differ from the last assembly (on the same base) only the entries
+        most :data:`INCREMENTAL_CONTACTS` contacts differ from the last assembly (the base changes only through
+        :meth:`shift_diagonal`, which forgets it) only the entries
         they touch are summed again, by the same rows in the same order: the values are those of a full
         assembly, bit for bit."""
         coef = (a_nn, a_sn, a_ss, broken)
         last = self._last
         changed = None
-        if last is not None and last[1] is self.base:
+        if last is not None:
             changed = np.flatnonzero(np.any([x != y for x, y in zip(coef, last[0])], axis=0))
         if changed is None or len(changed) > INCREMENTAL_CONTACTS:
             d = self._sum(None, *coef)
         else:
-            d = last[2].copy()
+            d = last[1].copy()
             indptr, indices = self._touch
             rows = np.unique(np.concatenate([indices[indptr[i]:indptr[i + 1]] for i in changed] + [indices[:0]]))
             d[rows] = self._sum(rows, *coef)
-        self._last = (tuple(np.array(x, copy=True) for x in coef), self.base, d)
+        self._last = (tuple(np.array(x, copy=True) for x in coef), d)
         return d
 
     def _sum(self, rows, a_nn, a_sn, a_ss, broken):
