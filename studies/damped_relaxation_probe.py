@@ -26,7 +26,7 @@ from grainfrac_yade.clocks import EventClock
 from grainfrac_yade.law import build_law
 from grainfrac_yade.static.cascade import Path
 from grainfrac_yade.static.creep import creep_hold
-from grainfrac_yade.static.damped import REST_TOLERANCE, AnchoredEquilibrium, RelaxingPath
+from grainfrac_yade.static.damped import MAX_RELAXATION_STEPS, REST_TOLERANCE, AnchoredEquilibrium, RelaxingPath
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
@@ -59,7 +59,7 @@ def sha256(text: str) -> str:
 
 def main(argv=None):
     ap = specimen_arguments(argparse.ArgumentParser())
-    ap.add_argument("--max-steps", type=int, default=200, help="pseudo-time steps of one relaxation")
+    ap.add_argument("--max-steps", type=int, default=MAX_RELAXATION_STEPS, help="pseudo-time steps of one relaxation")
     ap.add_argument("--tolerance", type=float, default=REST_TOLERANCE, help="relative unbalanced force at rest")
     ap.add_argument("--events", type=int, default=10**6)
     ap.add_argument("--plain", action="store_true", help="the plain static path, no relaxation")
