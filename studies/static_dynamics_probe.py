@@ -35,6 +35,8 @@ from grainfrac_yade.static.ucs import ucs_path
 
 #: Fraction of the critical step (Gershgorin bound on M^-1 K) [1].
 STEP_SAFETY = 0.8
+#: Steps between equilibrium checks [1] (creep.check_period).
+CHECK_PERIOD = 50
 
 
 def node_masses(enet, s, p, ndof, dofs):
@@ -111,9 +113,13 @@ class DynamicStint:
             v += self.dt * fd * inv_m
             u += self.dt * v
             steps += 1
-            if steps >= self.min_steps and steps % 20 == 0:
-                unb = np.abs(f[free]).mean()
-                ref = np.abs(fn[~broken]).mean() if (~broken).any() else 1.0
+            if steps >= self.min_steps and steps % CHECK_PERIOD == 0:
+                # the creep protocol's check: mean resultant force on the free nodes over the mean intact bond force
+                fx = np.where(n.dofs[:, 0] >= 0, f[n.dofs[:, 0]], 0.0)
+                fy = np.where(n.dofs[:, 1] >= 0, f[n.dofs[:, 1]], 0.0)
+                moving = ~(n.top | n.bottom)
+                unb = np.hypot(fx, fy)[moving].mean()
+                ref = np.hypot(fn, fs)[~broken].mean() if (~broken).any() else 1.0
                 if unb < self.rest * ref:
                     break
         status = np.where(broken, np.where(dn > 0, cl.OPEN, np.where(np.abs(trial) > cap, cl.SLIP, cl.STICK)),

@@ -29,7 +29,7 @@ def test_hybrid_engine_module():
     assert "hybrid" in ENGINE_NAMES and tuple(choices) == ENGINE_NAMES
     module = engine("hybrid")
     assert module.NAME == "hybrid" and module.DYNAMIC is False
-    assert "brazilian" in module.UNSUPPORTED and module.warn_dynamic_only(["numerics.damping=0.7"]) == []
+    assert "brazilian" in module.UNSUPPORTED and module.warn_dynamic_only(["numerics.damping=0.7"], None) == []
 
 
 def test_without_a_stint_the_hybrid_path_is_the_static_one():

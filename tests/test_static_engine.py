@@ -247,8 +247,13 @@ def test_creep_killed_and_resumed_gives_the_uninterrupted_run(tmp_path, monkeypa
 
 def test_dynamic_only_setting_warns_once():
     from grainfrac_yade.static.engine import warn_dynamic_only
-    lines = warn_dynamic_only(["numerics.damping=0.5", "specimen.width=3e-3", ("creep.servo_response_steps", 5)])
-    assert len(lines) == 2 and all("\n" not in s and s.startswith("warning:") for s in lines)
+    given = ["numerics.damping=0.5", "specimen.width=3e-3", ("creep.servo_response_steps", 5),
+             "numerics.verlet_fraction=0.2"]
+    lines = warn_dynamic_only(given, _params())
+    assert len(lines) == 3 and all("\n" not in s and s.startswith("warning:") for s in lines)
+    # the inertial relaxation reads damping and the servo: only the collider's setting is left unused
+    lines = warn_dynamic_only(given, _params("numerics.static_relaxation=inertial"))
+    assert len(lines) == 1 and "numerics.verlet_fraction" in lines[0]
 
 
 def test_engine_flag_is_the_parameter():

@@ -82,5 +82,5 @@ def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
         raise GrainfracError(refusal)
     if vtk and module.VTK_REFUSED:
         raise GrainfracError(module.VTK_REFUSED)
-    for line in module.warn_dynamic_only([o for o in overrides if override_origin(o) == "--set"]):
+    for line in module.warn_dynamic_only([o for o in overrides if override_origin(o) == "--set"], params):
         print(line, file=sys.stderr)

@@ -30,6 +30,6 @@ def version() -> str:
     return static_version()
 
 
-def warn_dynamic_only(overrides) -> list:
+def warn_dynamic_only(overrides, params) -> list:
     """None: the dynamic stints read every dynamic setting."""
     return []

@@ -121,7 +121,10 @@ class NumericsParams:
                                    "static status set settles: none = the engine gives out (static: a numerical "
                                    "failure; hybrid: YADE's dynamics take over); overdamped = implicit overdamped "
                                    "relaxation to rest or to the failure rule (grainfrac_yade.static.damped), and only "
-                                   "then the engine gives out", ("none", "overdamped"))
+                                   "then the engine gives out; inertial = explicit dynamics of the same network (masses "
+                                   "of the grain model with numerics.density_scale, numerics.damping, the creep "
+                                   "protocol's servo, equilibrium and collapse criteria and relaxation budget; "
+                                   "grainfrac_yade.static.inertial)", ("none", "overdamped", "inertial"))
     static_relaxation_steps: int = _spec("1", "positive_int", "static_relaxation = overdamped: pseudo-time steps one "
                                          "relaxation may take before the engine gives out there")
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "

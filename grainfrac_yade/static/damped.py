@@ -34,7 +34,8 @@ after one whose statuses do not settle it is stiffened four-fold and the step ta
   :class:`~grainfrac_yade.errors.NumericalFailure` (a solver that gives out is never a failure of the specimen).
 
 :class:`RelaxingPath` is the static path whose held-load regains relax so where the plain ones give out
-(``numerics.static_relaxation = "overdamped"``, docs/studies/static_engine.md, "Overdamped relaxation").
+(``numerics.static_relaxation = "overdamped"``, :mod:`.paths`; docs/studies/static_engine.md, "Overdamped
+relaxation").
 """
 from __future__ import annotations
 
@@ -254,26 +255,14 @@ class RelaxingPath(Path):
                     return super().hold(state, target, rule)
                 except NumericalFailure:
                     start = self.last_converged
-            out = relax_held(self, self.anchored, start, target, rule, self.tolerance, begin, self.max_steps)
+            out = self._relax(start, target, rule, begin)
         finally:
             self._in_hold = False
         self.relaxations.append(out)
         self.tally += (1, out.steps, out.unsettled, out.broken)
         return out.state, out.failure
 
-
-#: The static path of each value of ``numerics.static_relaxation``: (equilibrium, numerics, lateral traction [Pa]) ->
-#: path.
-PATHS = {
-    "none": lambda eq, numerics, confinement: Path(eq),
-    "overdamped": lambda eq, numerics, confinement: RelaxingPath(
-        eq, AnchoredEquilibrium(eq.net, confinement=confinement), REST_TOLERANCE,
-        max_steps=numerics.static_relaxation_steps),
-}
-
-
-def path_for(eq: Equilibrium, numerics, confinement: float = 0.0) -> Path:
-    """The static path on ``eq`` for the parameters' ``numerics`` (``static_relaxation`` picks it from :data:`PATHS`,
-    ``static_relaxation_steps`` is a relaxation's budget) under the lateral traction ``confinement`` [Pa] (the
-    anchored equilibrium of a relaxation carries the same dead load)."""
-    return PATHS[numerics.static_relaxation](eq, numerics, confinement)
+    def _relax(self, start: State, target: float, rule: FailureRule, begin: float) -> Relaxation:
+        """One relaxation of the converged state ``start`` under the held stress ``target`` [Pa], the regain having
+        begun at closure ``begin`` [m] (the collapse rule's origin): :func:`relax_held`."""
+        return relax_held(self, self.anchored, start, target, rule, self.tolerance, begin, self.max_steps)

@@ -49,7 +49,8 @@ from ..grains import layout_for
 from ..layout import bond_properties
 from ..vtkio import cluster_rigid_motion
 from . import contacts as cl
-from .damped import path_for
+from .inertial import dof_masses
+from .paths import path_for
 from .failure import FailureRule
 from .network import build_static_network
 from .settings import summary_keys
@@ -219,7 +220,7 @@ class StaticScene:
         self.canon[self.net.order] = np.arange(m)
         self.confinement_stress = 0.0
         self.eq = Equilibrium(self.net)
-        self.path = path_for(self.eq, params.numerics)
+        self.path = path_for(self.eq, params, 0.0, self.masses)
         self.drivers = []
         self._dt = load_increment(params)
         self._time = 0.0
@@ -469,7 +470,7 @@ class StaticScene:
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
-        self.path = path_for(self.eq, self.params.numerics, self.confinement_stress)
+        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses)
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)
         self.state = self.eq.solve(self.state.closure, self.state)
@@ -576,6 +577,11 @@ class StaticScene:
         if lay.model in BONDS_ON_FACES:
             return np.abs((d * normal).sum(1))
         return lay.sphere_radius[a] + lay.sphere_radius[b] - np.linalg.norm(d, axis=1)
+
+    def masses(self):
+        """(ndof,) masses and inertias of the network's dofs (:func:`.inertial.dof_masses`), for a path that moves
+        with inertia."""
+        return dof_masses(self.specimen, self.params, self.layout, self.net)
 
     def export_state(self, platens=None) -> SceneState:
         """The scene's state, engine-neutral; static extras: ``bond_slip`` holds each contact's shear reference s_p

@@ -1,0 +1,266 @@
+"""Explicit dynamic relaxation of the static network where the static statuses do not settle (pure numpy).
+
+Where a held-load regain gives out (no set of frictional contact statuses settles, :mod:`.solver`), the specimen
+is relaxed with inertia instead, as YADE would relax it, but on the static engine's own network: the same nodes,
+constant-strain triangles, bonds, rows and contact law, small strain, in numpy.  Central differences on
+
+    M a = f_ext - f_int(u, history),     f damped by Cundall's non-viscous rule f_i (1 - D sign(f_i v_i)),
+
+M lumped (each body's mass and, for rigid cells, its inertia about its node: the grain model's
+``masses_and_step``, with ``numerics.density_scale``), the step ``numerics.timestep_safety`` x 2 / omega_max
+(omega_max^2 bounded by the largest row sum of M^-1 |K| of the intact tangent, Gershgorin).  Every step evaluates
+the contact law of :mod:`.contacts` at the current displacements: intact bonds linear, broken at paper Eq. 4-5 as
+soon as they reach it (JCFpm's broken state, :func:`.contacts.break_state`); broken contacts compression only,
+with the residual friction by the return mapping from the last step (:func:`.contacts.trial_status`).
+
+The platens hold the target stress through the creep protocol's servo (closing speed (target - stress) x H /
+(E x ``creep.servo_response_steps`` x dt), within ``creep.servo_max_strain_rate`` x H), and the protocol's own
+criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_yade.protocols.loading.relaxed`):
+
+* **at rest**: mean resultant force on the nodes the platens do not drive over the mean intact bond force below
+  ``creep.equilibrium_tolerance``, the held stress within ``creep.stress_tolerance``.  The static equilibrium is
+  then solved at the closure reached, from the relaxed broken set and statuses, and the static regain goes on
+  from there; where that gives out too, the dynamics go on, and the next such take-back waits 2^k checks after
+  the k-th that gave out (each costs a static solve that gives out: 1.3 CPU s on 10 x 20 mm fem cells, where the
+  dynamics cost 0.3 ms per step);
+* **collapse**: the servo saturated closing while the axial strain grows by ``creep.collapse_strain_increment``
+  with the stress below ``creep.collapse_stress_ratio`` x the target
+  (:class:`grainfrac_yade.protocols.creep_loops.CollapseWatch`);
+* **no equilibrium within the budget** (``creep.max_relaxation_steps`` / ``_crossings``): the held load is lost,
+  the creep protocol's rule for a platen that cannot hold it.
+
+Inertia is thus simulated only where the static path cannot go on, and a run stays bit-for-bit repeatable (numpy
+in a fixed order, no YADE).  ``numerics.static_relaxation = "inertial"`` (:data:`.damped.PATHS`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import NumericalFailure
+from ..grains import model_of
+from ..layout import bond_properties
+from ..protocols.creep_loops import CollapseWatch, collapsing
+from ..wave import hold_budget, scene_density
+from . import contacts as cl
+from .cascade import Path
+from .damped import Relaxation, RelaxingPath
+from .failure import COLLAPSE, FailureRule
+from .solver import Equilibrium, State
+
+#: Why an inertial relaxation ended in a failure (the creep protocol's words for a load the platens cannot hold).
+LOST_LOAD = "no equilibrium at the held load within the relaxation budget"
+#: Smallest axial strain taken for the secant modulus that sets the servo's gain and the wave-crossing budget [1]
+#: (the creep protocol's floor).
+STRAIN_FLOOR = 1e-6
+
+
+def dof_masses(specimen, params, layout, net) -> np.ndarray:
+    """(ndof,) the mass on each translation dof and the inertia on each rotation dof of the static network
+    ``net`` [kg, kg m^2]: the grain model's bodies (``masses_and_step``: density x ``numerics.density_scale``,
+    the step floor if set), rigid cells' inertia about their network node."""
+    props = bond_properties(specimen, layout, params)
+    body_pos = np.column_stack([net.node_pos, np.full(len(net.node_pos), 0.5 * specimen.thickness)])
+    mass, inertia, _ = model_of(layout).masses_and_step(specimen, params, layout, props, body_pos)
+    inertia = np.asarray(inertia, float)
+    inertia = inertia[:, 2] if inertia.ndim == 2 else inertia
+    m = np.zeros(net.ndof)
+    for col, value in ((0, mass), (1, mass), (2, inertia)):
+        ok = net.dofs[:, col] >= 0
+        m[net.dofs[ok, col]] = np.asarray(value, float)[ok]
+    if np.any(m <= 0) or not np.all(np.isfinite(m)):
+        raise ValueError("inertial relaxation: every dof needs a positive, finite mass")
+    return m
+
+
+def critical_step(eq: Equilibrium, masses: np.ndarray) -> float:
+    """2 / omega_max [s] of the intact network, omega_max^2 bounded by the largest row sum of M^-1 |K| (Gershgorin)."""
+    m = eq.net.n_bonds
+    k = Equilibrium.tangent(eq, np.full(m, cl.INTACT), np.ones(m), np.zeros(m))
+    rows = np.asarray(abs(k).sum(axis=1)).ravel()
+    return 2.0 / math.sqrt(float((rows / masses).max()))
+
+
+def damped_step(u: np.ndarray, v: np.ndarray, f: np.ndarray, inv_m: np.ndarray, dt: float, damping: float) -> None:
+    """One central-difference step in place: Cundall's non-viscous damping f_i (1 - D sign(f_i v_i)) on the
+    unbalanced force ``f`` [N] (``f`` is overwritten), then v += dt f / m, u += dt v (``inv_m`` 1/m, 0 on driven
+    dofs).  Released from rest at u_0 against a spring, a dof swings past its equilibrium to
+    -u_0 sqrt((1 - D) / (1 + D)) (work (1 - D) k u_0^2 / 2 gained on the way in, (1 + D) k u_1^2 / 2 lost on the
+    way out)."""
+    f *= 1.0 - damping * np.sign(f * v)
+    v += dt * f * inv_m
+    u += dt * v
+
+
+class HeldServo:
+    """The creep protocol's stress servo on the static network's platen closure (module doc): the attributes
+    :func:`grainfrac_yade.protocols.creep_loops.collapsing` reads (``stress``, ``target``,
+    ``closing_clipped_steps``)."""
+
+    def __init__(self, target: float, gain: float, max_speed: float):
+        self.target, self.gain, self.max_speed = float(target), float(gain), float(max_speed)
+        self.stress, self.clipped, self.closing_clipped_steps = 0.0, 0, 0
+
+    def speed(self, stress: float, dt: float) -> float:
+        """The closing speed [m/s] for the measured ``stress`` [Pa] (and the clip bookkeeping)."""
+        self.stress = stress
+        v = (self.target - stress) * self.gain / dt
+        self.clipped = 1 if v > self.max_speed else (-1 if v < -self.max_speed else 0)
+        self.closing_clipped_steps = self.closing_clipped_steps + 1 if self.clipped == 1 else 0
+        return min(max(v, -self.max_speed), self.max_speed)
+
+
+class InertialRelaxation:
+    """Explicit dynamics of one static network under a held platen stress (module doc).  ``masses``: (ndof,)
+    [kg, kg m^2]; ``params``: the run's parameters (numerics and creep)."""
+
+    def __init__(self, eq: Equilibrium, masses: np.ndarray, params):
+        self.eq, self.net, self.params = eq, eq.net, params
+        self.masses = np.asarray(masses, float)
+        self.dt = params.numerics.timestep_safety * critical_step(eq, self.masses)
+        cp = params.creep
+        self.damping = cp.relaxation_damping if cp.relaxation_damping > 0 else params.numerics.damping
+        self.density = scene_density(params)
+        n = self.net
+        self._moving = np.stack([n.dofs[~(n.top | n.bottom), k] for k in range(2)], axis=1)
+        self._bottom_y, self._top_y = n.dofs[n.bottom, 1], n.dofs[n.top, 1]
+        self._intact_modulus = None
+
+    def platen_stress(self, r: np.ndarray) -> float:
+        """Platen stress [Pa, compression positive] of the internal force ``r`` less the dead load (as
+        :meth:`.solver.Equilibrium.platen_stress`)."""
+        n = self.net
+        r = r - self.eq.f_ext
+        return 0.5 * (r[self._bottom_y].sum() - r[self._top_y].sum()) / (n.width * n.thickness)
+
+    def relax(self, state: State, target: float, jt: np.ndarray, jc: np.ndarray, start_closure: float,
+              take_back=None):
+        """Relax ``state`` (a converged static state) under the held stress ``target`` [Pa] with the current
+        strengths ``jt``, ``jc`` [Pa], the regain having begun at closure ``start_closure`` [m].
+        ``take_back(state) -> (state, failure reason or None) | None``: the static regain from a relaxed dynamic
+        state (None where it gives out: the dynamics go on).  Returns (state, failure reason or None, steps,
+        take-backs that gave out, bonds broken)."""
+        net, eq, cp = self.net, self.eq, self.params.creep
+        young = max(state.stress, 0.0) / max(state.closure / net.height, STRAIN_FLOOR)
+        young = young if young > 0 else self.intact_modulus()
+        budget = hold_budget(cp, net.height, young, self.density, self.dt)
+        servo = HeldServo(target, net.height / (young * budget.servo_response_steps),
+                          cp.servo_max_strain_rate * net.height)
+        watch = CollapseWatch(cp.collapse_strain_increment, state.closure / net.height) \
+            if cp.collapse_strain_increment > 0 else None
+        u, v = state.u.copy(), np.zeros(net.ndof)
+        closure = state.closure
+        broken, status, sign, s_p = state.broken.copy(), state.status.copy(), state.sign.copy(), state.s_p.copy()
+        mode = state.break_mode.copy()
+        broken0 = int(broken.sum())
+        e = eq.e
+        plat = eq.platen_fixed
+        inv_m = np.where(plat, 0.0, 1.0 / self.masses)
+        rows = self._rows(broken)
+        gave_out = 0
+        steps = 0
+        next_take_back = 0      # after a take-back that gave out, the next waits 2, 4, 8, ... checks
+        dt, damping = self.dt, self.damping
+        while steps < budget.max_relaxation_steps:
+            u[plat] = closure * e[plat]
+            dn, ds = net.cn @ u, net.ct @ u
+            status, sign = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual, status, sign)[:2]
+            fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)
+            hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
+            if hit.any():
+                idx = np.flatnonzero(hit)
+                _, md = cl.overstress(fn[idx], fs[idx], net.area[idx], jt[idx], jc[idx], net.tan_friction[idx])
+                st, sg, sp = cl.break_state(dn[idx], ds[idx], fs[idx], net.kn[idx], net.ks[idx],
+                                            net.tan_residual[idx])
+                broken[idx], status[idx], sign[idx], s_p[idx], mode[idx] = True, st, sg, sp, md
+                fn[idx], fs[idx] = cl.forces(dn[idx], ds[idx], st, sg, sp, net.kn[idx], net.ks[idx],
+                                             net.tan_residual[idx])
+                rows = self._rows(broken)
+            s_p = np.where(broken, cl.converged_slip(ds, status, fs, net.ks), s_p)
+            r = net.k_grain @ u + rows[0] @ fn + rows[1] @ fs
+            stress = self.platen_stress(r)
+            f = eq.f_ext - r
+            damped_step(u, v, f, inv_m, dt, damping)
+            closure += dt * servo.speed(stress, dt)
+            steps += 1
+            if steps % cp.check_period:
+                continue
+            strain = closure / net.height
+            if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
+                                                  strain):
+                return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), COLLAPSE, \
+                    steps, gave_out, int(broken.sum()) - broken0
+            if steps < next_take_back:
+                continue
+            if self._at_rest(f, fn, fs, broken) and abs(stress - target) < cp.stress_tolerance * target:
+                relaxed = self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
+                back = take_back(relaxed) if take_back is not None else (relaxed, None)
+                if back is not None:
+                    return back[0], back[1], steps, gave_out, int(back[0].broken.sum()) - broken0
+                gave_out += 1
+                next_take_back = steps + cp.check_period * 2 ** gave_out
+        return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), LOST_LOAD, steps, \
+            gave_out, int(broken.sum()) - broken0
+
+    def intact_modulus(self) -> float:
+        """The intact specimen's axial modulus dS/d(strain) [Pa] (the servo's gain and the wave-crossing budget where
+        the held state carries no stress to take a secant from)."""
+        if self._intact_modulus is None:
+            fresh = Equilibrium(self.net, reuse_factor=False)     # the path's kept factor stays as it is
+            self._intact_modulus = float(fresh.response(fresh.initial(0.0))[3] * self.net.height)
+        return self._intact_modulus
+
+    # ------------------------------------------------------------------ helpers
+    def _rows(self, broken):
+        gn, gt = self.eq.force_rows(broken)
+        return gn.T.tocsr(), gt.T.tocsr()
+
+    def _at_rest(self, f, fn, fs, broken) -> bool:
+        """The creep protocol's measure (:func:`grainfrac_yade.protocols.loading.relaxed`) below its tolerance."""
+        mv = self._moving
+        force = np.hypot(*(np.where(mv[:, k] >= 0, f[np.maximum(mv[:, k], 0)], 0.0) for k in range(2)))
+        intact = ~broken
+        if not intact.any():
+            return False
+        ref = float(np.hypot(fn[intact], fs[intact]).mean())
+        return ref > 0 and float(force.mean()) < self.params.creep.equilibrium_tolerance * ref
+
+    def _state(self, closure, u, broken, status, sign, s_p, fn, fs, stress, mode) -> State:
+        if not (np.all(np.isfinite(u)) and math.isfinite(stress)):
+            raise NumericalFailure("inertial relaxation: the motion became NaN or infinite (a step beyond the "
+                                   "critical one?)")
+        return State(float(closure), u.copy(), broken.copy(), status.copy(), sign.copy(), s_p.copy(), fn.copy(),
+                     fs.copy(), float(stress), mode.copy())
+
+
+class InertialPath(RelaxingPath):
+    """The static path whose held-load regain relaxes by :class:`InertialRelaxation` where the plain static solve
+    gives out (``numerics.static_relaxation = "inertial"``); a relaxed state goes back to the static path by the
+    static equilibrium at its closure and the plain regain (:meth:`take_back`).  Relaxations are tallied as the
+    overdamped ones (their steps are DEM steps; "unsettled": take-backs that gave out)."""
+
+    def __init__(self, eq: Equilibrium, dynamics: InertialRelaxation, bracket_tol=None):
+        super().__init__(eq, None, bracket_tol=bracket_tol)
+        self.dynamics = dynamics
+
+    def take_back(self, relaxed: State, target: float, rule: FailureRule, begin: float):
+        """(state, failure reason or None) of the plain static regain from the relaxed dynamic state; None where
+        the static statuses do not settle there."""
+        try:
+            state = self.eq.solve(relaxed.closure, relaxed)
+            state, reason = Path.hold(self, Path.cascade(self, state), target, rule)
+        except NumericalFailure:
+            return None
+        if reason is None and rule.collapsed(begin, state.closure, self.net.height):
+            reason = COLLAPSE
+        return state, reason
+
+    def _relax(self, start: State, target: float, rule: FailureRule, begin: float) -> Relaxation:
+        state, reason, steps, gave_out, broken = self.dynamics.relax(
+            start, target, self.jt, self.jc, begin, lambda s: self.take_back(s, target, rule, begin))
+        out = Relaxation(state, reason, begin, steps, gave_out, broken)
+        return out
+
+
+__all__ = ["InertialPath", "InertialRelaxation", "HeldServo", "damped_step", "dof_masses", "critical_step", "LOST_LOAD"]

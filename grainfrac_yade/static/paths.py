@@ -1,0 +1,31 @@
+"""The static path of each ``numerics.static_relaxation``: what a held-load regain does where the static statuses do
+not settle (one registry, read once by the static scene).
+
+* ``"none"``: nothing; the engine gives out there (:class:`.cascade.Path`);
+* ``"overdamped"``: implicit overdamped relaxation to rest or to the failure rule (:mod:`.damped`);
+* ``"inertial"``: explicit dynamics of the same network under the creep protocol's servo and criteria
+  (:mod:`.inertial`).
+"""
+from __future__ import annotations
+
+from .cascade import Path
+from . import damped
+from .inertial import InertialPath, InertialRelaxation
+from .solver import Equilibrium
+
+#: (equilibrium, parameters, lateral traction [Pa], masses: () -> (ndof,) array) -> path, per value of
+#: ``numerics.static_relaxation``.
+PATHS = {
+    "none": lambda eq, params, confinement, masses: Path(eq),
+    "overdamped": lambda eq, params, confinement, masses: damped.RelaxingPath(
+        eq, damped.AnchoredEquilibrium(eq.net, confinement=confinement), damped.REST_TOLERANCE,
+        max_steps=params.numerics.static_relaxation_steps),
+    "inertial": lambda eq, params, confinement, masses: InertialPath(eq, InertialRelaxation(eq, masses(), params)),
+}
+
+
+def path_for(eq: Equilibrium, params, confinement: float = 0.0, masses=None) -> Path:
+    """The static path on ``eq`` for ``params`` (``numerics.static_relaxation`` picks it from :data:`PATHS`) under
+    the lateral traction ``confinement`` [Pa]; ``masses``: a callable giving the network's (ndof,) masses
+    (:func:`.inertial.dof_masses`), called only by a path that moves with inertia."""
+    return PATHS[params.numerics.static_relaxation](eq, params, confinement, masses)
