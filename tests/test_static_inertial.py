@@ -105,3 +105,27 @@ def test_a_sliding_face_under_a_larger_held_shear_is_a_failure_not_a_numerical_o
     out = path._relax(state, tau, FailureRule(1e-3), state.closure)
     assert out.failure in (COLLAPSE, LOST_LOAD) and out.steps > 0
     assert np.all(np.isfinite(out.state.u)) and math.isfinite(out.state.stress)
+
+
+def _fem_creep(*extra):
+    """The 4 x 8 mm fem creep at 160 MPa of seed 4 on the static engine: the plain path's regain gives out (a status
+    cycle) at its 14th event (tests/test_static_damped.py)."""
+    from grainfrac_yade.geometry.specimen import build_specimen
+    from grainfrac_yade.protocols.creep import run_creep
+    p = load_parameters(extra_files=["params/presets/fem.toml"],
+                        overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
+    return run_creep(build_specimen(p, 4), p, 160e6)
+
+
+def test_creep_hold_goes_on_with_inertia_past_a_status_cycle_and_repeats():
+    """Through the protocol: where the plain static engine ends this hold as a numerical failure, the inertial
+    relaxation takes it on (no numerical failure, at least one relaxation, its DEM steps in the summary), and the
+    same row run twice gives the same history and break times bit for bit (numpy in a fixed order, no YADE)."""
+    a, b = (_fem_creep("numerics.static_relaxation=inertial") for _ in range(2))
+    assert not a.numerical_failure and a.scene.path.tally[0] >= 1 and a.scene.path.tally[1] > 0
+    assert a.scene.summary_keys()["static_relaxation_steps"] == a.scene.path.tally[1]
+    assert (a.n_events, a.failed, a.failure_reason) == (b.n_events, b.failed, b.failure_reason)
+    assert np.array_equal(a.break_time, b.break_time, equal_nan=True)
+    drop = {"wall_s", "cpu_s"}
+    assert [{k: v for k, v in r.items() if k not in drop} for r in a.rows] == \
+        [{k: v for k, v in r.items() if k not in drop} for r in b.rows]
