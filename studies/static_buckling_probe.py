@@ -26,12 +26,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from grainfrac_yade.elastic import _triangle_b, build_network
-from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.grains import layout_for
-from grainfrac_yade.params import load_parameters
 from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
+from studies.static_engine_probe import specimen_arguments, specimen_layout
 
 #: Eigenvalues of K_t^-1 (-K_sigma) asked of ARPACK [1]: the largest few (the smallest load factors).
 EIGENVALUES = 4
@@ -77,19 +74,10 @@ def load_factor(eq, state, kg):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--params", action="append", default=[])
-    ap.add_argument("--width", type=float, default=10e-3)
-    ap.add_argument("--height", type=float, default=20e-3)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--set", action="append", default=[])
+    ap = specimen_arguments(argparse.ArgumentParser())
     ap.add_argument("--strains", default="0.001,0.002,0.003,0.004,0.005,0.006")
     a = ap.parse_args(argv)
-    p = load_parameters(extra_files=a.params,
-                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
-    s = build_specimen(p, a.seed)
-    lay = layout_for(s, p)
-    net = build_static_network(s, p, lay)
+    p, s, lay, net = specimen_layout(a)
     enet = build_network(s, p, lay.model, lay)
     if not len(enet.tri_nodes):
         raise SystemExit("static_buckling_probe: needs fem cells (--params params/presets/fem.toml)")

@@ -20,13 +20,10 @@ import time
 
 import numpy as np
 
-from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.grains import layout_for
-from grainfrac_yade.params import load_parameters
 from grainfrac_yade.static import contacts as cl
 from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
+from studies.static_engine_probe import specimen_arguments, specimen_layout
 from grainfrac_yade.static.ucs import ucs_path
 
 
@@ -69,20 +66,11 @@ class LossPath(Path):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--params", action="append", default=[])
-    ap.add_argument("--width", type=float, default=10e-3)
-    ap.add_argument("--height", type=float, default=20e-3)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--set", action="append", default=[])
+    ap = specimen_arguments(argparse.ArgumentParser())
     ap.add_argument("--reach", type=float, default=1.0, help="contact lost beyond this x the radii's sum")
     ap.add_argument("--max-strain", type=float, default=0.008)
     a = ap.parse_args(argv)
-    p = load_parameters(extra_files=a.params,
-                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
-    s = build_specimen(p, a.seed)
-    lay = layout_for(s, p)
-    net = build_static_network(s, p, lay)
+    p, s, lay, net = specimen_layout(a)
     rsum = lay.sphere_radius[net.bond_nodes[:, 0]] + lay.sphere_radius[net.bond_nodes[:, 1]]
     eq = Equilibrium(net)
     path = LossPath(eq, rsum, a.reach)

@@ -24,13 +24,10 @@ import time
 import numpy as np
 
 from grainfrac_yade.elastic import _triangle_b, build_network
-from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.grains import layout_for
-from grainfrac_yade.params import load_parameters
 from grainfrac_yade.static import contacts as cl
 from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
+from studies.static_engine_probe import specimen_arguments, specimen_layout
 from grainfrac_yade.static.ucs import ucs_path
 
 #: Fraction of the critical step (Gershgorin bound on M^-1 K) [1].
@@ -161,12 +158,7 @@ class DynamicPath(Path):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--params", action="append", default=[])
-    ap.add_argument("--width", type=float, default=10e-3)
-    ap.add_argument("--height", type=float, default=20e-3)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--set", action="append", default=[])
+    ap = specimen_arguments(argparse.ArgumentParser())
     ap.add_argument("--damping", type=float, default=0.2)
     ap.add_argument("--handover", type=int, default=1)
     ap.add_argument("--rest", type=float, default=1e-3)
@@ -174,11 +166,7 @@ def main(argv=None):
     ap.add_argument("--min-crossings", type=float, default=1.0)
     ap.add_argument("--max-strain", type=float, default=0.008)
     a = ap.parse_args(argv)
-    p = load_parameters(extra_files=a.params,
-                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
-    s = build_specimen(p, a.seed)
-    lay = layout_for(s, p)
-    net = build_static_network(s, p, lay)
+    p, s, lay, net = specimen_layout(a)
     enet = build_network(s, p, lay.model, lay)
     eq = Equilibrium(net)
     stint = DynamicStint(eq, node_masses(enet, s, p, net.ndof, net.dofs), a.damping, a.rest, a.budget,

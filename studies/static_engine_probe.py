@@ -60,12 +60,20 @@ def specimen_arguments(ap):
     return ap
 
 
-def specimen_network(a):
-    """(parameters, static network) of the parsed ``specimen_arguments`` (files, size, seed, --set)."""
+def specimen_layout(a):
+    """(parameters, specimen, layout, static network) of the parsed ``specimen_arguments`` (files, size, seed,
+    --set)."""
     p = load_parameters(extra_files=a.params,
                         overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
     s = build_specimen(p, a.seed)
-    return p, build_static_network(s, p, layout_for(s, p))
+    lay = layout_for(s, p)
+    return p, s, lay, build_static_network(s, p, lay)
+
+
+def specimen_network(a):
+    """(parameters, static network) of the parsed ``specimen_arguments`` (files, size, seed, --set)."""
+    p, _, _, net = specimen_layout(a)
+    return p, net
 
 
 def main(argv=None):

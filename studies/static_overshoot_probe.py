@@ -19,13 +19,10 @@ import time
 
 import numpy as np
 
-from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.grains import layout_for
-from grainfrac_yade.params import load_parameters
 from grainfrac_yade.static import contacts as cl
 from grainfrac_yade.static.cascade import BREAK_RATIO_TOL, LargeCascade, Path
-from grainfrac_yade.static.network import build_static_network
 from grainfrac_yade.static.solver import Equilibrium
+from studies.static_engine_probe import specimen_arguments, specimen_layout
 from grainfrac_yade.static.ucs import ucs_path
 
 
@@ -66,19 +63,11 @@ class OvershootPath(Path):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--params", action="append", default=[])
-    ap.add_argument("--width", type=float, default=10e-3)
-    ap.add_argument("--height", type=float, default=20e-3)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--set", action="append", default=[])
+    ap = specimen_arguments(argparse.ArgumentParser())
     ap.add_argument("--overshoot", type=float, default=0.0)
     ap.add_argument("--max-strain", type=float, default=0.01)
     a = ap.parse_args(argv)
-    p = load_parameters(extra_files=a.params,
-                        overrides=[f"specimen.width={a.width}", f"specimen.height={a.height}"] + a.set)
-    s = build_specimen(p, a.seed)
-    net = build_static_network(s, p, layout_for(s, p))
+    p, _, _, net = specimen_layout(a)
     eq = Equilibrium(net)
     path = OvershootPath(eq, a.overshoot)
     t0 = time.process_time()

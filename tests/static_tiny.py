@@ -43,6 +43,23 @@ def tension_pair(**kw):
     return network([[0.0, 0.0], [0.0, 1e-3]], [[0, 1]], [[0.0, 1.0]], top=[1], bottom=[0], **kw)
 
 
+def plain_hold_fails_once(monkeypatch):
+    """Make the plain static regain (``Path.hold``) give out once, from its start state, as a status cycle does
+    (helper of the relaxation tests: the next regain is the plain one)."""
+    from grainfrac_yade.errors import NumericalFailure
+    from grainfrac_yade.static.cascade import Path
+    calls = {"n": 0}
+    original = Path.hold
+
+    def fails_once(self, *args, **kw):
+        calls["n"] += 1
+        if calls["n"] == 1:
+            self.last_converged = args[0]
+            raise NumericalFailure("static equilibrium: contact statuses did not settle (made to fail)")
+        return original(self, *args, **kw)
+    monkeypatch.setattr(Path, "hold", fails_once)
+
+
 def assert_resumed_as_whole(resumed, whole):
     """A creep run resumed from a checkpoint against the uninterrupted one: the history (but wall times), events,
     failure and break times equal (helper of the kill-and-resume tests of the static and hybrid engines)."""

@@ -8,7 +8,7 @@ from grainfrac_yade.static.failure import NO_EQUILIBRIUM
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, network, shear_pair
+from static_tiny import KN, network, plain_hold_fails_once, shear_pair
 
 
 def chain(**kw):
@@ -125,7 +125,6 @@ def test_anchor_must_be_positive():
 def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
     """A plain regain that gives out (made to fail once here) is relaxed from the last converged state and ends on
     the plain static hold's state; a regain that does not give out is the plain one's, bit for bit."""
-    from grainfrac_yade.errors import NumericalFailure
     from grainfrac_yade.static.damped import RelaxingPath
 
     net = chain(jt=1e12, jc=1e12)
@@ -135,16 +134,7 @@ def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
     rp = RelaxingPath(eq, AnchoredEquilibrium(net, 1.0))
     same, reason = rp.hold(eq.initial(0.0), target, FailureRule(1e-3))
     assert reason is None and np.array_equal(same.u, plain.u) and not rp.relaxations
-    calls = {"n": 0}
-    original = Path.hold
-
-    def fails_once(self, *args, **kw):
-        calls["n"] += 1
-        if calls["n"] == 1:
-            self.last_converged = args[0]
-            raise NumericalFailure("static equilibrium: contact statuses did not settle (made to fail)")
-        return original(self, *args, **kw)
-    monkeypatch.setattr(Path, "hold", fails_once)
+    plain_hold_fails_once(monkeypatch)
     eq = Equilibrium(net)
     rp = RelaxingPath(eq, AnchoredEquilibrium(net, 1.0))
     state, reason = rp.hold(eq.initial(0.0), target, FailureRule(1e-3))

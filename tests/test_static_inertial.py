@@ -12,7 +12,7 @@ from grainfrac_yade.static.inertial import (LOST_LOAD, InertialPath, InertialRel
                                             dof_masses)
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, network, shear_pair
+from static_tiny import KN, network, plain_hold_fails_once, shear_pair
 
 #: Steps per period of the oscillator in the closed-form test [1]: the damping's switch of sign falls inside one
 #: step, an error of about 2 pi / STEPS of the swing (3e-4 here); the test's tolerance 2e-3 states that.
@@ -68,20 +68,10 @@ def test_critical_step_of_the_chain():
 def test_relaxation_comes_to_rest_on_the_static_hold(monkeypatch):
     """A plain regain made to give out once is relaxed with inertia from the last converged state; at rest the
     static regain from the relaxed state is the plain static hold's state (stress to 1e-9)."""
-    from grainfrac_yade.errors import NumericalFailure
     net = chain(jt=1e12, jc=1e12)
     target = 50e6
     plain, _ = Path(Equilibrium(net)).hold(Equilibrium(net).initial(0.0), target, FailureRule(1e-3))
-    calls = {"n": 0}
-    original = Path.hold
-
-    def fails_once(self, *args, **kw):
-        calls["n"] += 1
-        if calls["n"] == 1:
-            self.last_converged = args[0]
-            raise NumericalFailure("static equilibrium: contact statuses did not settle (made to fail)")
-        return original(self, *args, **kw)
-    monkeypatch.setattr(Path, "hold", fails_once)
+    plain_hold_fails_once(monkeypatch)
     eq = Equilibrium(net)
     path = InertialPath(eq, InertialRelaxation(eq, np.full(net.ndof, 2e-6), load_parameters()))
     start = eq.initial(0.0)
