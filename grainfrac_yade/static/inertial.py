@@ -44,7 +44,7 @@ from ..layout import bond_properties
 from ..protocols.creep_loops import CollapseWatch, collapsing
 from ..wave import hold_budget, scene_density
 from . import contacts as cl
-from .cascade import Path
+from .cascade import Path, Record
 from .damped import Relaxation, RelaxingPath
 from .failure import COLLAPSE, FailureRule
 from .solver import Equilibrium, State
@@ -96,11 +96,15 @@ def damped_step(u: np.ndarray, v: np.ndarray, f: np.ndarray, inv_m: np.ndarray, 
 class HeldServo:
     """The creep protocol's stress servo on the static network's platen closure (module doc): the attributes
     :func:`grainfrac_yade.protocols.creep_loops.collapsing` reads (``stress``, ``target``,
-    ``closing_clipped_steps``)."""
+    ``closing_clipped_steps``); its :attr:`watch` the collapse criterion."""
 
-    def __init__(self, target: float, gain: float, max_speed: float):
+    def __init__(self, target: float, gain: float, max_speed: float, creep, strain: float):
         self.target, self.gain, self.max_speed = float(target), float(gain), float(max_speed)
         self.stress, self.clipped, self.closing_clipped_steps = 0.0, 0, 0
+        self.stress_tolerance = creep.stress_tolerance
+        #: the creep protocol's collapse criterion from the strain ``strain`` on (None where it is off)
+        self.watch = CollapseWatch(creep.collapse_strain_increment, strain) if creep.collapse_strain_increment > 0 \
+            else None
 
     def speed(self, stress: float, dt: float) -> float:
         """The closing speed [m/s] for the measured ``stress`` [Pa] (and the clip bookkeeping)."""
@@ -109,6 +113,34 @@ class HeldServo:
         self.clipped = 1 if v > self.max_speed else (-1 if v < -self.max_speed else 0)
         self.closing_clipped_steps = self.closing_clipped_steps + 1 if self.clipped == 1 else 0
         return min(max(v, -self.max_speed), self.max_speed)
+
+    def held(self, stress: float) -> bool:
+        """The held stress within ``creep.stress_tolerance`` of the target (the rest criterion's second half)."""
+        return abs(stress - self.target) < self.stress_tolerance * self.target
+
+    def lost(self, stress: float) -> bool:
+        """Never: a held load is lost by the collapse watch or the budget."""
+        return False
+
+
+class FixedPlatens:
+    """The platens held where they are (displacement control: the UCS path, a ramp): no servo; the load is lost
+    once the platen stress falls below ``stop_below`` [Pa] (the UCS test's post-peak rule)."""
+
+    watch = None
+
+    def __init__(self, stop_below: float):
+        self.stop_below, self.stress = float(stop_below), 0.0
+
+    def speed(self, stress: float, dt: float) -> float:
+        self.stress = stress
+        return 0.0
+
+    def held(self, stress: float) -> bool:
+        return True
+
+    def lost(self, stress: float) -> bool:
+        return stress < self.stop_below
 
 
 class InertialRelaxation:
@@ -134,21 +166,31 @@ class InertialRelaxation:
         r = r - self.eq.f_ext
         return 0.5 * (r[self._bottom_y].sum() - r[self._top_y].sum()) / (n.width * n.thickness)
 
-    def relax(self, state: State, target: float, jt: np.ndarray, jc: np.ndarray, start_closure: float,
-              take_back=None):
-        """Relax ``state`` (a converged static state) under the held stress ``target`` [Pa] with the current
-        strengths ``jt``, ``jc`` [Pa], the regain having begun at closure ``start_closure`` [m].
-        ``take_back(state) -> (state, failure reason or None) | None``: the static regain from a relaxed dynamic
-        state (None where it gives out: the dynamics go on).  Returns (state, failure reason or None, steps,
-        take-backs that gave out, bonds broken)."""
-        net, eq, cp = self.net, self.eq, self.params.creep
-        young = max(state.stress, 0.0) / max(state.closure / net.height, STRAIN_FLOOR)
-        young = young if young > 0 else self.intact_modulus()
+    def servo(self, state: State, target: float) -> HeldServo:
+        """The creep protocol's servo holding ``target`` [Pa] from ``state`` (its gain and the budget from the
+        state's secant modulus, the intact one where the state carries no stress)."""
+        net, cp = self.net, self.params.creep
+        young = self.modulus(state)
         budget = hold_budget(cp, net.height, young, self.density, self.dt)
-        servo = HeldServo(target, net.height / (young * budget.servo_response_steps),
-                          cp.servo_max_strain_rate * net.height)
-        watch = CollapseWatch(cp.collapse_strain_increment, state.closure / net.height) \
-            if cp.collapse_strain_increment > 0 else None
+        return HeldServo(target, net.height / (young * budget.servo_response_steps),
+                         cp.servo_max_strain_rate * net.height, cp, state.closure / net.height)
+
+    def modulus(self, state: State) -> float:
+        """Secant axial modulus of ``state`` [Pa] (the intact one where it carries no stress)."""
+        young = max(state.stress, 0.0) / max(state.closure / self.net.height, STRAIN_FLOOR)
+        return young if young > 0 else self.intact_modulus()
+
+    def relax(self, state: State, control, jt: np.ndarray, jc: np.ndarray, take_back=None):
+        """Relax ``state`` (a converged static state) under ``control`` (:class:`HeldServo` or
+        :class:`FixedPlatens`) with the current strengths ``jt``, ``jc`` [Pa].  ``take_back(state) -> (state,
+        failure reason or None) | None``: the static equilibrium from a relaxed dynamic state (None where it gives
+        out: the dynamics go on).  Returns (state, failure reason or None, steps, take-backs that gave out, bonds
+        broken); with fixed platens the reason is :data:`LOST_LOAD` once the stress fell below the control's
+        limit, and at the end of the budget the relaxed state is taken back if it can be (as a YADE stint's)."""
+        net, eq, cp = self.net, self.eq, self.params.creep
+        budget = hold_budget(cp, net.height, self.modulus(state), self.density, self.dt)
+        servo = control
+        watch = control.watch
         u, v = state.u.copy(), np.zeros(net.ndof)
         closure = state.closure
         broken, status, sign, s_p = state.broken.copy(), state.status.copy(), state.sign.copy(), state.s_p.copy()
@@ -191,17 +233,24 @@ class InertialRelaxation:
                                                   strain):
                 return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), COLLAPSE, \
                     steps, gave_out, int(broken.sum()) - broken0
+            if control.lost(stress):
+                return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), LOST_LOAD, \
+                    steps, gave_out, int(broken.sum()) - broken0
             if steps < next_take_back:
                 continue
-            if self._at_rest(f, fn, fs, broken) and abs(stress - target) < cp.stress_tolerance * target:
+            if self._at_rest(f, fn, fs, broken) and control.held(stress):
                 relaxed = self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
                 back = take_back(relaxed) if take_back is not None else (relaxed, None)
                 if back is not None:
                     return back[0], back[1], steps, gave_out, int(back[0].broken.sum()) - broken0
                 gave_out += 1
                 next_take_back = steps + cp.check_period * 2 ** gave_out
-        return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), LOST_LOAD, steps, \
-            gave_out, int(broken.sum()) - broken0
+        last = self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
+        if isinstance(control, FixedPlatens) and take_back is not None:
+            back = take_back(last)
+            if back is not None:
+                return back[0], back[1], steps, gave_out, int(back[0].broken.sum()) - broken0
+        return last, LOST_LOAD, steps, gave_out, int(broken.sum()) - broken0
 
     def intact_modulus(self) -> float:
         """The intact specimen's axial modulus dS/d(strain) [Pa] (the servo's gain and the wave-crossing budget where
@@ -235,21 +284,28 @@ class InertialRelaxation:
 
 
 class InertialPath(RelaxingPath):
-    """The static path whose held-load regain relaxes by :class:`InertialRelaxation` where the plain static solve
-    gives out (``numerics.static_relaxation = "inertial"``); a relaxed state goes back to the static path by the
-    static equilibrium at its closure and the plain regain (:meth:`take_back`).  Relaxations are tallied as the
-    overdamped ones (their steps are DEM steps; "unsettled": take-backs that gave out)."""
+    """The static path that relaxes with :class:`InertialRelaxation` where the plain static solve gives out
+    (``numerics.static_relaxation = "inertial"``): under a held load (a creep hold's regain) with the creep
+    protocol's servo, and under displacement control (the UCS path, a ramp) with the platens held where the path
+    stood, as a YADE stint of the hybrid engine would (the specimen failing there once the stress falls below
+    ``ucs.stop_stress_ratio`` of the stint's start).  A relaxed state goes back to the static path by the static
+    equilibrium at its closure (and, under a held load, the plain regain: :meth:`take_back`).  Relaxations are
+    tallied as the overdamped ones (their steps are DEM steps; "unsettled": take-backs that gave out)."""
 
     def __init__(self, eq: Equilibrium, dynamics: InertialRelaxation, bracket_tol=None):
         super().__init__(eq, None, bracket_tol=bracket_tol)
         self.dynamics = dynamics
+        self._in_move = False       # inside a displacement-controlled step: a cascade that gives out is relaxed here
 
-    def take_back(self, relaxed: State, target: float, rule: FailureRule, begin: float):
-        """(state, failure reason or None) of the plain static regain from the relaxed dynamic state; None where
-        the static statuses do not settle there."""
+    def take_back(self, relaxed: State, target, rule: FailureRule, begin: float):
+        """(state, failure reason or None) of the static equilibrium at the relaxed dynamic state's closure, its
+        cascade, and under a held ``target`` [Pa] the plain static regain; None where the static statuses do not
+        settle there."""
         try:
-            state = self.eq.solve(relaxed.closure, relaxed)
-            state, reason = Path.hold(self, Path.cascade(self, state), target, rule)
+            state = Path.cascade(self, self.eq.solve(relaxed.closure, relaxed))
+            if target is None:
+                return state, None
+            state, reason = Path.hold(self, state, target, rule)
         except NumericalFailure:
             return None
         if reason is None and rule.collapsed(begin, state.closure, self.net.height):
@@ -257,10 +313,40 @@ class InertialPath(RelaxingPath):
         return state, reason
 
     def _relax(self, start: State, target: float, rule: FailureRule, begin: float) -> Relaxation:
-        state, reason, steps, gave_out, broken = self.dynamics.relax(
-            start, target, self.jt, self.jc, begin, lambda s: self.take_back(s, target, rule, begin))
-        out = Relaxation(state, reason, begin, steps, gave_out, broken)
-        return out
+        dyn = self.dynamics
+        state, reason, steps, gave_out, broken = dyn.relax(
+            start, dyn.servo(start, target), self.jt, self.jc, lambda s: self.take_back(s, target, rule, begin))
+        return Relaxation(state, reason, begin, steps, gave_out, broken)
+
+    def cascade(self, state, first=None, record=None):
+        if self._in_move:
+            return Path.cascade(self, state, first, record)
+        return super().cascade(state, first, record)
+
+    def step(self, state: State, target=None, max_closure=math.inf):
+        """:meth:`.cascade.Path.step`; under displacement control (no ``target``), where the static solve gives out
+        the specimen relaxes with inertia at the closure of the last converged state, its breaks one record."""
+        if target is not None:
+            return super().step(state, target, max_closure)
+        self._in_move = True
+        try:
+            return super().step(state, None, max_closure)
+        except NumericalFailure:
+            start = self.last_converged
+        finally:
+            self._in_move = False
+        dyn = self.dynamics
+        stop = self.dynamics.params.ucs.stop_stress_ratio * start.stress
+        state, reason, steps, gave_out, broken = dyn.relax(
+            start, FixedPlatens(stop), self.jt, self.jc, lambda s: self.take_back(s, None, FailureRule(0.0),
+                                                                                  start.closure))
+        new = np.flatnonzero(state.broken & ~start.broken)
+        self.records.append(Record(start.closure, start.stress, state.stress, new.tolist(),
+                                   state.break_mode[new].tolist()))
+        self.relaxations.append(Relaxation(state, reason, start.closure, steps, gave_out, broken))
+        self.tally += (1, steps, gave_out, broken)
+        self.last_converged = state
+        return state, "break"
 
 
-__all__ = ["InertialPath", "InertialRelaxation", "HeldServo", "damped_step", "dof_masses", "critical_step", "LOST_LOAD"]
+__all__ = ["FixedPlatens", "InertialPath", "InertialRelaxation", "HeldServo", "damped_step", "dof_masses", "critical_step", "LOST_LOAD"]
