@@ -119,3 +119,27 @@ def test_creep_hold_goes_on_with_inertia_past_a_status_cycle_and_repeats():
     drop = {"wall_s", "cpu_s"}
     assert [{k: v for k, v in r.items() if k not in drop} for r in a.rows] == \
         [{k: v for k, v in r.items() if k not in drop} for r in b.rows]
+
+
+def _rigid_ucs(*extra):
+    """The 4 x 8 mm rigid-cell UCS of seed 4 on the static engine (shipped calibration)."""
+    from grainfrac_yade.geometry.specimen import build_specimen
+    from grainfrac_yade.protocols.ucs import run_ucs
+    p = load_parameters(overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
+    return run_ucs(build_specimen(p, 4), p)
+
+
+def test_ucs_past_a_loaded_mechanism_by_inertia_to_a_post_peak_end():
+    """Through the protocol: the plain static UCS path of this specimen ends as a numerical failure (a loaded
+    mechanism); with ``numerics.static_relaxation = "inertial"`` the specimen relaxes there with the platens held,
+    loses its load, and the test ends post-peak with a strength, bit for bit the same in a second run."""
+    _, plain, _, _ = _rigid_ucs()
+    assert plain["numerical_failure"] and not plain["peak_reached"]
+    runs = [_rigid_ucs("numerics.static_relaxation=inertial") for _ in range(2)]
+    (cols, result, scene, _), (cols2, result2, _, _) = runs
+    assert not result["numerical_failure"] and result["end_reason"].startswith("post-peak")
+    assert result["peak_reached"] and scene.path.tally[0] >= 1 and result["static_relaxations"] >= 1
+    assert np.all(np.isfinite(cols["axial_stress_pa"]))
+    drop = {"wall_s", "cpu_s"}
+    assert {k: v for k, v in result.items() if k not in drop} == {k: v for k, v in result2.items() if k not in drop}
+    assert all(np.array_equal(cols[k], cols2[k]) for k in cols if k not in drop)

@@ -325,7 +325,8 @@ class InertialPath(RelaxingPath):
 
     def step(self, state: State, target=None, max_closure=math.inf):
         """:meth:`.cascade.Path.step`; under displacement control (no ``target``), where the static solve gives out
-        the specimen relaxes with inertia at the closure of the last converged state, its breaks one record."""
+        the specimen relaxes with inertia at the closure of the last converged state, its breaks one record; if it
+        loses the load there ("none": nothing lies ahead) the path ends on the relaxed state."""
         if target is not None:
             return super().step(state, target, max_closure)
         self._in_move = True
@@ -346,7 +347,9 @@ class InertialPath(RelaxingPath):
         self.relaxations.append(Relaxation(state, reason, start.closure, steps, gave_out, broken))
         self.tally += (1, steps, gave_out, broken)
         self.last_converged = state
-        return state, "break"
+        # a specimen that lost its load with the platens held has failed: nothing lies ahead on the path (the
+        # protocol's rows show the drop and its post-peak rule ends the test)
+        return state, "none" if reason else "break"
 
 
 __all__ = ["FixedPlatens", "InertialPath", "InertialRelaxation", "HeldServo", "damped_step", "dof_masses", "critical_step", "LOST_LOAD"]
