@@ -112,6 +112,11 @@ def test_quick_static_bench_writes_every_key(tmp_path):
     assert _positive(c["yade_over_static_cpu_per_event"])
     assert c["yade_over_static_cpu_per_event"] == c["yade"]["cpu_per_event_s"] / c["static"]["cpu_per_event_s"]
     assert "YADE / static, CPU per event: x" in res.stdout and "| 6x12 |" in res.stdout
+    k = data["collapse"]
+    assert [r["label"] for r in k["runs"]] == ["static + inertial", "hybrid"]
+    assert all(_positive(r["cpu_s"]) and r["end"] for r in k["runs"])
+    assert k["hybrid_over_inertial_cpu"] == k["runs"][1]["cpu_s"] / k["runs"][0]["cpu_s"]
+    assert "The collapse, 4x8 mm" in res.stdout
 
 
 @pytest.mark.parametrize("argv, words", [

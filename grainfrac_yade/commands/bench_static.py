@@ -18,6 +18,12 @@ Finite-element cells (``params/presets/fem.toml``), seed 1 (``--seed``), a creep
    (``ru_maxrss``: cumulative, the sizes run smallest first), and the exponent b of CPU per event ~ dofs^b fitted by
    least squares in log-log over the sizes.
 
+3. **The collapse** on the comparison's specimen: the same creep hold to its end with the static engine and its
+   inertial relaxation (``numerics.static_relaxation = "inertial"``: the core's own small-strain dynamics where the
+   static regain gives out) and with the hybrid engine (YADE's dynamic stint there): lifetime, events, the end, the
+   CPU of the whole run and of the dynamic part (``static_relaxation_cpu_s``, ``dynamic_stint_cpu_s``), and their
+   ratio hybrid / inertial, formed within the run.
+
 All times are the process's CPU time (``time.process_time``), which waiting for a core does not inflate; on this
 shared machine they still vary by ~20 % between runs, so no number here is comparable with another run's.  The JSON
 (``--out``, default ``docs/bench_static.json``; ``--quick``: ``results/bench_static_quick.json``) is rewritten after
@@ -148,6 +154,41 @@ def compare_engines(settings, preset, user_files, overrides, seed, stress, progr
     return out
 
 
+#: The two ways through the collapse of part 3: (label, engine, static_relaxation).
+COLLAPSE_ENGINES = (("static + inertial", "static", "inertial"), ("hybrid", "hybrid", "none"))
+
+
+def collapse_runs(settings, preset, user_files, overrides, seed, stress, progress) -> dict:
+    """The creep hold to its end on ``settings.compare``, the dynamic part in the core and in YADE (module doc,
+    part 3)."""
+    from ..protocols.creep import run_creep
+    from ..protocols.creep_output import end_reason
+    name, width, height = settings.compare
+    out = {"specimen": name, "width_m": width, "height_m": height, "runs": []}
+    for label, engine_name, relaxation in COLLAPSE_ENGINES:
+        params = size_params(preset, user_files, width, height,
+                             [*overrides, f"numerics.static_relaxation={relaxation}"], engine_name)
+        c0 = time.process_time()
+        run = run_creep(build_specimen(params, seed), params, stress)
+        keys = run.scene.summary_keys()
+        dyn_cpu = keys.get("static_relaxation_cpu_s", keys.get("dynamic_stint_cpu_s", 0.0))
+        row = {"label": label, "engine": engine_name, "static_relaxation": relaxation, "failed": bool(run.failed),
+               "numerical_failure": bool(run.numerical_failure),
+               "lifetime_s": float(run.rows[-1]["creep_time_s"]) if run.failed and not run.numerical_failure else None,
+               "events": int(run.n_events), "end": end_reason(run, params, float(run.rows[-1]["creep_time_s"])),
+               "cpu_s": time.process_time() - c0,
+               "dynamic_cpu_s": float(dyn_cpu),
+               "dynamic_steps": int(keys.get("static_relaxation_steps", keys.get("dynamic_stint_dem_steps", 0)))}
+        out["runs"].append(row)
+        progress(f"collapse, {name} mm, {label}: {row['end']}, {row['events']} events, {row['cpu_s']:.3g} CPU s "
+                 f"({row['dynamic_cpu_s']:.3g} in the dynamics)")
+    a, b = out["runs"]
+    out["hybrid_over_inertial_cpu"] = b["cpu_s"] / a["cpu_s"]
+    out["hybrid_over_inertial_dynamic_cpu"] = (b["dynamic_cpu_s"] / a["dynamic_cpu_s"]
+                                               if a["dynamic_cpu_s"] > 0 else None)
+    return out
+
+
 def size_series(settings, preset, user_files, overrides, seed, stress, progress, peak_rss, save, rows) -> list:
     """The core's creep hold on each specimen of ``settings.sizes`` (module doc, part 2), appended to ``rows`` (the
     result's list, so that ``save()`` after each size writes it)."""
@@ -212,6 +253,9 @@ def run_static_bench(settings: StaticBenchSettings, preset, seed=1, stress=HOLD_
         result["engines_per_event"] = compare_engines(settings, preset, extra_files, overrides, seed, stress, progress)
         result["peak_rss_mb_after_comparison"] = peak_rss()
         save()
+    if settings.compare is not None:
+        result["collapse"] = collapse_runs(settings, preset, extra_files, overrides, seed, stress, progress)
+        save()
     result["sizes"] = []
     size_series(settings, preset, extra_files, overrides, seed, stress, progress, peak_rss, save, result["sizes"])
     result["dofs_scaling"] = dofs_exponent(result["sizes"])
@@ -237,6 +281,18 @@ def static_tables(result: dict) -> str:
             lines.append(f"| {name} | {r['n_bodies']} / {r['n_bonds']} | {r['ramp_and_first_relaxation_cpu_s']:.2f} | "
                          f"{r['events']} | {r['cpu_per_event_s']:.4g} | {r['steps_per_event']:.0f} {steps} |")
         lines += ["", f"YADE / static, CPU per event: x {c['yade_over_static_cpu_per_event']:.1f}."]
+    k = result.get("collapse")
+    if k:
+        lines += ["", f"The collapse, {k['specimen']} mm, the hold to its end with the dynamic part in the core and in "
+                  "YADE:", "", "| run | end | lifetime [s] | events | CPU [s] | of it the dynamics [CPU s], steps |",
+                  "|---|---|---|---|---|---|"]
+        for r in k["runs"]:
+            life = f"{r['lifetime_s']:.5g}" if r["lifetime_s"] else "-"
+            lines.append(f"| {r['label']} | {r['end']} | {life} | {r['events']} | {r['cpu_s']:.3g} | "
+                         f"{r['dynamic_cpu_s']:.3g}, {r['dynamic_steps']} |")
+        ratio = k["hybrid_over_inertial_dynamic_cpu"]
+        lines += ["", f"Hybrid / static + inertial, CPU of the run: x {k['hybrid_over_inertial_cpu']:.1f}"
+                  + (f"; of the dynamics: x {ratio:.1f}." if ratio else "; the inertial run needed no dynamics.")]
     lines += ["", f"Per creep event against size, the static core's hold ({b['settings']['events']} events asked each):", "",
               "| specimen [mm] | dofs | bonds | build [CPU s] | ramp: CPU [s], equilibria, bonds broken | events | "
               "CPU per event [s] | equilibria per event | iterations per event | iterations per equilibrium | "

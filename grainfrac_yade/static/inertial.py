@@ -35,6 +35,7 @@ in a fixed order, no YADE).  ``numerics.static_relaxation = "inertial"`` (:data:
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -296,6 +297,19 @@ class InertialPath(RelaxingPath):
         super().__init__(eq, None, bracket_tol=bracket_tol)
         self.dynamics = dynamics
         self._in_move = False       # inside a displacement-controlled step: a cascade that gives out is relaxed here
+        #: CPU time spent in the relaxations since the run began (a resumed run's included) [s]
+        self.cpu_s = 0.0
+
+    def summary_keys(self) -> dict:
+        """The relaxations' tally and their CPU time [s] (``static_relaxation_cpu_s``)."""
+        return {**super().summary_keys(), "static_relaxation_cpu_s": float(self.cpu_s)}
+
+    def saved_arrays(self) -> dict:
+        return {**super().saved_arrays(), "relaxation_cpu_s": np.array([self.cpu_s])}
+
+    def restore_arrays(self, arrays: dict) -> None:
+        super().restore_arrays(arrays)
+        self.cpu_s = float(np.asarray(arrays.get("relaxation_cpu_s", [0.0]))[0])
 
     def take_back(self, relaxed: State, target, rule: FailureRule, begin: float):
         """(state, failure reason or None) of the static equilibrium at the relaxed dynamic state's closure, its
@@ -313,9 +327,10 @@ class InertialPath(RelaxingPath):
         return state, reason
 
     def _relax(self, start: State, target: float, rule: FailureRule, begin: float) -> Relaxation:
-        dyn = self.dynamics
+        dyn, c0 = self.dynamics, time.process_time()
         state, reason, steps, gave_out, broken = dyn.relax(
             start, dyn.servo(start, target), self.jt, self.jc, lambda s: self.take_back(s, target, rule, begin))
+        self.cpu_s += time.process_time() - c0
         return Relaxation(state, reason, begin, steps, gave_out, broken)
 
     def cascade(self, state, first=None, record=None):
@@ -336,11 +351,12 @@ class InertialPath(RelaxingPath):
             start = self.last_converged
         finally:
             self._in_move = False
-        dyn = self.dynamics
+        dyn, c0 = self.dynamics, time.process_time()
         stop = self.dynamics.params.ucs.stop_stress_ratio * start.stress
         state, reason, steps, gave_out, broken = dyn.relax(
             start, FixedPlatens(stop), self.jt, self.jc, lambda s: self.take_back(s, None, FailureRule(0.0),
                                                                                   start.closure))
+        self.cpu_s += time.process_time() - c0
         new = np.flatnonzero(state.broken & ~start.broken)
         self.records.append(Record(start.closure, start.stress, state.stress, new.tolist(),
                                    state.break_mode[new].tolist()))
