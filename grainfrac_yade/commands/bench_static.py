@@ -44,6 +44,8 @@ from ..engines.registry import engine
 from ..errors import GrainfracError
 from ..geometry.specimen import build_specimen
 from ..params import load_parameters, require_plane
+from ..protocols.creep import run_creep
+from ..protocols.creep_output import end_reason
 from ..protocols.timed_creep import TimedCreepRun
 from ..runs.runio import code_version, write_json
 
@@ -161,8 +163,6 @@ COLLAPSE_ENGINES = (("static + inertial", "static", "inertial"), ("hybrid", "hyb
 def collapse_runs(settings, preset, user_files, overrides, seed, stress, progress) -> dict:
     """The creep hold to its end on ``settings.compare``, the dynamic part in the core and in YADE (module doc,
     part 3)."""
-    from ..protocols.creep import run_creep
-    from ..protocols.creep_output import end_reason
     name, width, height = settings.compare
     out = {"specimen": name, "width_m": width, "height_m": height, "runs": []}
     for label, engine_name, relaxation in COLLAPSE_ENGINES:
