@@ -37,6 +37,22 @@ def shear_pair(**kw):
     return network([[0.0, 0.0], [1e-3, 0.0]], [[0, 1]], [[1.0, 0.0]], top=[1], bottom=[0], left=[0], right=[1], **kw)
 
 
+def chain(**kw):
+    """Three nodes in a column: bottom platen, one free node, top platen; two bonds with horizontal faces."""
+    return network([[0.0, 0.0], [0.0, 0.5e-3], [0.0, 1e-3]], [[0, 1], [1, 2]], [[0.0, 1.0], [0.0, 1.0]],
+                   top=[2], bottom=[0], **kw)
+
+
+def fem_creep_4x8(*extra):
+    """The 4 x 8 mm fem creep at 160 MPa of seed 4 on the static engine (``extra``: overrides): the plain path's
+    regain gives out (a status cycle) at its 14th event."""
+    from grainfrac_yade.params import load_parameters
+    from grainfrac_yade.protocols.creep import run_creep
+    p = load_parameters(extra_files=["params/presets/fem.toml"],
+                        overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
+    return run_creep(build_specimen(p, 4), p, 160e6)
+
+
 def tension_pair(**kw):
     """Two nodes one above the other, on the bottom and top platens, one bond with a horizontal face (normal +y):
     opening the platens pulls it (width x thickness = area, so platen stress = -sigma)."""

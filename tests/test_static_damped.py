@@ -8,13 +8,7 @@ from grainfrac_yade.static.failure import NO_EQUILIBRIUM
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, network, plain_hold_fails_once, shear_pair
-
-
-def chain(**kw):
-    """Three nodes in a column: bottom platen, one free node, top platen; two bonds with horizontal faces."""
-    return network([[0.0, 0.0], [0.0, 0.5e-3], [0.0, 1e-3]], [[0, 1], [1, 2]], [[0.0, 1.0], [0.0, 1.0]],
-                   top=[2], bottom=[0], **kw)
+from static_tiny import KN, chain, fem_creep_4x8, plain_hold_fails_once, shear_pair
 
 
 @pytest.mark.parametrize("alpha", [0.3, 1.0, 10.0])
@@ -143,29 +137,18 @@ def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
     assert np.allclose(state.u, plain.u, rtol=1e-9, atol=1e-9 * np.abs(plain.u).max())
 
 
-def _fem_creep(*extra):
-    """The 4 x 8 mm fem creep at 160 MPa of seed 4 on the static engine: the plain path's regain gives out (a status
-    cycle) at its 14th event."""
-    from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.params import load_parameters
-    from grainfrac_yade.protocols.creep import run_creep
-    p = load_parameters(extra_files=["params/presets/fem.toml"],
-                        overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
-    return run_creep(build_specimen(p, 4), p, 160e6)
-
-
 def test_creep_hold_relaxes_past_a_status_cycle_whatever_the_rest_tolerance(monkeypatch):
     """Through the protocol: the plain static engine ends that hold as a numerical failure; with
     ``numerics.static_relaxation = "overdamped"`` the regain relaxes and the hold goes on to the time limit.  The
     rest tolerance 1e-6 or 1e-9 gives the same events, the same broken bonds at the same creep times and the same
     end (the relaxed states differ within the tolerance: strains to 1e-4 relative)."""
     import grainfrac_yade.static.damped as damped
-    plain = _fem_creep()
+    plain = fem_creep_4x8()
     assert plain.numerical_failure and "did not settle" in plain.failure_reason
     runs = []
     for tol in (1e-6, 1e-9):
         monkeypatch.setattr(damped, "REST_TOLERANCE", tol)
-        runs.append(_fem_creep("numerics.static_relaxation=overdamped"))
+        runs.append(fem_creep_4x8("numerics.static_relaxation=overdamped"))
     a, b = runs
     for run in runs:
         assert not run.numerical_failure and run.scene.path.tally[0] >= 1

@@ -12,7 +12,7 @@ from grainfrac_yade.static.inertial import (LOST_LOAD, InertialPath, InertialRel
                                             dof_masses)
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, network, plain_hold_fails_once, shear_pair
+from static_tiny import KN, chain, fem_creep_4x8, plain_hold_fails_once, shear_pair
 
 #: Steps per period of the oscillator in the closed-form test [1]: the damping's switch of sign falls inside one
 #: step, an error of about 2 pi / STEPS of the swing (3e-4 here); the test's tolerance 2e-3 states that.
@@ -50,12 +50,6 @@ def test_dof_masses_carry_the_cells_masses(model):
     total = float((rho * s.tessellation.cell_measure * s.thickness).sum())
     assert m[net.dofs[:, 0]].sum() == pytest.approx(total, rel=1e-12)
     assert np.all(m > 0) and (net.dofs[:, 2] >= 0).any() == (model == "rigid")
-
-
-def chain(**kw):
-    """Three nodes in a column: bottom platen, one free node, top platen (as tests/test_static_damped.py)."""
-    return network([[0.0, 0.0], [0.0, 0.5e-3], [0.0, 1e-3]], [[0, 1], [1, 2]], [[0.0, 1.0], [0.0, 1.0]],
-                   top=[2], bottom=[0], **kw)
 
 
 def test_critical_step_of_the_chain():
@@ -97,21 +91,11 @@ def test_a_sliding_face_under_a_larger_held_shear_is_a_failure_not_a_numerical_o
     assert np.all(np.isfinite(out.state.u)) and math.isfinite(out.state.stress)
 
 
-def _fem_creep(*extra):
-    """The 4 x 8 mm fem creep at 160 MPa of seed 4 on the static engine: the plain path's regain gives out (a status
-    cycle) at its 14th event (tests/test_static_damped.py)."""
-    from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.protocols.creep import run_creep
-    p = load_parameters(extra_files=["params/presets/fem.toml"],
-                        overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
-    return run_creep(build_specimen(p, 4), p, 160e6)
-
-
 def test_creep_hold_goes_on_with_inertia_past_a_status_cycle_and_repeats():
     """Through the protocol: where the plain static engine ends this hold as a numerical failure, the inertial
     relaxation takes it on (no numerical failure, at least one relaxation, its DEM steps in the summary), and the
     same row run twice gives the same history and break times bit for bit (numpy in a fixed order, no YADE)."""
-    a, b = (_fem_creep("numerics.static_relaxation=inertial") for _ in range(2))
+    a, b = (fem_creep_4x8("numerics.static_relaxation=inertial") for _ in range(2))
     assert not a.numerical_failure and a.scene.path.tally[0] >= 1 and a.scene.path.tally[1] > 0
     assert a.scene.summary_keys()["static_relaxation_steps"] == a.scene.path.tally[1]
     assert (a.n_events, a.failed, a.failure_reason) == (b.n_events, b.failed, b.failure_reason)

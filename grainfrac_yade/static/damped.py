@@ -135,16 +135,20 @@ class AnchoredEquilibrium(Equilibrium):
 
 
 def relative_unbalanced(anchored: AnchoredEquilibrium, state: State) -> float:
-    """The creep protocol's equilibrium measure at ``state`` (an anchored step's answer): the mean magnitude of the
-    unbalanced force (:meth:`AnchoredEquilibrium.unbalanced`, translations) on the nodes the platens do not drive,
-    over the mean magnitude of the intact bonds' forces hypot(F_n, F_s) [1] (every intact bond: the static state
-    has them all at no cost); infinite when no bond is intact."""
-    net = anchored.net
-    r = anchored.unbalanced(state)
+    """The creep protocol's equilibrium measure at ``state`` (an anchored step's answer): :func:`relative_force` of
+    the unbalanced force (:meth:`AnchoredEquilibrium.unbalanced`) [1]."""
+    return relative_force(anchored.net, anchored.unbalanced(state), state.fn, state.fs, state.broken)
+
+
+def relative_force(net, r: np.ndarray, fn: np.ndarray, fs: np.ndarray, broken: np.ndarray) -> float:
+    """The creep protocol's equilibrium measure of the force ``r`` (ndof,) [N]: the mean magnitude of its
+    translations on the nodes the platens do not drive, over the mean magnitude of the intact bonds' forces
+    hypot(F_n, F_s) [1] (every intact bond: the static state has them all at no cost); infinite when no bond is
+    intact."""
     dofs = net.dofs[~(net.top | net.bottom)][:, :2]
     force = np.hypot(*(np.where(dofs[:, k] >= 0, r[np.maximum(dofs[:, k], 0)], 0.0) for k in range(2)))
-    intact = ~state.broken
-    ref = float(np.hypot(state.fn[intact], state.fs[intact]).mean()) if intact.any() else 0.0
+    intact = ~broken
+    ref = float(np.hypot(fn[intact], fs[intact]).mean()) if intact.any() else 0.0
     return float(force.mean()) / ref if ref > 0 else math.inf
 
 
@@ -258,9 +262,13 @@ class RelaxingPath(Path):
             out = self._relax(start, target, rule, begin)
         finally:
             self._in_hold = False
+        self.count(out)
+        return out.state, out.failure
+
+    def count(self, out: Relaxation) -> None:
+        """Keep ``out`` in :attr:`relaxations` and add it to :attr:`tally`."""
         self.relaxations.append(out)
         self.tally += (1, out.steps, out.unsettled, out.broken)
-        return out.state, out.failure
 
     def _relax(self, start: State, target: float, rule: FailureRule, begin: float) -> Relaxation:
         """One relaxation of the converged state ``start`` under the held stress ``target`` [Pa], the regain having

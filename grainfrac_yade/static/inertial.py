@@ -46,7 +46,7 @@ from ..protocols.creep_loops import CollapseWatch, collapsing
 from ..wave import hold_budget, scene_density
 from . import contacts as cl
 from .cascade import Path, Record
-from .damped import Relaxation, RelaxingPath
+from .damped import Relaxation, RelaxingPath, relative_force
 from .failure import COLLAPSE, FailureRule
 from .solver import Equilibrium, State
 
@@ -155,26 +155,19 @@ class InertialRelaxation:
         cp = params.creep
         self.damping = cp.relaxation_damping if cp.relaxation_damping > 0 else params.numerics.damping
         self.density = scene_density(params)
-        n = self.net
-        self._moving = np.stack([n.dofs[~(n.top | n.bottom), k] for k in range(2)], axis=1)
-        self._bottom_y, self._top_y = n.dofs[n.bottom, 1], n.dofs[n.top, 1]
         self._intact_modulus = None
 
-    def platen_stress(self, r: np.ndarray) -> float:
-        """Platen stress [Pa, compression positive] of the internal force ``r`` less the dead load (as
-        :meth:`.solver.Equilibrium.platen_stress`)."""
-        n = self.net
-        r = r - self.eq.f_ext
-        return 0.5 * (r[self._bottom_y].sum() - r[self._top_y].sum()) / (n.width * n.thickness)
+    def budget(self, state: State):
+        """The creep protocol's :class:`~grainfrac_yade.wave.HoldBudget` of a relaxation from ``state`` (in this
+        network's steps; its wave crossing from the state's secant modulus, :meth:`modulus`)."""
+        return hold_budget(self.params.creep, self.net.height, self.modulus(state), self.density, self.dt)
 
     def servo(self, state: State, target: float) -> HeldServo:
-        """The creep protocol's servo holding ``target`` [Pa] from ``state`` (its gain and the budget from the
-        state's secant modulus, the intact one where the state carries no stress)."""
+        """The creep protocol's servo holding ``target`` [Pa] from ``state`` (its gain from the state's secant
+        modulus and the budget's servo response)."""
         net, cp = self.net, self.params.creep
-        young = self.modulus(state)
-        budget = hold_budget(cp, net.height, young, self.density, self.dt)
-        return HeldServo(target, net.height / (young * budget.servo_response_steps),
-                         cp.servo_max_strain_rate * net.height, cp, state.closure / net.height)
+        gain = net.height / (self.modulus(state) * self.budget(state).servo_response_steps)
+        return HeldServo(target, gain, cp.servo_max_strain_rate * net.height, cp, state.closure / net.height)
 
     def modulus(self, state: State) -> float:
         """Secant axial modulus of ``state`` [Pa] (the intact one where it carries no stress)."""
@@ -189,9 +182,7 @@ class InertialRelaxation:
         broken); with fixed platens the reason is :data:`LOST_LOAD` once the stress fell below the control's
         limit, and at the end of the budget the relaxed state is taken back if it can be (as a YADE stint's)."""
         net, eq, cp = self.net, self.eq, self.params.creep
-        budget = hold_budget(cp, net.height, self.modulus(state), self.density, self.dt)
-        servo = control
-        watch = control.watch
+        budget = self.budget(state)
         u, v = state.u.copy(), np.zeros(net.ndof)
         closure = state.closure
         broken, status, sign, s_p = state.broken.copy(), state.status.copy(), state.sign.copy(), state.s_p.copy()
@@ -205,6 +196,13 @@ class InertialRelaxation:
         steps = 0
         next_take_back = 0      # after a take-back that gave out, the next waits 2, 4, 8, ... checks
         dt, damping = self.dt, self.damping
+
+        def now():
+            return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
+
+        def end(state_, reason):
+            return state_, reason, steps, gave_out, int(state_.broken.sum()) - broken0
+
         while steps < budget.max_relaxation_steps:
             u[plat] = closure * e[plat]
             dn, ds = net.cn @ u, net.ct @ u
@@ -222,36 +220,32 @@ class InertialRelaxation:
                 rows = self._rows(broken)
             s_p = np.where(broken, cl.converged_slip(ds, status, fs, net.ks), s_p)
             r = net.k_grain @ u + rows[0] @ fn + rows[1] @ fs
-            stress = self.platen_stress(r)
+            stress = eq.reaction_stress(r - eq.f_ext)
             f = eq.f_ext - r
             damped_step(u, v, f, inv_m, dt, damping)
-            closure += dt * servo.speed(stress, dt)
+            closure += dt * control.speed(stress, dt)
             steps += 1
             if steps % cp.check_period:
                 continue
-            strain = closure / net.height
-            if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
-                                                  strain):
-                return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), COLLAPSE, \
-                    steps, gave_out, int(broken.sum()) - broken0
+            if control.watch is not None and control.watch.update(
+                    collapsing(control, cp.check_period, cp.collapse_stress_ratio), closure / net.height):
+                return end(now(), COLLAPSE)
             if control.lost(stress):
-                return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode), LOST_LOAD, \
-                    steps, gave_out, int(broken.sum()) - broken0
+                return end(now(), LOST_LOAD)
             if steps < next_take_back:
                 continue
-            if self._at_rest(f, fn, fs, broken) and control.held(stress):
-                relaxed = self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
-                back = take_back(relaxed) if take_back is not None else (relaxed, None)
+            if relative_force(net, f, fn, fs, broken) < cp.equilibrium_tolerance and control.held(stress):
+                back = take_back(now()) if take_back is not None else (now(), None)
                 if back is not None:
-                    return back[0], back[1], steps, gave_out, int(back[0].broken.sum()) - broken0
+                    return end(*back)
                 gave_out += 1
                 next_take_back = steps + cp.check_period * 2 ** gave_out
-        last = self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
+        last = now()
         if isinstance(control, FixedPlatens) and take_back is not None:
             back = take_back(last)
             if back is not None:
-                return back[0], back[1], steps, gave_out, int(back[0].broken.sum()) - broken0
-        return last, LOST_LOAD, steps, gave_out, int(broken.sum()) - broken0
+                return end(*back)
+        return end(last, LOST_LOAD)
 
     def intact_modulus(self) -> float:
         """The intact specimen's axial modulus dS/d(strain) [Pa] (the servo's gain and the wave-crossing budget where
@@ -265,16 +259,6 @@ class InertialRelaxation:
     def _rows(self, broken):
         gn, gt = self.eq.force_rows(broken)
         return gn.T.tocsr(), gt.T.tocsr()
-
-    def _at_rest(self, f, fn, fs, broken) -> bool:
-        """The creep protocol's measure (:func:`grainfrac_yade.protocols.loading.relaxed`) below its tolerance."""
-        mv = self._moving
-        force = np.hypot(*(np.where(mv[:, k] >= 0, f[np.maximum(mv[:, k], 0)], 0.0) for k in range(2)))
-        intact = ~broken
-        if not intact.any():
-            return False
-        ref = float(np.hypot(fn[intact], fs[intact]).mean())
-        return ref > 0 and float(force.mean()) < self.params.creep.equilibrium_tolerance * ref
 
     def _state(self, closure, u, broken, status, sign, s_p, fn, fs, stress, mode) -> State:
         if not (np.all(np.isfinite(u)) and math.isfinite(stress)):
@@ -352,7 +336,7 @@ class InertialPath(RelaxingPath):
         finally:
             self._in_move = False
         dyn, c0 = self.dynamics, time.process_time()
-        stop = self.dynamics.params.ucs.stop_stress_ratio * start.stress
+        stop = dyn.params.ucs.stop_stress_ratio * start.stress
         state, reason, steps, gave_out, broken = dyn.relax(
             start, FixedPlatens(stop), self.jt, self.jc, lambda s: self.take_back(s, None, FailureRule(0.0),
                                                                                   start.closure))
@@ -360,12 +344,12 @@ class InertialPath(RelaxingPath):
         new = np.flatnonzero(state.broken & ~start.broken)
         self.records.append(Record(start.closure, start.stress, state.stress, new.tolist(),
                                    state.break_mode[new].tolist()))
-        self.relaxations.append(Relaxation(state, reason, start.closure, steps, gave_out, broken))
-        self.tally += (1, steps, gave_out, broken)
+        self.count(Relaxation(state, reason, start.closure, steps, gave_out, broken))
         self.last_converged = state
         # a specimen that lost its load with the platens held has failed: nothing lies ahead on the path (the
         # protocol's rows show the drop and its post-peak rule ends the test)
         return state, "none" if reason else "break"
 
 
-__all__ = ["FixedPlatens", "InertialPath", "InertialRelaxation", "HeldServo", "damped_step", "dof_masses", "critical_step", "LOST_LOAD"]
+__all__ = ["FixedPlatens", "InertialPath", "InertialRelaxation", "HeldServo", "damped_step", "dof_masses", "critical_step",
+           "LOST_LOAD"]

@@ -436,8 +436,12 @@ class Equilibrium:
         n = self.net
         gn, gt = self.summed_rows(broken)
         r = n.k_grain @ u + gn.T @ fn + gt.T @ fs
-        if constant:
-            r = r - self.f_ext
+        return self.reaction_stress(r - self.f_ext if constant else r)
+
+    def reaction_stress(self, r: np.ndarray) -> float:
+        """Platen stress [Pa, compression positive] of the force ``r`` (ndof,) [N] on the platen nodes: half the
+        bottom's y sum less the top's, over width x thickness."""
+        n = self.net
         return 0.5 * (r[n.dofs[n.bottom, 1]].sum() - r[n.dofs[n.top, 1]].sum()) / (n.width * n.thickness)
 
     # ------------------------------------------------------------------ the active-set iteration
