@@ -26,6 +26,7 @@ from grainfrac_yade.hybrid import scene as hybrid_scene
 from grainfrac_yade.static.cascade import LargeCascade
 from grainfrac_yade.static.inertial import FixedPlatens, InertialRelaxation
 from grainfrac_yade.yade_adapter import engine as dynamic_engine
+from studies.pass_through_probe import initial_gap
 
 
 class Captured(BaseException):
@@ -60,14 +61,6 @@ class StopAfter(FixedPlatens):
     def lost(self, stress: float) -> bool:
         self.left -= 1
         return self.left <= 0
-
-
-def initial_gap(scene) -> np.ndarray:
-    """(bonds,) in the network's order: the initial distance of each bond's two sphere centres along its face
-    normal [m] (YADE's smooth-joint ``initD``; about the contact inset x the two centroid-face distances)."""
-    lay = scene.layout
-    p, b = lay.sphere_center[:, :2], lay.bond_spheres
-    return np.abs(((p[b[:, 0]] - p[b[:, 1]]) * lay.bond_normal).sum(1))[scene.net.order]
 
 
 class PassThrough:
@@ -119,7 +112,7 @@ def main(argv=None):
     core_dt = rel.dt
     rel.dt = dyn.dt
     if a.pass_through:
-        rel.net = dataclasses.replace(rel.net, cn=PassThrough(rel.net.cn, initial_gap(scene)))
+        rel.net = dataclasses.replace(rel.net, cn=PassThrough(rel.net.cn, initial_gap(scene.layout, scene.net)))
     if a.damping is not None:
         rel.damping = a.damping
         dyn.relaxation_damping(a.damping)
