@@ -38,6 +38,8 @@ declare -A WHAT=(
   [lab_creep]="docs/studies/lab_calibration.md creep of the preset and of the corner candidate, and the preset's rate check (params/ldb_lab_creep.table, lab_corner_creep.table, ldb_lab_rate_ucs.table; 10 x 20 mm fem: 47-520 CPU s per creep row, the 0.4 rows the dearest): about 1.5 h on one core"
   [fem_mesh]="docs/studies/paper_fem.md mesh resolution: 10 x 20 mm fem UCS at 2 and 3 bonds per face (the 10 x 20 mm rows of params/fem_size_mesh_ucs.table: 94-164 and about 500 CPU s) and the creep rows at 0.7 and 0.85 of each run's own UCS that studies/fem_size_mesh.py writes from them"
   [lab_disc_size]="docs/studies/lab_calibration.md disc-size probe: fem Brazilian discs of 10, 20 and 31.7 mm (params/lab_disc_size.table, 14 discs: 43-57 CPU s at 10 mm, 6-12 CPU min at 20 mm, 31.7 mm not measured)"
+  [paper_static]="docs/studies/paper_static.md creep rows and docs/studies/paper_static/runs.csv, report/ (params/paper_static_inertial_creep.table: 20 paper-size fem creep rows on the static engine, 5.5-15 CPU min each: about 3.5 h on one core)"
+  [lifetime_sensitivity]="docs/studies/paper_static.md lifetime sensitivity, docs/studies/paper_static/lifetime_sensitivity.{csv,md} (params/lifetime_sensitivity_static_small.table: 30 rows of 10 x 20 mm fem creep on the static engine, 10-40 CPU s each: about 15 min on one core)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -122,6 +124,12 @@ run_target() {
                    $PY -m studies.brazilian_table results/lab_disc_size ;;
     accuracy_cost_paper_size) batch params/accuracy_cost_paper_size.table creep.py accuracy_cost_paper_size
                               $PY -m grainfrac_yade analyze results/accuracy_cost_paper_size ;;
+    paper_static) $PY -m grainfrac_yade batch params/paper_static_inertial_creep.table --jobs 1
+                  $PY -m grainfrac_yade analyze results/paper_static_inertial --out docs/studies/paper_static/report
+                  cp docs/studies/paper_static/report/runs.csv docs/studies/paper_static/runs.csv ;;
+    lifetime_sensitivity) $PY -m grainfrac_yade batch params/lifetime_sensitivity_static_small.table --jobs 1
+                          $PY -m studies.lifetime_sensitivity results/lifetime_sensitivity_static \
+                              --out docs/studies/paper_static/lifetime_sensitivity ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
   esac
 }
@@ -133,7 +141,8 @@ fi
 targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
-                           regularisation lab_bands lab_calibration lab_creep lab_disc_size fem_mesh paper_fem)
+                           regularisation lab_bands lab_calibration lab_creep lab_disc_size fem_mesh paper_fem paper_static
+                           lifetime_sensitivity)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)
