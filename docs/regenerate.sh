@@ -39,7 +39,7 @@ declare -A WHAT=(
   [fem_mesh]="docs/studies/paper_fem.md mesh resolution: 10 x 20 mm fem UCS at 2 and 3 bonds per face (the 10 x 20 mm rows of params/fem_size_mesh_ucs.table: 94-164 and about 500 CPU s) and the creep rows at 0.7 and 0.85 of each run's own UCS that studies/fem_size_mesh.py writes from them"
   [lab_disc_size]="docs/studies/lab_calibration.md disc-size probe: fem Brazilian discs of 10, 20 and 31.7 mm (params/lab_disc_size.table, 14 discs: 43-57 CPU s at 10 mm, 6-12 CPU min at 20 mm, 31.7 mm not measured)"
   [paper_static]="docs/studies/paper_static.md creep rows and docs/studies/paper_static/runs.csv, report/ (params/paper_static_inertial_creep.table: 20 paper-size fem creep rows on the static engine, 5.5-15 CPU min each: about 3.5 h on one core)"
-  [lifetime_sensitivity]="docs/studies/paper_static.md lifetime sensitivity, docs/studies/paper_static/lifetime_sensitivity.{csv,md} (params/lifetime_sensitivity_static_small.table: 30 rows of 10 x 20 mm fem creep on the static engine, 10-40 CPU s each: about 15 min on one core)"
+  [lifetime_sensitivity]="docs/studies/paper_static.md lifetime sensitivity, docs/studies/paper_static/lifetime_sensitivity.{csv,md} (params/lifetime_sensitivity_static_small.table and lifetime_mesh_static_small.table: 40 rows of 10 x 20 mm fem creep on the static engine, 10 s to 3 min each: about 35 min on one core)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -128,6 +128,7 @@ run_target() {
                   $PY -m grainfrac_yade analyze results/paper_static_inertial --out docs/studies/paper_static/report
                   cp docs/studies/paper_static/report/runs.csv docs/studies/paper_static/runs.csv ;;
     lifetime_sensitivity) $PY -m grainfrac_yade batch params/lifetime_sensitivity_static_small.table --jobs 1
+                          $PY -m grainfrac_yade batch params/lifetime_mesh_static_small.table --jobs 1
                           $PY -m studies.lifetime_sensitivity results/lifetime_sensitivity_static \
                               --out docs/studies/paper_static/lifetime_sensitivity ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
