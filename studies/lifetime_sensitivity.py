@@ -6,9 +6,10 @@
 Reads the run folders of ``params/lifetime_sensitivity_static_small.table`` (descriptions ``<variant>_s<seed>``) and,
 per variant against ``base`` on the same seed: d ln t_f (both failed), d ln t_(k) of the k-th shortest time to
 failure of a contact at creep start under its frozen stresses (paper Eq. 7 integrated: (J - s) / (beta1
-exp(beta2 s)) per channel, s = sigma_n in tension, tau in shear, from bond_stresses_start.csv), and the stress shift
+exp(beta2 s)) per channel, from bond_stresses_start.csv), and the stress shift
 that change of the tail is worth, -d ln t_(k) / beta2 [MPa].  Writes ``<out>.csv`` (one row per run) and
-``<out>.md`` (one row per variant: mean and range over the seeds).
+``<out>_variants.csv`` and ``<out>.md`` (one row per variant: the change per seed, a run that did not fail as a lower
+bound, and the mean over the seeds where both failed).
 """
 from __future__ import annotations
 
@@ -20,20 +21,20 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from grainfrac_yade.law.hillig_charles import time_to_failure
+
 #: The k of the tail's k-th shortest contact time to failure [1].
 TAIL_RANK = 10
 
 
 def contact_times(stresses: pd.DataFrame, beta1: float, beta2: float) -> np.ndarray:
-    """(bonds,) each intact contact's time to failure at creep start under frozen stresses [s] (Eq. 7): the shorter
-    of its tension channel (sigma_n > 0) and its shear channel; inf where neither corrodes to failure."""
-    out = np.full(len(stresses), math.inf)
-    for stress, util in ((stresses.normal_stress_pa.to_numpy(), stresses.tensile_utilisation.to_numpy()),
-                         (stresses.shear_stress_pa.to_numpy(), stresses.shear_utilisation.to_numpy())):
-        ok = (stress > 0) & (util > 0) & (util < 1)
-        margin = np.where(ok, stress * (1.0 / np.where(ok, util, 1.0) - 1.0), math.inf)
-        out = np.minimum(out, margin / (beta1 * np.exp(beta2 * np.where(ok, stress, 0.0))))
-    return out
+    """(bonds,) each intact contact's time to failure at creep start under frozen stresses [s]: paper Eq. 7's closed
+    form (:func:`grainfrac_yade.law.hillig_charles.time_to_failure`), its strengths read back from the stresses and
+    utilisations of bond_stresses_start.csv (J^T = sigma / u_T; the shear strength J^C + s_n tan(phi) = tau / u_S,
+    carried by the cohesion channel)."""
+    sigma, tau = stresses.normal_stress_pa.to_numpy(), stresses.shear_stress_pa.to_numpy()
+    u_t, u_s = stresses.tensile_utilisation.to_numpy(), stresses.shear_utilisation.to_numpy()
+    return time_to_failure(sigma / u_t, tau / u_s, sigma, tau, 0.0, beta1, beta2)[0]
 
 
 def run_row(folder: Path) -> dict:
@@ -51,21 +52,34 @@ def run_row(folder: Path) -> dict:
             "cpu_s": float(summary["cpu_s"]), "folder": folder.name}
 
 
-def variant_table(runs: pd.DataFrame) -> pd.DataFrame:
+def paired_changes(g: pd.DataFrame, base: pd.DataFrame, limit: float) -> list:
+    """Per seed (base failed): (seed, d ln t_f, censored) of a variant's runs ``g`` against ``base`` (both indexed by
+    seed); a variant run that did not fail by ``limit`` [s] gives the lower bound ln(limit / t_base)."""
+    out = []
+    for seed in g.index:
+        if seed in base.index and base.failed[seed]:
+            if g.failed[seed]:
+                out.append((seed, math.log(g.lifetime_s[seed] / base.lifetime_s[seed]), False))
+            else:
+                out.append((seed, math.log(limit / base.lifetime_s[seed]), True))
+    return out
+
+
+def variant_table(runs: pd.DataFrame, limit: float) -> pd.DataFrame:
+    """One row per variant: its paired changes of ln t_f against ``base`` (censored ones as lower bounds), the mean
+    over the seeds where both failed, and the mean change of the tail (all seeds)."""
     base = runs[runs.variant == "base"].set_index("seed")
     tail = f"tail_time_{TAIL_RANK}_s"
     rows = []
     for variant, g in runs.groupby("variant", sort=False):
         g = g.set_index("seed")
-        both = [s for s in g.index if s in base.index and g.failed[s] and base.failed[s]]
-        d_life = np.array([math.log(g.lifetime_s[s] / base.lifetime_s[s]) for s in both])
+        pairs = paired_changes(g, base, limit)
+        exact = [d for _, d, censored in pairs if not censored]
         d_tail = np.array([math.log(g[tail][s] / base[tail][s]) for s in g.index if s in base.index])
-        shift = -d_tail / g.beta2_per_pa.iloc[0] / 1e6
         rows.append({"variant": variant, "seeds_failed": f"{int(g.failed.sum())} of {len(g)}",
-                     "dln_tf_mean": d_life.mean() if len(d_life) else math.nan,
-                     "dln_tf_min": d_life.min() if len(d_life) else math.nan,
-                     "dln_tf_max": d_life.max() if len(d_life) else math.nan, "paired_seeds": len(d_life),
-                     "dln_tail_mean": d_tail.mean(), "tail_shift_mpa_mean": shift.mean(),
+                     "dln_tf_mean": float(np.mean(exact)) if exact else math.nan, "paired_seeds": len(exact),
+                     "dln_tf_per_seed": ", ".join(f"s{s} {'>' if c else ''}{d:+.2f}" for s, d, c in pairs),
+                     "dln_tail_mean": d_tail.mean(), "tail_shift_mpa_mean": -d_tail.mean() / g.beta2_per_pa.iloc[0] / 1e6,
                      "broken_ramp_mean": g.broken_ramp.mean(), "cpu_s_mean": g.cpu_s.mean()})
     return pd.DataFrame(rows)
 
@@ -74,17 +88,20 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("study")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--creep-time-limit", type=float, default=1e9,
+                    help="the runs' stress_corrosion.creep_time_limit [s]: a run not failed by it is a lower bound")
     a = ap.parse_args(argv)
     folders = sorted(p.parent for p in Path(a.study).glob("*/summary.json"))
     runs = pd.DataFrame([run_row(f) for f in folders]).sort_values(["variant", "seed"], kind="stable")
     runs.to_csv(a.out + ".csv", index=False)
-    table = variant_table(runs)
-    lines = ["| variant | failed | d ln t_f mean (min / max) over paired seeds | d ln t_(10) at creep start | "
-             "tail shift [MPa] | bonds broken in the ramp | CPU [s] |", "|---|---|---|---|---|---|---|"]
+    table = variant_table(runs, a.creep_time_limit)
+    table.to_csv(a.out + "_variants.csv", index=False)
+    lines = ["| variant | failed | d ln t_f per seed (> : not failed by the time limit, a lower bound) | mean where both "
+             "failed | d ln t_(10) at creep start | tail shift [MPa] | bonds broken in the ramp | CPU [s] |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in table.itertuples():
-        life = (f"{r.dln_tf_mean:+.2f} ({r.dln_tf_min:+.2f} / {r.dln_tf_max:+.2f}), {r.paired_seeds}"
-                if r.paired_seeds else "-")
-        lines.append(f"| {r.variant} | {r.seeds_failed} | {life} | {r.dln_tail_mean:+.2f} | "
+        mean = f"{r.dln_tf_mean:+.2f} ({r.paired_seeds})" if r.paired_seeds else "-"
+        lines.append(f"| {r.variant} | {r.seeds_failed} | {r.dln_tf_per_seed} | {mean} | {r.dln_tail_mean:+.2f} | "
                      f"{r.tail_shift_mpa_mean:+.1f} | {r.broken_ramp_mean:.0f} | {r.cpu_s_mean:.0f} |")
     Path(a.out + ".md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
