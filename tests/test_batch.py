@@ -41,6 +41,7 @@ def _log_lines(folder):
 TINY_ROW = {"specimen.width": 3e-3, "specimen.height": 6e-3, "ratio": 0.8, "ucs": 300e6, "seed": 1}
 
 
+@pytest.mark.slow   # about 16 s: the default suite stays under about 10 min
 def test_a_rerun_after_a_parameter_edit_stops_or_runs_into_a_new_folder(tmp_path):
     out = tmp_path / "row"
     script = ROOT / "yade_scripts" / "creep.py"

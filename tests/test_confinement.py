@@ -127,6 +127,7 @@ def test_confinement_forces_consolidation_and_a_higher_peak(tmp_path):
     assert peaks[20 * MPA] > peaks[0.0] + 20 * MPA   # more than the confinement itself: friction mobilised
 
 
+@pytest.mark.slow   # about 17 s: the default suite stays under about 10 min
 @needs_yade
 @pytest.mark.yade
 def test_a_confined_creep_run_killed_mid_creep_resumes_to_the_uninterrupted_result(tmp_path):

@@ -112,6 +112,7 @@ def test_small_specimen_creep_curve_has_three_stages():
     assert inner[0] > STAGE_RATE_FACTOR * inner.min() and inner[-1] > STAGE_RATE_FACTOR * inner.min()
 
 
+@pytest.mark.slow   # about 14 s: the default suite stays under about 10 min
 def test_hold_budget_in_wave_crossings(small_ucs):
     """The hold's budget: by default the fixed step counts exactly; with crossings, ceil(crossings x H / (c dt)),
     c = sqrt(E / rho) from the servo's modulus estimate and the scene's density (closed form, to the last bit).

@@ -418,6 +418,7 @@ def test_a_run_killed_inside_a_relaxation_resumes_to_the_uninterrupted_result(tm
     assert resumed["n_events"] == s["n_events"]
 
 
+@pytest.mark.slow   # about 9 s: the default suite stays under about 10 min
 @needs_yade
 @pytest.mark.yade
 def test_a_creep_run_killed_in_its_ramp_resumes_to_the_uninterrupted_result(tmp_path):
@@ -436,6 +437,7 @@ def test_a_creep_run_killed_in_its_ramp_resumes_to_the_uninterrupted_result(tmp_
     assert [(r["dem_steps"], r["phase"]) for r in resumed["resumed_from"]] == [(state["dem_steps"], "loading")]
 
 
+@pytest.mark.slow   # about 9 s: the default suite stays under about 10 min
 @needs_yade
 @pytest.mark.yade
 def test_a_yade_batch_rerun_resumes_an_unfinished_ucs_row(tmp_path):

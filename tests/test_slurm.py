@@ -415,6 +415,7 @@ def test_a_three_row_study_runs_through_slurm_as_local_batch_rows(slurm, tmp_pat
     assert res.returncode == 0 and "nothing to submit: 3 finished" in res.stdout
 
 
+@pytest.mark.slow   # about 21 s: the default suite stays under about 10 min
 @needs_yade
 @pytest.mark.yade
 def test_a_cancelled_task_is_the_only_row_submit_runs_again(slurm, tmp_path):

@@ -56,6 +56,7 @@ def test_the_post_peak_stop_waits_for_the_minimum_strain():
     assert h1["axial_strain"][-1] >= 1.5 * end and len(h1["axial_strain"]) > n
 
 
+@pytest.mark.slow   # about 12 s: the default suite stays under about 10 min
 def test_doubled_strengths_give_a_higher_ucs():
     base, _, _ = _ucs([])
     p = load_parameters()
