@@ -112,7 +112,7 @@ def main(argv=None):
     core_dt = rel.dt
     rel.dt = dyn.dt
     if a.pass_through:
-        rel.net = dataclasses.replace(rel.net, cn=PassThrough(rel.net.cn, initial_gap(scene.layout, scene.net)))
+        rel.net = dataclasses.replace(rel.net, cn=PassThrough(rel.net.cn, initial_gap(scene)))
     if a.damping is not None:
         rel.damping = a.damping
         dyn.relaxation_damping(a.damping)

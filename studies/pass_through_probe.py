@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from grainfrac_yade.static.cascade import Path
+from grainfrac_yade.static.scene import StaticScene
 from grainfrac_yade.static.solver import Equilibrium
 from grainfrac_yade.static.ucs import ucs_path
 from studies.static_engine_probe import specimen_arguments, specimen_layout
@@ -28,11 +29,11 @@ from studies.static_engine_probe import specimen_arguments, specimen_layout
 REPORT_EVERY = 5e-4
 
 
-def initial_gap(layout, net) -> np.ndarray:
-    """(bonds,) in the network's order: the initial distance of each bond's sphere centres along its face normal [m]
-    (YADE's smooth-joint ``initD``)."""
-    p, b = layout.sphere_center[:, :2], layout.bond_spheres
-    return np.abs(((p[b[:, 0]] - p[b[:, 1]]) * layout.bond_normal).sum(1))[net.order]
+def initial_gap(scene) -> np.ndarray:
+    """(bonds,) in the static network's order: each bond's stress-free normal gap [m], as the scene exports it for a
+    dynamic engine (``bond_reference_gap``: for bonds on their face's plane the sphere centres' distance along the
+    face normal, YADE's smooth-joint ``initD``)."""
+    return scene.export_state().bond_reference_gap[scene.net.order]
 
 
 class GapPath(Path):
@@ -61,11 +62,12 @@ def main(argv=None):
     ap = specimen_arguments(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     ap.add_argument("--max-strain", type=float, default=0.006)
     a = ap.parse_args(argv)
-    p, s, lay, net = specimen_layout(a)
-    gap = initial_gap(lay, net)
-    print(json.dumps({"seed": a.seed, "contact_inset": p.resolution.contact_inset, "bonds": net.n_bonds,
+    p, s, lay, _ = specimen_layout(a)
+    scene = StaticScene(s, p, lay)
+    gap = initial_gap(scene)
+    print(json.dumps({"seed": a.seed, "contact_inset": p.resolution.contact_inset, "bonds": scene.n_bonds,
                       "gap_um_median": float(np.median(gap)) * 1e6, "gap_um_min": float(gap.min()) * 1e6}))
-    eq = Equilibrium(net)
+    eq = Equilibrium(scene.net)
     ucs_path(eq, a.max_strain, p.ucs.stop_stress_ratio, path=GapPath(eq, gap))
 
 
