@@ -62,6 +62,8 @@ STATE_FIELDS = ("closure", "u", "broken", "status", "sign", "s_p", "fn", "fs", "
 #: Grain models whose bonds act on their face's plane (fem cells: a node sphere on each side of the face), whose
 #: reference gap is the spheres' distance along the face normal and whose plane normal a state carries.
 BONDS_ON_FACES = ("fem",)
+#: Prefix of the solver's kept state (:meth:`.solver.Equilibrium.factor_state`) in a saved scene's arrays.
+FACTOR_PREFIX = "factor_"
 #: Name the static engine's parts carry in :meth:`StaticScene.engine_names`.
 EQUILIBRIUM_NAME = "StaticEquilibrium"
 
@@ -111,6 +113,8 @@ class StaticPlatens:
             raise GrainfracError(f"static engine: a held platen stress must be finite and > 0 Pa (got {target!r}); "
                                  "fix: a positive creep stress")
         gain = self.height / (young * response_steps) if young > 0 and response_steps > 0 else 0.0
+        # a hold starts from a fresh factor of the ramp's end state, not from the ramp's low-rank history
+        self.scene.eq.forget_factor()
         return self._servo(StaticServo(self.scene, float(target), gain, float(max_speed)))
 
     def resume_hold(self, saved: dict) -> "StaticServo":
@@ -506,12 +510,13 @@ class StaticScene:
         return out
 
     def save(self, path) -> None:
-        """An ``.npz`` of the core's state, strengths, bookkeeping and counters (exact doubles).  The kept factor is
-        dropped here (the solver's answers depend on it at round-off), so that the run that saves and the run that
-        restores go on from the same solver state, bit for bit."""
+        """An ``.npz`` of the core's state, strengths, bookkeeping and counters (exact doubles), and what rebuilds
+        the solver's kept factor (:meth:`.solver.Equilibrium.factor_state`: its answers depend on it at round-off).
+        Saving only reads: a run that saves goes on as one that does not, and a restored one as both."""
+        arrays = self._arrays()
+        arrays.update({FACTOR_PREFIX + k: v for k, v in self.eq.factor_state().items()})
         with open(path, "wb") as fh:
-            np.savez(fh, **self._arrays())
-        self.eq.forget_factor()
+            np.savez(fh, **arrays)
 
     def restore(self, path) -> None:
         """Replace this scene's state by the one :meth:`save` wrote (same specimen and parameters)."""
@@ -528,7 +533,7 @@ class StaticScene:
         for k in ("held", "iterations"):
             values[k] = int(values[k])
         self.state = State(**values)
-        self.eq.forget_factor()
+        self.eq.restore_factor_state({k[len(FACTOR_PREFIX):]: v for k, v in a.items() if k.startswith(FACTOR_PREFIX)})
         self.path.jt, self.path.jc = a["jt"].copy(), a["jc"].copy()
         self.path.restore_arrays(a)
         self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()

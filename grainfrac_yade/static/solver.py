@@ -181,6 +181,7 @@ class Equilibrium:
         self.counters = Counters()
         self._ground = None
         self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
+        self._plain = None      # (status, sign) of the kept plain factor (_factor_now)
         ea, eb = net_tri_edges(net)
         nn = len(net.node_pos)
         self._n_cells, self._cell_of_node = connected_components(
@@ -199,9 +200,49 @@ class Equilibrium:
     def forget_factor(self):
         """Drop the kept factor (and with it the low-rank history): the next solve factorises afresh, as a new
         ``Equilibrium`` on the same network would.  The fast path's answers depend on which factor is kept at
-        round-off (1e-12 relative); a caller that saves and restores a run calls this at every save, in the saved
-        and in the uninterrupted run alike, so that both go on bit for bit."""
-        self._key, self._lr, self._op, self._lu, self._k = None, None, None, None, None
+        round-off (1e-12 relative), so a run that drops it goes on along another rounding than one that does not."""
+        self._key, self._lr, self._op, self._lu, self._k, self._plain = None, None, None, None, None, None
+
+    def factor_state(self) -> dict:
+        """What rebuilds the solver's kept state bit for bit (:meth:`restore_factor_state`), as arrays: the ground
+        springs (made from the first tangent that needed them); the fast path's reference factor as the statuses
+        it was made at (its contacts' coefficients and fixed dofs), the largest residual of a direct solve on it and
+        the K^-1 U columns it computed, in their blocks; or the plain factor's statuses (direct or grounded).
+        Reading it changes nothing: a run that saves it goes on as one that does not."""
+        out = {}
+        if self._ground is not None:
+            out["ground"] = self._ground.diagonal().copy()
+        if self._lr is not None:
+            a_nn, a_sn, a_ss, broken = self._lr.coef
+            out.update(reference_a_nn=a_nn, reference_a_sn=a_sn, reference_a_ss=a_ss, reference_broken=broken,
+                       reference_fixed=self._lr_fixed, reference_residual=np.float64(self._lr.direct_residual),
+                       reference_columns=self._lr.column_table())
+        elif self._plain is not None and self._key is not None:
+            status, sign = self._plain
+            out.update(plain_status=status, plain_sign=sign, plain_ground=np.bool_(self._grounded))
+        return out
+
+    def restore_factor_state(self, saved: dict) -> None:
+        """Rebuild the kept state :meth:`factor_state` gave: the same matrices factorised with the same options and
+        the same columns back-substituted in the same blocks give the same factor and columns, bit for bit (on one
+        machine), so the next solve answers as the saved run's did.  An empty ``saved`` (a checkpoint written
+        before these were kept) drops the factor instead."""
+        self.forget_factor()
+        if "ground" in saved:
+            self._ground = sp.diags(np.asarray(saved["ground"], float))
+        if "reference_fixed" in saved:
+            coef = tuple(np.asarray(saved["reference_" + k], float) for k in ("a_nn", "a_sn", "a_ss")) + \
+                (np.asarray(saved["reference_broken"], bool),)
+            self._fixed = np.asarray(saved["reference_fixed"], bool)
+            self._kff = self._pattern.free_block(self._pattern.data(*coef), self._fixed)
+            self._coef = coef
+            self._refactor_fast()
+            self._lr.direct_residual = float(saved["reference_residual"])
+            self._lr.replay(saved["reference_columns"])
+        elif "plain_status" in saved:
+            status, sign = np.asarray(saved["plain_status"]), np.asarray(saved["plain_sign"], float)
+            key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
+            self._factor_now(key, status, sign, np.zeros(self.net.n_bonds), bool(saved["plain_ground"]))
 
     # ------------------------------------------------------------------ assembly
     def force_rows(self, broken):
@@ -353,7 +394,7 @@ class Equilibrium:
         self.counters.factorisations += 1
         self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
         self._kfc = k[free][:, fixed].tocsr()
-        self._op, self._lr = _PlainOp(lu), None
+        self._op, self._lr, self._plain = _PlainOp(lu), None, (status.copy(), np.asarray(sign, float).copy())
         if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread
             d = np.abs(lu.U.diagonal())
             if d.min() <= PIVOT_RATIO * d.max():

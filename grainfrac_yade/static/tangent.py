@@ -202,6 +202,9 @@ class LowRankSolver:
     def __init__(self, net, lu, coef, free, max_contacts=MAX_LOW_RANK_CONTACTS):
         self.net, self.lu, self.coef, self.free, self.max_contacts = net, lu, coef, free, max_contacts
         self._z = {}            # (contact, coefficients) -> K^-1 U columns (n x 2, free dofs)
+        #: the keys of every back-substitution of U columns, in the order and blocks they were computed (what
+        #: :meth:`replay` repeats to rebuild :attr:`_z` bit for bit: a block's columns are solved together)
+        self.blocks = []
         #: Columns back-substituted on the reference factor (each U column counts one, whether solved alone or
         #: in a block with others; each solve of a right-hand side counts one).
         self.back_substitutions = 0
@@ -243,7 +246,21 @@ class LowRankSolver:
             self.back_substitutions += u.shape[1]
             for q, j in enumerate(miss):
                 self._z[keys[j]] = z[:, 2 * q:2 * q + 2]
+            self.blocks.append([keys[j] for j in miss])
         return [self._z[k] for k in keys]
+
+    def column_table(self) -> np.ndarray:
+        """(k, 6) the keys of :attr:`blocks` as rows (block, contact, a_nn, a_sn, a_ss, broken): exact doubles."""
+        rows = [(b,) + key for b, keys in enumerate(self.blocks) for key in keys]
+        return np.array(rows, float).reshape(-1, 6)
+
+    def replay(self, table: np.ndarray) -> None:
+        """Compute the K^-1 U columns of :meth:`column_table`'s rows block by block, as they were first computed:
+        the same right-hand sides in the same blocks on the same factor give the same columns, bit for bit."""
+        table = np.asarray(table, float).reshape(-1, 6)
+        for b in np.unique(table[:, 0]):
+            rows = table[table[:, 0] == b]
+            self._columns([int(r[1]) for r in rows], [(r[2], r[3], r[4], bool(r[5])) for r in rows])
 
     def prepare(self, coef_new):
         """The low-rank operator for the new coefficients, or None where it is not worth it (too many changes)."""
