@@ -3,7 +3,8 @@
 The static engine's scene, tests and bond writer (:mod:`grainfrac_yade.static.engine`), with dynamic stints on
 YADE where statics give out (:class:`.scene.HybridScene`).  Between stints nothing moves in time: the paper clock
 (Eq. 8 measures an unbalanced force at every creep step) is refused as on the static engine.  The dynamic settings
-(damping, mass scaling, the servo and the relaxation budgets) are used by the stints, so none is reported unused.
+(damping, mass scaling, the servo and the relaxation budgets) are used by the stints, so none is reported unused;
+the static engine's relaxation settings are not (:mod:`.settings`).
 Importing this module does not import YADE: the first stint does.
 """
 from __future__ import annotations
@@ -13,6 +14,7 @@ from ..static.engine import (VTK_REFUSED,  # noqa: F401
 from ..static.engine import UNSUPPORTED as STATIC_UNSUPPORTED
 from ..static.engine import version as static_version
 from .scene import HybridScene, build_scene, scene_from_state  # noqa: F401
+from .settings import warn_not_used
 
 #: The value of ``numerics.engine`` that selects this engine.
 NAME = "hybrid"
@@ -31,5 +33,6 @@ def version() -> str:
 
 
 def warn_dynamic_only(overrides, params) -> list:
-    """None: the dynamic stints read every dynamic setting."""
-    return []
+    """The dynamic stints read every dynamic setting; the static relaxation's settings are not read
+    (:mod:`.settings`)."""
+    return warn_not_used(overrides)

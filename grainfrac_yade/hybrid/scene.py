@@ -54,6 +54,7 @@ from ..protocols.creep_loops import CollapseWatch, collapsing
 from ..protocols.loading import held_at_equilibrium, relaxed
 from ..static.cascade import LargeCascade
 from ..static.scene import StaticScene
+from .settings import not_used_settings
 from ..wave import hold_budget, scene_density
 from ..yade_adapter import engine as dynamic_engine
 
@@ -75,6 +76,9 @@ class HybridScene(StaticScene):
     """A static scene whose solves hand over to YADE's dynamics where statics give out (module doc)."""
 
     engine_name = "hybrid"
+    #: Where statics give out, the plain static path gives out and YADE's dynamic stint relaxes instead
+    #: (``numerics.static_relaxation`` is not read).
+    relaxation = "none"
 
     def __init__(self, specimen, params, layout=None):
         super().__init__(specimen, params, layout)
@@ -293,7 +297,8 @@ class HybridScene(StaticScene):
     def summary_keys(self) -> dict:
         """The engine's name, no unused settings (the stints use the dynamic ones), and the stints' totals and log."""
         keys = super().summary_keys()
-        keys.update({"engine": self.engine_name, "settings_not_used": {}, "dynamic_stints": len(self.stints),
+        keys.update({"engine": self.engine_name, "settings_not_used": not_used_settings(self.params),
+                     "dynamic_stints": len(self.stints),
                      "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
                      "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
                      "dynamic_stint_log": list(self.stints),

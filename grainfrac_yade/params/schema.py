@@ -117,14 +117,15 @@ class NumericsParams:
                         "explicit DEM with dynamic relaxation; static = static equilibrium between bond failures (grainfrac_yade.static: "
                         "no inertia, no loading rate); hybrid = static, with YADE's dynamics where the static "
                         "equilibrium gives out or a cascade grows (grainfrac_yade.hybrid)", ("yade", "static", "hybrid"))
-    static_relaxation: str = _spec("", "choice", "static and hybrid engines: what a held-load regain does where no "
-                                   "static status set settles: none = the engine gives out (static: a numerical "
-                                   "failure; hybrid: YADE's dynamics take over); overdamped = implicit overdamped "
-                                   "relaxation to rest or to the failure rule (grainfrac_yade.static.damped), and only "
-                                   "then the engine gives out; inertial = explicit dynamics of the same network (masses "
-                                   "of the grain model with numerics.density_scale, numerics.damping, the creep "
-                                   "protocol's servo, equilibrium and collapse criteria and relaxation budget; "
-                                   "grainfrac_yade.static.inertial)", ("none", "overdamped", "inertial"))
+    static_relaxation: str = _spec("", "choice", "static engine: what a held-load regain or a displacement-"
+                                   "controlled path does where no static status set settles: inertial (the default) = "
+                                   "explicit dynamics of the same network (masses of the grain model with "
+                                   "numerics.density_scale, numerics.damping, the creep protocol's servo, equilibrium "
+                                   "and collapse criteria and relaxation budget; grainfrac_yade.static.inertial); "
+                                   "overdamped = implicit overdamped relaxation to rest or to the failure rule "
+                                   "(grainfrac_yade.static.damped), and only then the engine gives out; none = the "
+                                   "engine gives out there (a numerical failure).  The hybrid engine does not read it "
+                                   "(YADE's dynamic stints relax there)", ("none", "overdamped", "inertial"))
     static_relaxation_steps: int = _spec("1", "positive_int", "static_relaxation = overdamped: pseudo-time steps one "
                                          "relaxation may take before the engine gives out there")
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "

@@ -24,8 +24,9 @@ PATHS = {
 }
 
 
-def path_for(eq: Equilibrium, params, confinement: float = 0.0, masses=None) -> Path:
-    """The static path on ``eq`` for ``params`` (``numerics.static_relaxation`` picks it from :data:`PATHS`) under
-    the lateral traction ``confinement`` [Pa]; ``masses``: a callable giving the network's (ndof,) masses
-    (:func:`.inertial.dof_masses`), called only by a path that moves with inertia."""
-    return PATHS[params.numerics.static_relaxation](eq, params, confinement, masses)
+def path_for(eq: Equilibrium, params, confinement: float = 0.0, masses=None, relaxation: str | None = None) -> Path:
+    """The static path on ``eq`` for ``params`` (``numerics.static_relaxation`` picks it from :data:`PATHS`, or
+    ``relaxation`` where a scene relaxes its own way) under the lateral traction ``confinement`` [Pa]; ``masses``: a
+    callable giving the network's (ndof,) masses (:func:`.inertial.dof_masses`), called only by a path that moves
+    with inertia."""
+    return PATHS[relaxation or params.numerics.static_relaxation](eq, params, confinement, masses)

@@ -213,6 +213,8 @@ class StaticScene:
 
     #: The engine a checkpoint of this scene names (a checkpoint is resumed by the engine that wrote it).
     engine_name = "static"
+    #: The static path's relaxation (:data:`.paths.PATHS`); None: ``numerics.static_relaxation``.
+    relaxation = None
 
     def __init__(self, specimen, params, layout=None):
         self.specimen, self.params = specimen, params
@@ -224,7 +226,7 @@ class StaticScene:
         self.canon[self.net.order] = np.arange(m)
         self.confinement_stress = 0.0
         self.eq = Equilibrium(self.net)
-        self.path = path_for(self.eq, params, 0.0, self.masses)
+        self.path = path_for(self.eq, params, 0.0, self.masses, self.relaxation)
         self.drivers = []
         self._dt = load_increment(params)
         self._time = 0.0
@@ -474,7 +476,7 @@ class StaticScene:
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
-        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses)
+        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.relaxation)
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)
         self.state = self.eq.solve(self.state.closure, self.state)
