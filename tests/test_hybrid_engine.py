@@ -182,3 +182,25 @@ def test_a_hybrid_creep_killed_after_a_stint_resumes_to_the_uninterrupted_run(tm
     assert_resumed_as_whole(resumed, whole)
     strip = [{k: v for k, v in s.items() if k != "cpu_s"} for s in whole.scene.stints]
     assert [{k: v for k, v in s.items() if k != "cpu_s"} for s in resumed.scene.stints] == strip
+
+
+def test_the_hybrid_relaxes_by_its_stints_not_by_the_static_relaxation():
+    """The static engine's default relaxation is the inertial one; the hybrid's static path stays the plain one
+    (YADE's stints relax where it gives out), and a static relaxation given to it is warned about and recorded as
+    not used."""
+    from grainfrac_yade.engines.registry import engine
+    from grainfrac_yade.geometry.specimen import build_specimen
+    from grainfrac_yade.params import load_parameters
+    from grainfrac_yade.static.cascade import Path
+    from grainfrac_yade.static.inertial import InertialPath
+    p = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
+    assert p.numerics.static_relaxation == "inertial"
+    specimen = build_specimen(p, 1)
+    assert isinstance(engine("static").build_scene(specimen, p).path, InertialPath)
+    hybrid = engine("hybrid").build_scene(specimen, p)
+    assert type(hybrid.path) is Path
+    assert hybrid.summary_keys()["settings_not_used"] == {"numerics.static_relaxation": "inertial",
+                                                          "numerics.static_relaxation_steps": 1000}
+    lines = engine("hybrid").warn_dynamic_only(["numerics.static_relaxation=overdamped", "numerics.damping=0.5"], p)
+    assert lines == ["warning: --set numerics.static_relaxation: the hybrid engine relaxes by YADE's dynamics and "
+                     "does not use it"]

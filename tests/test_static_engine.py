@@ -110,7 +110,9 @@ def test_ucs_through_the_protocol_writes_a_run_folder(tmp_path):
         assert (out / name).exists(), name
     assert summary["numerical_failure"] is False and summary["peak_reached"] is True
     assert summary["ucs_pa"] > 0 and summary["engine"] == "static"
-    assert "numerics.damping" in summary["settings_not_used"]
+    # the inertial relaxation (the default) reads the integration's settings; the collider's none
+    assert "numerics.verlet_fraction" in summary["settings_not_used"]
+    assert "numerics.damping" not in summary["settings_not_used"]
     assert json.loads((out / "params.json").read_text())["numerics"]["engine"] == "static"
     text = (out / "history.csv").read_text() + (out / "summary.json").read_text() + (out / "cracks.csv").read_text()
     assert "nan" not in text.lower() and "infinity" not in text.lower()
@@ -249,7 +251,7 @@ def test_dynamic_only_setting_warns_once():
     from grainfrac_yade.static.engine import warn_dynamic_only
     given = ["numerics.damping=0.5", "specimen.width=3e-3", ("creep.servo_response_steps", 5),
              "numerics.verlet_fraction=0.2"]
-    lines = warn_dynamic_only(given, _params())
+    lines = warn_dynamic_only(given, _params("numerics.static_relaxation=none"))
     assert len(lines) == 3 and all("\n" not in s and s.startswith("warning:") for s in lines)
     # the inertial relaxation reads damping and the servo: only the collider's setting is left unused
     lines = warn_dynamic_only(given, _params("numerics.static_relaxation=inertial"))
