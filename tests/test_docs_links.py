@@ -1,4 +1,4 @@
-"""README.md and docs/: every relative link and image resolves, anchors included; the README stays short.
+"""README.md, CHANGELOG.md and docs/: every relative link and image resolves, anchors included; the README stays short.
 
 Pure file checks (no YADE). Links are read outside code blocks and inline code; web links are not
 fetched. An anchor (``file.md#heading``) must match a heading of the target as GitHub writes its ids
@@ -21,7 +21,7 @@ HEADING = re.compile(r"^(#{1,6})\s+(.*?)\s*#*\s*$")
 
 
 def _pages():
-    return [ROOT / "README.md"] + sorted((ROOT / "docs").rglob("*.md"))
+    return [ROOT / "README.md", ROOT / "CHANGELOG.md"] + sorted((ROOT / "docs").rglob("*.md"))
 
 
 def _prose(text: str) -> str:

@@ -1,11 +1,14 @@
 """Mechanical engines: what computes a scene's motion and bond forces (pure; the engines load lazily).
 
-Two engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep``, ``brazilian``):
+Three engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep``, ``brazilian``; docs/engines.md):
 
 * ``"yade"`` (the default): YADE's explicit DEM with dynamic relaxation
   (:mod:`grainfrac_yade.yade_adapter.engine`, which alone imports YADE);
-* ``"static"``: static equilibrium between bond failures, bonds broken one at a time
-  (:mod:`grainfrac_yade.static.engine`, pure numpy and scipy; the UCS so far).
+* ``"static"``: static equilibrium between bond failures, bonds broken one at a time, relaxing where no static
+  equilibrium settles (:mod:`grainfrac_yade.static.engine`, pure numpy and scipy; UCS, confined, Brazilian and
+  creep tests);
+* ``"hybrid"``: the static engine with YADE's dynamic stints where the statics give out
+  (:mod:`grainfrac_yade.hybrid.engine`; UCS, confined and creep tests).
 
 Every engine module offers ``NAME``, ``build_scene(specimen, params, layout=None)`` and
 ``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements

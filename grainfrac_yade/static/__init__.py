@@ -1,18 +1,32 @@
-"""Quasi-static engine, numerical core (pure numpy and scipy; no YADE).
+"""Quasi-static engine (pure numpy and scipy; never imports YADE).
 
-The same specimen, bonds and laws as the YADE scene, solved by static equilibrium between bond failures
-instead of explicit dynamic relaxation.  One module per job:
+The same specimen, bonds and laws as the YADE scene, solved by static equilibrium between bond failures instead of
+explicit dynamic relaxation (docs/engines.md).  One module per job:
 
 * :mod:`.network`: the contact network of a specimen and its grain layout (rigid or fem cells, from
   :mod:`grainfrac_yade.elastic`'s builders): kinematic and force rows of every bond, the grains' stiffness,
   platens and sides, bond strengths, a canonical (numbering-free) bond order;
 * :mod:`.contacts`: the contact law as array functions: intact bonds (linear, tension cut-off, Mohr-Coulomb
-  shear), broken ones (compression only, residual friction, return mapping), stress-to-strength ratios;
-* :mod:`.solver`: equilibrium at a platen closure: tangent assembly, SuperLU factor (kept while the tangent
-  does not change), the active-set iteration on open/closed and stick/slip contacts, cells cut loose;
-* :mod:`.cascade`: bonds broken one at a time, the most overstressed first; the sequentially linear path in
-  the platen closure (UCS without a loading rate) and the return to a held load (creep holds);
-* :mod:`.failure`: the physical failure rule under a held load;
-* :mod:`.creep`: the creep hold: the law package's :func:`~grainfrac_yade.law.creep_step` and the event
-  clock fed by the static stresses.
+  shear, paper Eq. 4-5), broken ones (compression only, residual friction, return mapping), stress-to-strength ratios;
+* :mod:`.solver`: equilibrium at a platen closure: the active-set iteration on open/closed and stick/slip
+  contacts, SuperLU factors, split steps where statuses cycle, cells cut loose, ground springs of a singular factor;
+* :mod:`.tangent`: the fast linear algebra: the tangent assembled on one cached pattern, a kept factor reused by
+  low-rank (Woodbury) updates;
+* :mod:`.cascade`: bonds broken one at a time, the most overstressed first; the sequentially linear path in the
+  platen closure and the return to a held load;
+* :mod:`.failure`: the physical failure rule under a held load (no equilibrium ahead, or too much strain to regain);
+* :mod:`.paths`: the registry that turns ``numerics.static_relaxation`` into the scene's path;
+* :mod:`.damped`: the overdamped relaxation where no status set settles (backward Euler, an anchor halved step by
+  step);
+* :mod:`.inertial`: the inertial relaxation there (explicit small-strain dynamics of the same network under the
+  creep protocol's servo and criteria; the default);
+* :mod:`.ucs`: the UCS (and confined) path without a loading rate and its stop rule;
+* :mod:`.creep`: the core's creep hold: :func:`~grainfrac_yade.law.creep_step` and the event clock fed by the
+  static stresses;
+* :mod:`.scene`: :class:`~.scene.StaticScene`, the engine's scene of :class:`grainfrac_yade.engines.Scene` (load
+  increments, the held platen stress, save and restore with the kept factor, the state export);
+* :mod:`.jaws`: the Brazilian disc's jaw cells as prescribed displacements, and the Brazilian levers;
+* :mod:`.settings`: the engine's name and the dynamic-only settings it does not read;
+* :mod:`.bench_timing`: the timings of ``bench --static`` (a network built, a creep hold timed per event);
+* :mod:`.engine`: what the engine registry returns for ``numerics.engine = "static"``.
 """

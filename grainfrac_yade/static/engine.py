@@ -9,9 +9,10 @@ imports YADE.
 What the protocols reach through an engine module: ``build_scene``, ``scene_from_state``, ``consolidate`` (the
 isotropic stage of a confined test) and ``stress_corrosion`` (the creep test's bond writer, :class:`StaticCorrosion`:
 the creep test of :mod:`grainfrac_yade.protocols.creep` runs on the static scene's held platen stress with the event
-clock; the paper clock needs dynamics and is refused).  Not in the static engine yet, each refused with one line
-naming the fix (:data:`UNSUPPORTED`, checked by the command line before a run folder is made): none at present.
-The Brazilian test runs on the disc's jaws of :mod:`.jaws` (``attach_jaws``) with the levers of ``apply_levers``.
+clock; the paper clock needs dynamics and is refused).  Every command runs on it: :data:`UNSUPPORTED` (what the
+command line refuses before a run folder is made) is empty; what it refuses within a command (the paper clock, a
+stiffness-changing law, rough platens, blocked rotation of fem cells) is refused in one line naming the fix.  The
+Brazilian test runs on the disc's jaws of :mod:`.jaws` (``attach_jaws``) with the levers of ``apply_levers``.
 The timings of ``bench --static`` (:mod:`.bench_timing`: a network built and a creep hold timed per event, in CPU
 time) are reached here, as YADE's are in its engine module.  VTK series are written as on any engine
 (:mod:`grainfrac_yade.protocols.snapshots` reads the scene's ``cell_motion`` and ``bond_shift``; :data:`VTK_REFUSED`
@@ -41,9 +42,8 @@ from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noq
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
 DYNAMIC = False
 
-#: Commands the static engine cannot run yet -> the one line that says so and the fix.
-UNSUPPORTED = {
-}
+#: Commands the static engine cannot run -> the one line that says so and the fix: none (the hybrid engine adds its own).
+UNSUPPORTED: dict = {}
 
 
 def version() -> str:

@@ -36,7 +36,7 @@ from .network import StaticNetwork
 from .tangent import MAX_LOW_RANK_CONTACTS, LowRankSolver, TangentPattern
 
 #: Active-set iterations per equilibrium before giving up [1]: each is one factorisation; a consistent set is
-#: normally found in a handful (measured on 10 x 20 mm, docs/studies/static_engine.md).
+#: normally found in a handful (measured on 10 x 20 mm, docs/studies/static_bench.md).
 MAX_ACTIVE_SET_ITERATIONS = 200
 #: Status changes allowed in the first iteration [1]: all of them; the cap halves when an iteration does not
 #: reduce the number of inconsistent contacts (module doc).
@@ -49,7 +49,7 @@ ILL_CONDITIONED_RESIDUAL = 1e-6
 #: SuperLU options of the fast path's reference factors (``_refactor_fast``) [-]: minimum degree ordering on
 #: A^T + A with SymmetricMode (the diagonal taken as pivot while it is at least ``diag_pivot_thresh`` of its
 #: column's largest entry, else partial pivoting).  The tangent is symmetric but for slipping contacts; measured at
-#: paper size (docs/studies/static_engine.md, "Cost at paper size"): fill 3.27e6 against 5.56e6 with COLAMD, one
+#: paper size (docs/studies/static_bench.md, "Cost at paper size"): fill 3.27e6 against 5.56e6 with COLAMD, one
 #: back-substitution 0.0076 s against 0.0136 s; on the 160 MPa creep hold (150 events) solve CPU 33.2 s against
 #: 47.4 s with the same break sequence, direct residuals 2.3e-14 (COLAMD 3.7e-14), no low-rank solve refused,
 #: and the same factors at thresholds 0.0, 0.01 and 0.1.  Without SymmetricMode this ordering factorises in 5.4 s

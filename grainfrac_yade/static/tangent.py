@@ -40,7 +40,7 @@ REFINEMENT_GAIN = 0.5
 MAX_REFINEMENT = 4
 #: Changed contacts relative to the reference factor beyond which the tangent is factorised anew [1]: each adds
 #: two back-substitutions (its K^-1 U columns) and two columns to every later solve, against one factorisation of
-#: ~18 back-substitutions at paper size (0.18 s / 0.010 s).  Measured (docs/studies/static_engine.md, "Cost at
+#: ~18 back-substitutions at paper size (0.18 s / 0.010 s).  Measured (docs/studies/static_bench.md, "Cost at
 #: paper size"): 10 x 20 mm path to 0.8 % strain 18.4 / 15.8 / 16.0 CPU s at 16 / 48 / 128; paper-size creep at
 #: 160 MPa, events 1-200: 132.8 s at 48, 101.5 s at 128 (12 factorisations for 2,727 tangents).
 MAX_LOW_RANK_CONTACTS = 128
