@@ -320,6 +320,12 @@ def _pa(mpa):
 CREEP_ROW_COLUMNS = {"ratio": 0.0, "stress": 0.0, "ucs": 0.0}
 
 
+def creep_name_parts(controls: dict) -> list:
+    """The load columns that name a creep row's folder, before its parameters: ratio (or stress), and ucs if given."""
+    parts = [("ratio", controls["ratio"])] if float(controls["ratio"]) else [("stress", controls["stress"])]
+    return parts + ([("ucs", controls["ucs"])] if float(controls["ucs"]) else [])
+
+
 def run_creep_in_yade(rows):
     """Entry of ``yade_scripts/creep.py``: one creep run per yade-batch row.
 
@@ -343,9 +349,7 @@ def run_creep_in_yade(rows):
                                  "(stress in Pa, ratio of the UCS)")
         check_stress_range(params)
         stress, ratio, ref = resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
-        name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
-        name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
-        name = run_folder_name(controls, name_parts + overrides)
+        name = run_folder_name(controls, creep_name_parts(controls) + overrides)
         out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
                                      {"seed": int(controls["seed"]), "stress_pa": stress})
     if action == "skip":
