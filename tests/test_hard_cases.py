@@ -162,9 +162,9 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
     s = ucs_folder(load_parameters(overrides=TINY), tmp_path / "run", captured, MEASURES)
     assert s["numerical_failure"] is True and s["ucs_pa"] is None and s["steps"] == 0
     assert s["end_reason"].startswith("numerical failure: DEM step ")
-    cmd_analyze_ucs(SimpleNamespace(folder=str(tmp_path)))
+    cmd_analyze_ucs(SimpleNamespace(folder=str(tmp_path), out=None))
     assert f"numerical failure (no result, not counted): run: {s['end_reason']}" in \
-        (tmp_path / "ucs_stats.md").read_text()
+        (tmp_path / "report" / "ucs_stats.md").read_text()
 
 
 # ------------------------------------------------------------------ (b) a load above the UCS
