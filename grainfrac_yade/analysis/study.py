@@ -16,7 +16,7 @@ import pandas as pd
 
 from ..errors import GrainfracError
 from ..runs.runio import write_csv
-from . import crack_phases, crackmaps, figures, rescale
+from . import crack_phases, crackmaps, creep_rates, figures, rescale
 from .collect import ENGINE_COLUMN, check_report_folder, code_version_note
 from .figures import MAP_FRACTIONS, Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
@@ -32,11 +32,29 @@ from .study_runs import (CREEP_OUTCOMES, NO_PARAMS_VARIANT, RUN_TABLE, VARIANT_I
 ORDER_OF_MAGNITUDE = 1.0
 
 
+def fitted(runs: pd.DataFrame) -> pd.Series:
+    """True for the runs no reason leaves out of the lifetime fits (column ``fit_left_out`` empty)."""
+    if "fit_left_out" not in runs:
+        return pd.Series(True, index=runs.index)
+    return runs["fit_left_out"].isna()
+
+
+def left_out_note(g: pd.DataFrame) -> str:
+    """The fit note naming the failed runs of ``g`` left out of the fits, each with its lifetime, and why."""
+    out = g[(g["outcome"] == "failed") & ~fitted(g)]
+    if not len(out):
+        return ""
+    runs = ", ".join(f"{r['run']} (t = {_num(r['lifetime_s']):.3g} s)" for r in out.to_dict("records"))
+    reasons = "; ".join(sorted(set(out["fit_left_out"])))
+    return f"; {len(out)} left out of the fit ({reasons}): {runs}"
+
+
 def lifetime_sets(runs: pd.DataFrame) -> list:
-    """One :class:`LifetimeSet` per model variant: failed points (t > 0, fitted) and lower bounds."""
+    """One :class:`LifetimeSet` per model variant: failed points (t > 0, fitted; not those
+    :func:`fitted` leaves out) and lower bounds."""
     sets = []
     for variant, g in runs[runs["outcome"].isin(CREEP_OUTCOMES)].groupby("variant", sort=True):
-        failed = g[(g["outcome"] == "failed") & g["ratio"].notna()]
+        failed = g[(g["outcome"] == "failed") & g["ratio"].notna() & fitted(g)]
         lower = g[(g["outcome"] == "not failed") & g["ratio"].notna()]
         ratio, life = failed["driving_stress_ratio"].to_numpy(float), failed["lifetime_s"].to_numpy(float)
         fit = fit_lifetimes(ratio, life, source=f"{variant} runs") if len(ratio) else None
@@ -235,6 +253,7 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         n_load = int((g["outcome"] == "failed at load").sum())
         note = (f"{s.label}: {len(s.ratio)} failed run(s) at {k} distinct ratio(s)"
                 + (" fitted" if s.fit is not None else ": fit skipped (needs failed runs at 2 or more ratios)"))
+        note += left_out_note(g)
         note += f"; {int((g['outcome'] == 'not failed').sum())} run(s) did not fail (lower bounds, drawn, not fitted)"
         note += f"; {n_load} failed at load (t = 0, not in the log fit)" if n_load else ""
         n_num = int((g["outcome"] == "numerical failure").sum())
@@ -315,6 +334,17 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     else:
         for name in ("strain_time.png", "strain_time_normalised.png"):
             content.skipped.append((name, "no finished run with a history.csv and a positive end time"))
+    rates = creep_rates.strain_rate_table(runs, lambda r: read_history(r["folder"], _factor(r)))
+    write_csv(out / "strain_rate.csv", rates)
+    content.tables.append("strain_rate.csv")
+    shown = reps[reps["run"].isin(set(rates["run"]))]
+    if len(shown):
+        creep_rates.strain_rate_figure(out / "strain_rate.png", rates, shown)
+        content.figures.append(("strain_rate.png", "Axial creep strain rate vs normalised time, one run per load, "
+                                                   "with the minimum (secondary) creep strain rate"))
+    else:
+        content.skipped.append(("strain_rate.png", "no failed run whose history resolves its creep stages (at least "
+                                                   "9 creep times before the collapse)"))
     failed_curves = [(r, c) for r, c in curves if r["outcome"] == "failed"]
     if failed_curves:
         pick = [failed_curves[0]] if len(failed_curves) == 1 else \

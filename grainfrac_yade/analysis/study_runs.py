@@ -16,6 +16,8 @@ from ..runs.columns import history_as_today
 from ..runs.runio import RESULT_NEUTRAL_KEYS
 from . import rescale
 from .collect import collect_runs, flatten
+from .creep_analysis import MinimumCreepRate, minimum_creep_rate
+from .durations import readable_duration
 from .lifetimes import classify_runs
 from .runparams import default_tree
 
@@ -27,12 +29,15 @@ CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure",
                   "run error")
 #: Columns of runs.csv (those present); the parameter columns are those of ucs_runs.csv that tell runs apart.
 RUN_TABLE = ("run", "folder", "command", "engine", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
-             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "first_creep_crack_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
+             "ucs_pa", "failed", "lifetime_s", "lifetime_readable", "fit_left_out", "min_creep_strain_rate_per_s",
+             "min_creep_strain_rate", "creep_time_end_s", "first_creep_crack_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
-             "tertiary_start_s", "steps", "wall_s", "cpu_s", "specimen.width", "specimen.height", "specimen.grain_size",
+             "tertiary_start_s", "steps", "steps_counted", "wall_s", "cpu_s", "specimen.width", "specimen.height", "specimen.grain_size",
              "resolution.grain_model", "resolution.nodes_per_face", "calibration.strength_scale", "calibration.stiffness_scale",
              "stress_corrosion.beta1", "stress_corrosion.beta2", "specimen.min_edge_fraction", "creep.ramp_strain_rate",
              "numerics.density_scale", "study", "beta1_run", "time_factor", "code_version", "problem")
+
+
 def _fmt_value(v) -> str:
     return f"{v:g}" if isinstance(v, float) else str(v)
 
@@ -127,7 +132,56 @@ def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
         runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else runs.at[i, "outcome"]
     runs["first_creep_crack_s"] = [first_creep_crack(f, tf) if o in CREEP_OUTCOMES else np.nan
                                    for f, tf, o in zip(runs["folder"], runs["time_factor"], runs["outcome"])]
+    runs["fit_left_out"] = [FIRST_RELAXATION if no_creep_life(r) else None for r in runs.to_dict("records")]
+    runs["lifetime_readable"] = [readable_duration(t) if o == "failed" else None
+                                 for t, o in zip(runs["lifetime_s"], runs["outcome"])]
+    runs = with_minimum_creep_rates(runs)
     runs.attrs["filled"] = filled
+    return runs
+
+
+#: Why a failed run is left out of the lifetime fits (column ``fit_left_out``; empty for a fitted run).
+FIRST_RELAXATION = "failed in the relaxation after its first creep event: no creep life"
+
+
+def no_creep_life(row: dict) -> bool:
+    """Whether a failed run collapsed in the relaxation after its first creep event (summary.json
+    ``failed_in_first_relaxation``; in summaries older than the key: an event-clock run with one event or none):
+    its lifetime is one bond's corrosion time, not a creep life, and it is left out of the fits."""
+    if row.get("outcome") != "failed":
+        return False
+    flag = row.get("failed_in_first_relaxation")
+    if isinstance(flag, (bool, np.bool_)):
+        return bool(flag)
+    clock = row.get("clock") if isinstance(row.get("clock"), str) else row.get("stress_corrosion.clock")
+    events = pd.to_numeric(pd.Series([row.get("n_events")]), errors="coerce").iloc[0]
+    return clock == "event" and bool(events <= 1)
+
+
+#: The summary key of the minimum creep strain rate [1/s] and of its status ("resolved" or why not).
+MIN_RATE, MIN_RATE_STATUS = "min_creep_strain_rate_per_s", "min_creep_strain_rate"
+
+
+def with_minimum_creep_rates(runs: pd.DataFrame) -> pd.DataFrame:
+    """``runs`` with :data:`MIN_RATE` and :data:`MIN_RATE_STATUS` for every failed run: as its summary.json gives
+    them (rescaled with its times), else, for a run written before the keys, from its history.csv as the run
+    would have (:func:`~grainfrac_yade.analysis.creep_analysis.minimum_creep_rate` of the history before the
+    collapse row)."""
+    runs = runs.copy()
+    for col in (MIN_RATE, MIN_RATE_STATUS):
+        if col not in runs:
+            runs[col] = np.nan
+    runs[MIN_RATE_STATUS] = runs[MIN_RATE_STATUS].astype(object)
+    for i in runs.index[(runs["outcome"] == "failed") & runs[MIN_RATE_STATUS].isna()]:
+        hist = read_history(runs.at[i, "folder"], runs.at[i, "time_factor"])
+        life = pd.to_numeric(pd.Series([runs.at[i, "lifetime_s"]]), errors="coerce").iloc[0]
+        if hist is None or len(hist) < 2:
+            rate = MinimumCreepRate(None, "no history.csv")
+        else:
+            rate = minimum_creep_rate(hist["creep_time_s"].to_numpy(float)[:-1],
+                                      hist["axial_strain"].to_numpy(float)[:-1], life)
+        runs.at[i, MIN_RATE] = np.nan if rate.rate_per_s is None else rate.rate_per_s
+        runs.at[i, MIN_RATE_STATUS] = rate.unresolved or "resolved"
     return runs
 
 
