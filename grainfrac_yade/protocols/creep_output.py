@@ -153,9 +153,8 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     min_rate = (minimum_creep_rate(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end) if resolvable
                 else MinimumCreepRate(None, unresolved))
     hist["broken_creep"] = broken_creep
-    # D_n = N(t) / N(t_f): no t_f without a result (a numerical failure's last count is not a failure's)
-    hist["damage_index"] = (np.full(len(broken_creep), np.nan) if no_test
-                            else damage_index(broken_creep, broken_creep[-1]))
+    if not no_test:   # D_n = N(t) / N(t_f): no t_f without a result (a numerical failure's last count is no failure's)
+        hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
     if run.rows:
         write_csv(out / "history.csv", hist)
     write_crack_list(out / "cracks.csv", run)
