@@ -213,9 +213,11 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
 def failed_in_first_relaxation(run, params, lifetime) -> bool:
     """Whether a failed event-clock run collapsed in the relaxation after its first creep event: the first bond the
     law broke brought the specimen down, with no creep damage before it, so its lifetime is that bond's corrosion
-    time, not a creep life (the analysis leaves such runs out of its fits).  False for a run without a lifetime
-    and for the paper clock (no relaxation after an event: it corrodes every step)."""
-    return bool(lifetime is not None and params.stress_corrosion.clock == "event" and run.n_events <= 1)
+    time, not a creep life (the analysis leaves such runs out of its fits).  False for a run without a lifetime or
+    with a lifetime of 0 (failed at load: no creep event at all), and for the paper clock (no relaxation after an
+    event: it corrodes every step)."""
+    return bool(lifetime is not None and lifetime > 0 and params.stress_corrosion.clock == "event"
+                and run.n_events <= 1)
 
 
 def end_reason(run, params, t_end) -> str:
