@@ -93,7 +93,7 @@ run_target() {
                cp results/threshold_tiny/report/lifetime.png docs/figures/threshold_tiny_lifetime.png ;;
     paper_fem) batch params/paper_fem_ucs.table ucs.py paper_fem_ucs
                $PY -m grainfrac_yade analyze-ucs results/paper_fem_ucs
-               cp results/paper_fem_ucs/ucs_runs.csv docs/studies/paper_fem/ucs_runs.csv
+               cp results/paper_fem_ucs/report/ucs_runs.csv docs/studies/paper_fem/ucs_runs.csv
                batch params/paper_fem_creep.table creep.py paper_fem_creep
                $PY -m grainfrac_yade analyze results/paper_fem_creep
                cp results/paper_fem_creep/report/runs.csv docs/studies/paper_fem/runs.csv ;;

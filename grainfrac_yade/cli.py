@@ -22,7 +22,7 @@ import traceback
 from pathlib import Path
 
 from .commands import animate, register_all
-from .errors import GrainfracError
+from .errors import EXIT_NUMERICAL_FAILURE, GrainfracError  # noqa: F401  (the statuses, here)
 
 #: Exit status for user errors (bad input), as argparse uses.
 EXIT_USER_ERROR = 2
@@ -35,6 +35,10 @@ DEBUG_FLAG = "--debug"
 ERROR_LOG_DIR = "results/logs"
 #: Commands that take ``--engine NAME`` (a shortcut for ``--set numerics.engine=NAME``).
 ENGINE_COMMANDS = ("ucs", "creep", "brazilian")
+#: Help of ``--engine`` (the engines of :data:`grainfrac_yade.engines.registry.ENGINE_NAMES`).
+ENGINE_HELP = ("mechanical engine (numerics.engine): yade (the default: explicit DEM), static (static equilibrium "
+               "between bond failures) or hybrid (static, with YADE's dynamics where statics give out); given also "
+               "as --set numerics.engine=... with another value: refused")
 #: A negative number with an exponent (-10e-3): argparse takes it for an option ("expected one argument").
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
@@ -100,9 +104,7 @@ def build_parser() -> argparse.ArgumentParser:
     animate.register(sub, _common)
     for name in ENGINE_COMMANDS:
         if name in sub.choices:
-            sub.choices[name].add_argument("--engine", metavar="NAME",
-                                           help="mechanical engine: yade (the default: explicit DEM) or static "
-                                                "(static equilibrium between bond failures); numerics.engine")
+            sub.choices[name].add_argument("--engine", metavar="NAME", help=ENGINE_HELP)
     return parser
 
 

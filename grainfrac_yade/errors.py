@@ -1,4 +1,11 @@
-"""User-facing errors: one clear line naming the file, the key and the fix."""
+"""User-facing errors: one clear line naming the file, the key and the fix; the exit status of a run without a
+result."""
+
+#: Exit status of a command whose run ended as a numerical failure (NaN or infinite numbers, contact statuses that
+#: do not settle, a stalled clock): no result, and its summary.json says so (``numerical_failure: true``).  Neither
+#: 0 (a result), 1 (an unexpected error, or a specimen that broke apart before its test) nor 2 (bad input), so that
+#: a script can tell "the model gave no answer here" apart.
+EXIT_NUMERICAL_FAILURE = 3
 
 
 class GrainfracError(Exception):

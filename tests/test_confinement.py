@@ -66,11 +66,11 @@ def test_analyze_ucs_writes_the_envelope_of_a_confined_study(tmp_path):
         peak = s3 + sigma_ci * math.sqrt(m_i * s3 / sigma_ci + 1)
         write_run_folder(tmp_path / f"run{k}", params, summary=dict(UCS_SUMMARY, ucs_pa=peak))
     assert main(["analyze-ucs", str(tmp_path)]) == 0
-    env = json.loads(json.dumps(__import__("pandas").read_csv(tmp_path / "envelope.csv").iloc[0].to_dict()))
+    env = json.loads(json.dumps(__import__("pandas").read_csv(tmp_path / "report" / "envelope.csv").iloc[0].to_dict()))
     assert env["n_tests"] == 4
     assert env["hb_sigma_ci_pa"] == pytest.approx(sigma_ci, rel=1e-9) and env["hb_m_i"] == pytest.approx(m_i, rel=1e-9)
-    assert (tmp_path / "envelope_1.png").stat().st_size > 0
-    table = (tmp_path / "ucs_stats.md").read_text()
+    assert (tmp_path / "report" / "envelope_1.png").stat().st_size > 0
+    table = (tmp_path / "report" / "ucs_stats.md").read_text()
     assert "| 40 | 1 |" in table and "Hoek-Brown sigma_ci 250.0 MPa, m_i 20.0" in table
 
 

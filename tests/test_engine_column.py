@@ -57,13 +57,13 @@ def test_analyze_ucs_keeps_the_engines_apart(tmp_path, capsys):
     _ucs_folder(tmp_path / "yade2", drop_engine=True, summary=dict(UCS_SUMMARY, ucs_pa=310e6))   # older: YADE
     _ucs_folder(tmp_path / "static1", engine="static", summary=dict(UCS_SUMMARY, ucs_pa=500e6, engine="static"))
     assert main(["analyze-ucs", str(tmp_path)]) == 0
-    runs = pd.read_csv(tmp_path / "ucs_runs.csv").set_index("run")
+    runs = pd.read_csv(tmp_path / "report" / "ucs_runs.csv").set_index("run")
     assert runs[ENGINE_COLUMN].to_dict() == {"static1": "static", "yade1": "yade", "yade2": "yade"}
-    stats = pd.read_csv(tmp_path / "ucs_stats.csv").set_index(ENGINE_COLUMN)
+    stats = pd.read_csv(tmp_path / "report" / "ucs_stats.csv").set_index(ENGINE_COLUMN)
     assert list(stats.columns)[:1] == ["resolution.spheres_per_cell"] and len(stats) == 2
     assert stats.loc["yade", "ucs_pa_count"] == 2 and stats.loc["yade", "ucs_pa_mean"] == pytest.approx(305e6)
     assert stats.loc["static", "ucs_pa_count"] == 1 and stats.loc["static", "ucs_pa_mean"] == 500e6
-    table = (tmp_path / "ucs_stats.md").read_text().splitlines()
+    table = (tmp_path / "report" / "ucs_stats.md").read_text().splitlines()
     head = [c.strip() for c in table[0].strip("|").split("|")]
     assert head[:2] == ["engine", "cells"] and table[1].count("---") == len(head)
     rows = {line.split("|")[1].strip(): line for line in table[2:4]}
@@ -79,7 +79,7 @@ def test_analyze_ucs_envelope_per_engine(tmp_path):
             write_run_folder(tmp_path / f"{engine}{k}", p,
                              summary=dict(UCS_SUMMARY, ucs_pa=(250e6 if engine == "yade" else 400e6) + 4 * s3))
     assert main(["analyze-ucs", str(tmp_path)]) == 0
-    env = pd.read_csv(tmp_path / "envelope.csv").set_index(ENGINE_COLUMN)
+    env = pd.read_csv(tmp_path / "report" / "envelope.csv").set_index(ENGINE_COLUMN)
     assert sorted(env.index) == ["static", "yade"] and list(env["n_tests"]) == [3, 3]
     assert env.loc["static", "mc_unconfined_strength_pa"] == pytest.approx(400e6, rel=1e-9)
     assert env.loc["yade", "mc_unconfined_strength_pa"] == pytest.approx(250e6, rel=1e-9)

@@ -104,12 +104,12 @@ def test_analyze_ucs_keeps_rigid_fem_and_retired_lattice_runs_apart(tmp_path):
     write_run_folder(study / "older_rigid", rigid, summary=dict(UCS_SUMMARY, ucs_pa=310e6),
                      drop=("resolution.grain_model", "resolution.nodes_per_face"))
     assert main(["analyze-ucs", str(study)]) == 0
-    stats = pd.read_csv(study / "ucs_stats.csv").set_index("resolution.grain_model")
+    stats = pd.read_csv(study / "report" / "ucs_stats.csv").set_index("resolution.grain_model")
     assert len(stats) == 3
     assert stats.loc["rigid", "ucs_pa_count"] == 2 and stats.loc["rigid", "ucs_pa_mean"] == pytest.approx(305e6)
     assert stats.loc["fem", "ucs_pa_count"] == 1 and stats.loc["fem", "ucs_pa_mean"] == 500e6
     assert stats.loc["deformable", "ucs_pa_count"] == 1 and stats.loc["deformable", "ucs_pa_mean"] == 700e6
-    table = (study / "ucs_stats.md").read_text()
+    table = (study / "report" / "ucs_stats.md").read_text()
     assert "| rigid | 1 |" in table and "| fem, 2/face | 1 |" in table and "| lattice (retired), 2/face | 1 |" in table
 
 
@@ -132,9 +132,9 @@ def test_analyze_ucs_keeps_runs_older_than_the_grain_model(tmp_path):
     for seed in (1, 2):
         write_run_folder(tmp_path / f"seed{seed}", rigid, seed=seed, summary=UCS_SUMMARY, drop=old)
     assert main(["analyze-ucs", str(tmp_path)]) == 0
-    stats = pd.read_csv(tmp_path / "ucs_stats.csv")
+    stats = pd.read_csv(tmp_path / "report" / "ucs_stats.csv")
     assert len(stats) == 1 and stats["ucs_pa_count"].iloc[0] == 2
-    assert "| rigid | 1 |" in (tmp_path / "ucs_stats.md").read_text()
+    assert "| rigid | 1 |" in (tmp_path / "report" / "ucs_stats.md").read_text()
 
 
 def fake_scene(specimen, layout):

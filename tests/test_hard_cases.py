@@ -103,7 +103,9 @@ def ucs_folder(params, out, captured, nullable=("crack_initiation_pa",)) -> dict
 
 
 #: summary.json keys a creep run leaves null when it has no lifetime or no creep stages
-NO_LIFETIME = ("lifetime_s", "primary_end_s", "tertiary_start_s")
+#: What a creep history resolves: the stages and the minimum creep strain rate between them (null where it does not).
+STAGES = ("primary_end_s", "tertiary_start_s", "min_creep_strain_rate_per_s")
+NO_LIFETIME = ("lifetime_s", "lifetime_readable") + STAGES
 #: A run that never held its load (failed on loading, or before it) has no hold budget.
 NO_HOLD = ("wave_crossing_steps", "servo_response_steps_used", "max_relaxation_steps_used")
 
@@ -162,9 +164,9 @@ def test_a_dem_step_ten_times_the_critical_one_is_no_ucs(tmp_path, step_ten_time
     s = ucs_folder(load_parameters(overrides=TINY), tmp_path / "run", captured, MEASURES)
     assert s["numerical_failure"] is True and s["ucs_pa"] is None and s["steps"] == 0
     assert s["end_reason"].startswith("numerical failure: DEM step ")
-    cmd_analyze_ucs(SimpleNamespace(folder=str(tmp_path)))
+    cmd_analyze_ucs(SimpleNamespace(folder=str(tmp_path), out=None))
     assert f"numerical failure (no result, not counted): run: {s['end_reason']}" in \
-        (tmp_path / "ucs_stats.md").read_text()
+        (tmp_path / "report" / "ucs_stats.md").read_text()
 
 
 # ------------------------------------------------------------------ (b) a load above the UCS
@@ -194,7 +196,7 @@ def test_b_a_load_above_the_ucs_fails_on_loading_with_lifetime_0(tmp_path, rigid
     carried (sampled every 2e-5 strain; the ramp checks every 1e-5), and the run is a short lifetime.
     The CLI and batch rows refuse a load at or above the UCS they refer to."""
     s = creep_folder(load_parameters(overrides=TINY), tmp_path / "run", factor * rigid_ucs, rigid_ucs, captured,
-                     NO_LIFETIME[1:] + NO_HOLD)
+                     STAGES + NO_HOLD)
     _fails_on_loading(s)
     assert outcome_in_analysis(tmp_path) == ["failed at load"]
 
@@ -212,7 +214,7 @@ def test_b_fem_grains_above_their_ucs_fail_on_loading(tmp_path, captured):
     (lifetime 0, not on loading); at 1.01 and 1.03 x it failed in the ramp."""
     p = load_parameters(overrides=TINY, extra_files=FEM)
     ucs = ucs_folder(p, tmp_path / "ucs", captured)["ucs_pa"]
-    _fails_on_loading(creep_folder(p, tmp_path / "creep", 1.01 * ucs, ucs, captured, NO_LIFETIME[1:] + NO_HOLD))
+    _fails_on_loading(creep_folder(p, tmp_path / "creep", 1.01 * ucs, ucs, captured, STAGES + NO_HOLD))
 
 
 # ------------------------------------------------------------------ (c) a very low load
@@ -228,8 +230,10 @@ def test_c_a_very_low_load_reaches_the_creep_time_limit_not_failed(tmp_path, cap
     assert s["creep_time_end_s"] >= 1e9 and s["end_reason"] == (
         "creep time reached stress_corrosion.creep_time_limit = 1e+09 s: not failed, the lifetime is a lower bound")
     assert outcome_in_analysis(tmp_path) == ["not failed"]
+    from grainfrac_yade.analysis.durations import readable_duration
     from grainfrac_yade.commands.creep import outcome
-    assert outcome(s) == f"not failed by {s['creep_time_end_s']:.4g} s"   # the paper clock's last step may pass
+    assert outcome(s) == (f"not failed by {s['creep_time_end_s']:.4g} s "   # the paper clock's last step may pass
+                          f"({readable_duration(s['creep_time_end_s'])})")
     assert s["creep_time_end_s"] < 1e9 + p.stress_corrosion.dt_max    # the limit by less than dt_max: 1.076e9 s
 
 
@@ -251,8 +255,7 @@ def test_d_a_stiffness_contrast_of_100_runs_ucs_and_creep_without_nan(tmp_path, 
     p = load_parameters(overrides=TINY + CONTRASTS[contrast])
     u = ucs_folder(p, tmp_path / "ucs", captured)
     assert u["numerical_failure"] is False and u["peak_reached"] and 1e8 < u["ucs_pa"] < 1e9
-    s = creep_folder(p, tmp_path / "creep", 0.7 * u["ucs_pa"], u["ucs_pa"], captured, ("primary_end_s",
-                                                                                        "tertiary_start_s"))
+    s = creep_folder(p, tmp_path / "creep", 0.7 * u["ucs_pa"], u["ucs_pa"], captured, STAGES)
     assert s["numerical_failure"] is False and s["failed"] and s["lifetime_s"] > 0 and not s["failed_on_loading"]
 
 
@@ -402,7 +405,7 @@ def test_g_the_same_seed_twice_gives_identical_creep_results(tmp_path):
         _cli_run("creep", "--width", 4e-3, "--height", 8e-3, "--seed", 1, "--ratio", 0.8, "--ucs", 252,
                  "--out", tmp_path / name)
     assert_same_runs(tmp_path / "a", tmp_path / "b")
-    s = clean_folder(tmp_path / "a", ("primary_end_s", "tertiary_start_s"))
+    s = clean_folder(tmp_path / "a", STAGES)
     assert s["failed"] and s["n_events"] > 0
 
 

@@ -68,8 +68,11 @@ def test_cli_stresses_are_mpa_and_batch_stresses_pa():
     from grainfrac_yade.commands.creep import resolve_stress
     p = load_parameters()
     assert resolve_stress(p, stress=160 * MPA, cli=True)[0] == 160 * MPA
-    with pytest.raises(GrainfracError, match="column stress = 160 Pa: must be above the confining"):
+    with pytest.raises(GrainfracError, match="column stress = 160 Pa is below 1 MPa, no creep load for granite; fix: "
+                                             "CLI stress flags are in MPa, batch columns in Pa: e.g. stress 160e6"):
         resolve_stress(load_parameters(overrides=[("confinement.stress", 1e3)]), stress=160.0, ucs=258e6)
+    with pytest.raises(GrainfracError, match="column stress = 1e\\+06 Pa: must be above the confining"):
+        resolve_stress(load_parameters(overrides=[("confinement.stress", 2e6)]), stress=1e6, ucs=258e6)
     with pytest.raises(GrainfracError, match="above 0"):
         resolve_stress(p, stress=-1.0)
     with pytest.raises(GrainfracError, match="--ucs 2.58e\\+08 MPa is above 4 x the reference strength"):

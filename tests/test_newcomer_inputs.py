@@ -125,7 +125,8 @@ def test_a_cell_of_the_wrong_type_names_the_type_its_column_takes(tmp_path, caps
     err = capsys.readouterr().err.strip().splitlines()
     bad = [c for c in cell.split() if not c[0].isdigit()][0]
     col = columns.split()[cell.split().index(bad)]
-    assert err[1] == f"batch table {table}:2: column {col}: {bad!r} is not a number or a quoted text; fix: {fix}"
+    assert err == [f"error: {table}: 1 bad row, nothing run: batch table {table}:2: column {col}: {bad!r} is not a "
+                   f"number or a quoted text; fix: {fix}"]
 
 
 def test_a_row_whose_out_cannot_be_made_is_refused_with_the_rows(tmp_path, capsys):
@@ -135,9 +136,8 @@ def test_a_row_whose_out_cannot_be_made_is_refused_with_the_rows(tmp_path, capsy
     table.write_text(f"seed out\n1 '{tmp_path / 'fine'}'\n2 '{a_file / 'run'}'\n")
     assert main(["batch", str(table), "--log-dir", str(tmp_path / "logs")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [f"error: {table}: 1 bad row(s), nothing run; fix each:",
-                   f"batch table {table}:3: out = '{a_file / 'run'}': {a_file} is a file, not a folder; fix: give "
-                   "the row an out below a folder"]
+    assert err == [f"error: {table}: 1 bad row, nothing run: batch table {table}:3: out = '{a_file / 'run'}': "
+                   f"{a_file} is a file, not a folder; fix: give the row an out below a folder"]
     assert not (tmp_path / "logs").exists() and not (tmp_path / "fine").exists()
 
 

@@ -41,7 +41,8 @@ NOT_COMPARED = {"wall_s", "cpu_s", "code_version"}
 #: Parameter sections compared between the stored and the fresh run.
 MODEL_SECTIONS = ("specimen", "composition", "grains", "contacts", "calibration")
 #: Summary keys added after the stored run was made, with the value a default run must give them.
-ADDED_KEYS = {"confining_stress_pa": 0.0, "failed_before_test": False, "bonds_erased_by_sliding": 0}
+ADDED_KEYS = {"confining_stress_pa": 0.0, "failed_before_test": False, "bonds_erased_by_sliding": 0, "engine": "yade",
+              "steps_counted": "DEM steps"}
 #: History columns not compared (wall time).
 HISTORY_NOT_COMPARED = {"wall_s"}
 #: Summary keys derived by least-squares fits, and their tolerance on a matching machine (module doc).

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..errors import GrainfracError
 from ..params import RENAMED_KEYS, migrate_tree
 from ..params import flatten as flatten_tree
 from ..runs.columns import summary_as_today
@@ -30,6 +31,18 @@ _SUMMARY_LAW = RENAMED_KEYS["stress_corrosion.mode"][1]
 ENGINE_COLUMN = "engine"
 #: The engine of a run whose params.json and summary.json predate ``numerics.engine``: YADE, the only engine there was.
 ENGINE_BEFORE_THE_KEY = "yade"
+
+
+def check_report_folder(out) -> None:
+    """GrainfracError (one line) if report folder ``out`` lies inside a run folder (a report never writes into
+    run folders) or is a file; the reports of ``analyze`` and ``analyze-ucs``."""
+    out = Path(out).resolve()
+    for p in (out, *out.parents):
+        if (p / "run.json").exists():
+            raise GrainfracError(f"{out}: is inside the run folder {p} (the report never writes into run "
+                                 "folders); fix: give --out DIR outside run folders")
+    if out.exists() and not out.is_dir():
+        raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
 
 
 def run_engine(params: dict | None, summary: dict | None) -> str | None:

@@ -94,6 +94,32 @@ def resolve_creep_stages(time, strain, t_end=None) -> CreepStages:
     return CreepStages(float(tau[secondary[0]] * t_end), float(tau[secondary[-1]] * t_end))
 
 
+class MinimumCreepRate(NamedTuple):
+    """Minimum (secondary) creep strain rate [1/s], or None with ``unresolved`` saying why."""
+    rate_per_s: float | None
+    unresolved: str | None = None
+
+
+def minimum_creep_rate(time, strain, t_end=None) -> MinimumCreepRate:
+    """The minimum (secondary) axial creep strain rate of a history [1/s]: the secant rate over the secondary
+    stage of :func:`resolve_creep_stages`, (eps(t_t) - eps(t_p)) / (t_t - t_p) between the end of primary creep
+    t_p and the start of tertiary creep t_t, the strain interpolated linearly in the history.
+
+    The secondary stage is where the windowed rate (a least-squares slope over ``STAGE_WINDOW`` of the life)
+    stays within ``STAGE_RATE_FACTOR`` x its floored minimum (module doc), so the window is one the history
+    resolves: the primary stage and the tertiary one before failure are outside it, and a step-like history
+    (the event clock moves strain only at events) gives the mean rate over its steps, not the 0 between two.
+    None (with the reason) where the stages are not resolved.  ``time``, ``strain``: the hold's history before
+    the collapse; ``t_end``: the lifetime."""
+    stages = resolve_creep_stages(time, strain, t_end)
+    if stages.unresolved:
+        return MinimumCreepRate(None, stages.unresolved)
+    time, strain = np.asarray(time, float), np.asarray(strain, float)
+    t_p, t_t = stages.primary_end_s, stages.tertiary_start_s
+    eps = np.interp([t_p, t_t], time, strain)
+    return MinimumCreepRate(float((eps[1] - eps[0]) / (t_t - t_p)))
+
+
 def creep_stages(time, strain, t_end=None):
     """(end of primary, start of tertiary creep) [s]; (None, None) when not resolved."""
     stages = resolve_creep_stages(time, strain, t_end)

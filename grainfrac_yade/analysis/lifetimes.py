@@ -25,6 +25,7 @@ import pandas as pd
 from ..law.hillig_charles import NAME as PAPER_LAW
 
 from .collect import ENGINE_BEFORE_THE_KEY, ENGINE_COLUMN
+from .durations import readable_duration
 from .fits import RATIO_DECIMALS
 
 #: Minimum number of failed runs at one ratio for a scatter statistic (three seeds per ratio, as the lifetime studies run).
@@ -82,8 +83,8 @@ def classify_runs(runs: pd.DataFrame) -> pd.DataFrame:
 def lifetime_stats(ratio, lifetime, min_count: int = MIN_SEEDS_FOR_STATS) -> pd.DataFrame:
     """Scatter of lifetimes per ratio with at least ``min_count`` points.
 
-    Geometric mean 10^mean(log10 t), standard deviation of log10 t (sample, ddof 1), min, max and
-    the spread log10(max / min) in decades.
+    Geometric mean 10^mean(log10 t) (also in a readable unit, :func:`.durations.readable_duration`), standard
+    deviation of log10 t (sample, ddof 1), min, max and the spread log10(max / min) in decades.
     """
     frame = pd.DataFrame({"ratio": np.round(np.asarray(ratio, float), RATIO_DECIMALS),
                           "log10_t": np.log10(np.asarray(lifetime, float))})
@@ -93,10 +94,11 @@ def lifetime_stats(ratio, lifetime, min_count: int = MIN_SEEDS_FOR_STATS) -> pd.
             continue
         lg = g["log10_t"].to_numpy()
         rows.append({"driving_stress_ratio": r, "n": len(lg), "geomean_lifetime_s": 10 ** lg.mean(),
+                     "geomean_lifetime_readable": readable_duration(10 ** lg.mean()),
                      "sd_log10_lifetime": lg.std(ddof=1), "min_lifetime_s": 10 ** lg.min(),
                      "max_lifetime_s": 10 ** lg.max(), "spread_decades": lg.max() - lg.min()})
-    columns = ["driving_stress_ratio", "n", "geomean_lifetime_s", "sd_log10_lifetime", "min_lifetime_s",
-               "max_lifetime_s", "spread_decades"]
+    columns = ["driving_stress_ratio", "n", "geomean_lifetime_s", "geomean_lifetime_readable", "sd_log10_lifetime",
+               "min_lifetime_s", "max_lifetime_s", "spread_decades"]
     return pd.DataFrame(rows, columns=columns)
 
 

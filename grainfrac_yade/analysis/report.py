@@ -59,10 +59,17 @@ CRACK_COUNTS = ("Crack counts: *cracks* are broken bonds (microcracks) of the ra
                 "fully separated, ramp or creep: a subset of the cracks (never more), not of the creep cracks. The "
                 "crack maps title each panel \"N cracks, M of them macro\" at its time.")
 
+#: The minimum creep strain rate of the run table, defined once (as in docs/reference/output_files.md).
+MIN_RATE_WORDS = ("*min creep rate*: the minimum (secondary) axial creep strain rate of a failed run, the secant rate "
+                  "between the end of primary and the start of tertiary creep (summary.json "
+                  "min_creep_strain_rate_per_s; where the history does not resolve the stages, runs.csv "
+                  "min_creep_strain_rate says why). *lifetime*: the lifetime in the unit that reads best.")
+
 RUN_COLUMNS = {
     "link": ("run", ""), "engine": ("engine", ""), "seed": ("seed", ""), "variant": ("variant", ""), "driving_stress_ratio": ("ratio", ".4f"),
     "stress_mpa": ("stress [MPa]", ".1f"), "status": ("status", ""), "outcome": ("outcome", ""),
-    "lifetime_s": ("lifetime [s]", ".4g"), "creep_time_end_s": ("end of creep [s]", ".4g"),
+    "lifetime_s": ("lifetime [s]", ".4g"), "lifetime_readable": ("lifetime", ""),
+    "min_creep_strain_rate_per_s": ("min creep rate [1/s]", ".3g"), "creep_time_end_s": ("end of creep [s]", ".4g"),
     "n_events": ("events", ".0f"), "broken_total": ("cracks", ".0f"), "broken_creep": ("creep cracks", ".0f"),
     "macrocracks": ("macrocracks", ".0f"),
     "wall_s": ("wall [s]", ".0f"), "problem": ("problem", ""),
@@ -81,11 +88,20 @@ CRACK_PHASE_TABLE = {
 }
 STATS_COLUMNS = {
     "dataset": ("data set", ""), "driving_stress_ratio": ("ratio", ".4f"), "n": ("n", "d"),
-    "geomean_lifetime_s": ("geometric mean lifetime [s]", ".4g"),
+    "geomean_lifetime_s": ("geometric mean lifetime [s]", ".4g"), "geomean_lifetime_readable": ("(readable)", ""),
     "sd_log10_lifetime": ("sd of log10 t [decades]", ".3f"),
     "min_lifetime_s": ("min [s]", ".4g"), "max_lifetime_s": ("max [s]", ".4g"),
     "spread_decades": ("max/min [decades]", ".2f"),
 }
+
+
+#: The outcomes as the report's first line counts them: what each means for a run (a specimen that *failed* gave a
+#: lifetime; nothing crashed).
+OUTCOME_WORDS = {"failed": "failed by creep (a lifetime each)", "failed at load": "failed at load (t = 0)",
+                 "not failed": "not failed (lower bounds)", "numerical failure": "numerical failure (no result)",
+                 "failed before test": "broke apart before the test (no result)",
+                 "unfinished": "unfinished (no summary.json)", "run error": "run error (the task failed)",
+                 "not creep": "not creep runs"}
 
 
 @dataclass
@@ -126,7 +142,8 @@ def render_report(c: ReportContent) -> str:
         lines = [f"# Creep study report: {' + '.join(names)}", "",
                  f"{len(studies)} study folders, each labelled by its name and fitted separately: "
                  + ", ".join(f"`{s}`" for s in studies) + ". "]
-    lines[-1] += f"{len(c.runs)} run folder(s): " + ", ".join(f"{n} {k}" for k, n in counts.items()) + "."
+    lines[-1] += f"{len(c.runs)} run folder(s): " + ", ".join(f"{n} {OUTCOME_WORDS.get(k, k)}"
+                                                              for k, n in counts.items()) + "."
     lines.append("")
     if c.banner:   # a block quote: paragraphs separated by ">" lines
         for k, t in enumerate(c.banner):
@@ -134,8 +151,10 @@ def render_report(c: ReportContent) -> str:
         lines.append("")
     lines += ["## Runs", "",
              "Every folder holding a run.json or failed.json is listed, and every SLURM row without one. "
-             "Outcomes: *failed* (lifetime = creep time at failure, "
-             "fitted), *failed at load* (failed at creep time 0: no creep life, not in the log fit), "
+             "Outcomes: *failed* (the specimen failed by creep: lifetime = creep time at failure, "
+             "fitted unless fit_left_out says why not, e.g. a run that failed in the relaxation after its first "
+             "creep event: no creep life), *failed at load* (failed at creep time 0: no creep life, not in the log "
+             "fit), "
              "*not failed* (the run ended without failure: its end time is a lower bound of the lifetime, drawn "
              "as an open marker with an arrow and **not used in the fit**), *numerical failure* (the run stopped on NaN or "
              "infinite numbers or a stalled creep clock, reason in failure_reason: no result, neither a lifetime "
@@ -144,7 +163,7 @@ def render_report(c: ReportContent) -> str:
              "running, stopped or crashed, or a SLURM row not started yet), *run error* (no summary.json; the batch "
              "task that ran it failed and recorded its error line in failed.json, shown as problem), "
              "*unreadable* (a JSON file that cannot be parsed, or a failed run without a "
-             "valid lifetime).", "", CRACK_COUNTS, "",
+             "valid lifetime).", "", CRACK_COUNTS, "", MIN_RATE_WORDS, "",
              markdown_table(_runs_for_table(c), RUN_COLUMNS), ""]
     lines += ["## Lifetime vs driving-stress ratio (paper Fig. 4)", "",
               "Fitted by least squares in ln t: the static-fatigue line ln t_f = a - b r and the power law "

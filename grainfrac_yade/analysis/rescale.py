@@ -30,6 +30,8 @@ from ..params import read_toml
 #: Summary and table columns that are creep times [s] (wall_s is wall-clock time: not scaled).
 TIME_COLUMNS = ("lifetime_s", "creep_time_end_s", "primary_end_s", "tertiary_start_s",
                 "stress_corrosion.creep_time_limit")
+#: Summary and table columns that are creep rates [1/s]: divided by the factor the times are multiplied by.
+RATE_COLUMNS = ("min_creep_strain_rate_per_s",)
 #: Per-run files' creep-time columns; negative values are markers (-1 = broken during the ramp).
 HISTORY_TIME_COLUMNS = ("creep_time_s",)
 CRACK_TIME_COLUMNS = ("creep_time_s", "macro_time_s")
@@ -131,5 +133,9 @@ def rescale_runs(runs: pd.DataFrame, beta1: float, creep_outcomes) -> pd.DataFra
         if c in runs:
             v = pd.to_numeric(runs[c], errors="coerce")
             runs[c] = v.where(~ok, v * runs["time_factor"])
+    for c in RATE_COLUMNS:
+        if c in runs:
+            v = pd.to_numeric(runs[c], errors="coerce")
+            runs[c] = v.where(~ok, v / runs["time_factor"])
     runs.loc[ok, "stress_corrosion.beta1"] = beta1
     return runs

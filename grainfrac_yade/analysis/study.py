@@ -15,211 +15,46 @@ import numpy as np
 import pandas as pd
 
 from ..errors import GrainfracError
-from ..runs.columns import history_as_today
-from ..runs.runio import RESULT_NEUTRAL_KEYS, write_csv
-from . import crack_phases, crackmaps, figures, rescale
-from .collect import ENGINE_COLUMN, code_version_note, collect_runs, flatten
+from ..runs.runio import write_csv
+from . import crack_phases, crackmaps, creep_rates, figures, rescale
+from .collect import ENGINE_COLUMN, check_report_folder, code_version_note
 from .figures import MAP_FRACTIONS, Curve, LifetimeSet
 from .fits import coefficient_table, distinct_ratios, fit_lifetimes
 from .labdata import paper_reference, read_lab_csv
-from .lifetimes import (_num, classify_runs, confinement_lifetimes, lifetime_stats, representatives,
-                        with_confinement_columns)
+from .lifetimes import _num, confinement_lifetimes, lifetime_stats, representatives, with_confinement_columns
 from .report import CONFINEMENT_TABLE, CRACK_PHASE_TABLE, ReportContent, coefficients_markdown, markdown_table, render_report, STATS_COLUMNS
-from .runparams import default_tree, rebuild_specimen
+from .runparams import rebuild_specimen
+from .study_runs import (CREEP_OUTCOMES, NO_PARAMS_VARIANT, RUN_TABLE, VARIANT_IGNORE, _read_csv,  # noqa: F401
+                         fill_missing_params, first_creep_crack, load_studies, load_study, read_cracks, read_history,
+                         study_names, variant_labels)
 
-#: Parameters that do not make a different model (a longer time limit is the same model; how often a run
-#: was checkpointed changes nothing it computes).
-VARIANT_IGNORE = ("stress_corrosion.creep_time_limit",) + RESULT_NEUTRAL_KEYS
-#: Outcomes of creep runs that belong to a model variant.
-CREEP_OUTCOMES = ("failed", "failed at load", "not failed", "numerical failure", "failed before test", "unfinished",
-                  "run error")
-#: Columns of runs.csv (those present); the parameter columns are those of ucs_runs.csv that tell runs apart.
-RUN_TABLE = ("run", "folder", "command", "engine", "seed", "variant", "status", "outcome", "driving_stress_ratio", "stress_pa",
-             "ucs_pa", "failed", "lifetime_s", "creep_time_end_s", "first_creep_crack_s", "numerical_failure", "failure_reason", "clock", "law", "n_events",
-             "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
-             "tertiary_start_s", "steps", "wall_s", "cpu_s", "specimen.width", "specimen.height", "specimen.grain_size",
-             "resolution.grain_model", "resolution.nodes_per_face", "calibration.strength_scale", "calibration.stiffness_scale",
-             "stress_corrosion.beta1", "stress_corrosion.beta2", "specimen.min_edge_fraction", "creep.ramp_strain_rate",
-             "numerics.density_scale", "study", "beta1_run", "time_factor", "code_version", "problem")
 #: Decades of lifetime scatter that count as "orders of magnitude" when comparing with the lab.
 ORDER_OF_MAGNITUDE = 1.0
 
 
-def _fmt_value(v) -> str:
-    return f"{v:g}" if isinstance(v, float) else str(v)
+def fitted(runs: pd.DataFrame) -> pd.Series:
+    """True for the runs no reason leaves out of the lifetime fits (column ``fit_left_out`` empty)."""
+    if "fit_left_out" not in runs:
+        return pd.Series(True, index=runs.index)
+    return runs["fit_left_out"].isna()
 
 
-#: Variant of creep rows without parameters yet (a SLURM row not started, a task that failed before its
-#: run folder held params.json) in a study of several variants.
-NO_PARAMS_VARIANT = "parameters not written yet"
-
-
-def variant_labels(runs: pd.DataFrame) -> pd.Series:
-    """Label per run naming the parameters that differ among the creep runs ("model" if none).
-
-    Rows without parameters (no params.json yet) name no variant: they join the study's only one, or
-    :data:`NO_PARAMS_VARIANT` when there are several."""
-    creep = runs["outcome"].isin(CREEP_OUTCOMES)
-    has = runs["specimen.width"].notna() if "specimen.width" in runs else pd.Series(False, index=runs.index)
-    basis = creep & has if (creep & has).any() else creep
-    keys = [c for c in runs.columns if "." in c and c not in VARIANT_IGNORE
-            and runs.loc[basis, c].astype(str).nunique() > 1]
-    if not keys:
-        return pd.Series(np.where(creep, "model", ""), index=runs.index)
-    short = {k: k.split(".")[-1] for k in keys}
-    if len(set(short.values())) < len(keys):
-        short = {k: k for k in keys}
-    labels = [", ".join(f"{short[k]}={_fmt_value(r[k])}" for k in keys) if ok else ""
-              for ok, r in zip(basis, runs.to_dict("records"))]
-    known = sorted({lab for lab, ok in zip(labels, basis) if ok})
-    fill = known[0] if len(known) == 1 else NO_PARAMS_VARIANT
-    labels = [fill if c and not b else lab for lab, c, b in zip(labels, creep, basis)]
-    return pd.Series(labels, index=runs.index)
-
-
-def fill_missing_params(runs: pd.DataFrame) -> tuple:
-    """Parameter columns that some runs lack (params.json written before the key existed) filled
-    with the shipped default, so that an older file does not look like another model.
-    Returns (runs, {key: number of runs filled})."""
-    try:
-        defaults = flatten(default_tree())
-    except GrainfracError:
-        return runs, {}
-    runs = runs.copy()
-    has_params = runs["specimen.width"].notna() if "specimen.width" in runs else pd.Series(False, index=runs.index)
-    filled = {}
-    for key, value in defaults.items():
-        if key not in runs or key.split(".")[0] in ("sources", "composition", "grains", "contacts"):
-            continue   # no run has the key (all alike), or a material table (never assumed)
-        missing = has_params & runs[key].isna()
-        if missing.any() and (has_params & runs[key].notna()).any():
-            runs[key] = runs[key].astype(object)
-            for i in runs.index[missing]:
-                runs.at[i, key] = value
-            filled[key] = int(missing.sum())
-    return runs, filled
-
-
-def load_study(folder, beta1: float | None = None) -> pd.DataFrame:
-    """All run folders of a study with ``outcome``, ``ratio`` and ``variant`` (see lifetimes module).
-
-    ``beta1``: every creep time rescaled to this rate (:func:`.rescale.rescale_runs`; GrainfracError
-    if a creep run is not rescalable). ``runs.attrs["filled"]``: parameter keys filled with defaults.
-    """
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise GrainfracError(f"{folder}: study folder not found; fix: give a folder holding run folders "
-                             "(e.g. results/lifetime_small)")
-    runs = collect_runs(folder, all_params=True)
-    if runs.empty:
-        raise GrainfracError(f"{folder}: no run folders (no run.json below it); fix: run the study first "
-                             "(python3 -m grainfrac_yade creep ... or yade-batch)")
-    runs = classify_runs(runs)
-    if not runs["outcome"].isin(CREEP_OUTCOMES).any():
-        raise GrainfracError(f"{folder}: no creep runs among {len(runs)} run folder(s); fix: analyze a creep study "
-                             "(UCS studies: python3 -m grainfrac_yade analyze-ucs)")
-    if beta1 is not None:
-        runs = rescale.rescale_runs(runs, beta1, CREEP_OUTCOMES)   # before defaults are filled in
-    else:
-        runs["time_factor"] = 1.0
-    runs, filled = fill_missing_params(runs)
-    runs["variant"] = variant_labels(runs)
-    for col in ("problem", "lifetime_s", "creep_time_end_s", "driving_stress_ratio"):
-        if col not in runs:
-            runs[col] = np.nan if col != "problem" else None
-    runs["problem"] = runs["problem"].astype(object)
-    for i in runs.index[runs["outcome"].isin(("unfinished", "run error"))]:
-        hist = read_history(runs.at[i, "folder"], runs.at[i, "time_factor"])
-        reach = f"; history.csv reaches t = {hist['creep_time_s'].iloc[-1]:.4g} s" if hist is not None and len(hist) \
-            else ""
-        known = runs.at[i, "problem"]   # a failed task's error, a SLURM row not started yet
-        runs.at[i, "problem"] = (known if isinstance(known, str) and known else
-                                 "no summary.json (running, stopped or crashed)") + reach
-    for i in runs.index[runs["outcome"].isin(("numerical failure", "failed before test"))]:
-        runs.at[i, "problem"] = runs.at[i, "failure_reason"] if "failure_reason" in runs else runs.at[i, "outcome"]
-    runs["first_creep_crack_s"] = [first_creep_crack(f, tf) if o in CREEP_OUTCOMES else np.nan
-                                   for f, tf, o in zip(runs["folder"], runs["time_factor"], runs["outcome"])]
-    runs.attrs["filled"] = filled
-    return runs
-
-
-def study_names(folders) -> list:
-    """Short distinct labels of study folders: the folder name, with parents added where names repeat."""
-    paths = [Path(f).resolve() for f in folders]
-    depth = 1
-    while True:
-        names = ["/".join(p.parts[-depth:]) for p in paths]
-        if len(set(names)) == len(names) or depth >= max(len(p.parts) for p in paths):
-            return names
-        depth += 1
-
-
-def load_studies(folders, beta1: float | None = None) -> pd.DataFrame:
-    """Runs of one or several studies. With several, runs are labelled by study (column ``study``,
-    ``run`` = study/run) and each study's variants become "study" or "study: variant"."""
-    folders = [Path(f) for f in folders]
-    if len(folders) == 1:
-        runs = load_study(folders[0], beta1)
-        runs["study"] = study_names(folders)[0]
-        return runs
-    frames, filled = [], {}
-    for folder, name in zip(folders, study_names(folders)):
-        runs = load_study(folder, beta1)
-        for k, n in runs.attrs.get("filled", {}).items():
-            filled[k] = filled.get(k, 0) + n
-        runs["study"] = name
-        runs["run"] = [f"{name}/{r}" for r in runs["run"]]
-        creep = runs["outcome"].isin(CREEP_OUTCOMES)
-        several = runs.loc[creep, "variant"].nunique() > 1
-        runs["variant"] = [(f"{name}: {v}" if several else name) if c else "" for v, c in zip(runs["variant"], creep)]
-        frames.append(runs)
-    runs = pd.concat(frames, ignore_index=True)
-    runs.attrs["filled"] = filled
-    return runs
-
-
-def _read_csv(path: Path, required) -> pd.DataFrame | None:
-    """A run's CSV, or None if missing, unreadable or lacking ``required`` columns (never raises)."""
-    try:
-        frame = history_as_today(pd.read_csv(path))   # step columns of older runs by today's names
-    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError):
-        return None
-    return frame if all(c in frame for c in required) else None
-
-
-def read_history(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
-    """history.csv of a run (creep times multiplied by ``time_factor``), or None."""
-    hist = _read_csv(Path(folder) / "history.csv", ("creep_time_s", "axial_strain"))
-    return rescale.scale_times(hist, time_factor, rescale.HISTORY_TIME_COLUMNS)
-
-
-def read_cracks(folder, time_factor: float = 1.0) -> pd.DataFrame | None:
-    """cracks.csv of a run (creep times >= 0 multiplied by ``time_factor``), or None.  Cracks of the ramp get
-    the creep time -1 in the frame (:data:`grainfrac_yade.analysis.crack_phases.RAMP_TIME`): files with a
-    ``phase`` column leave their creep time empty, older files wrote -1."""
-    cracks = _read_csv(Path(folder) / "cracks.csv", ("creep_time_s", "mode", "kind", "x_m", "y_m",
-                                                     "face_normal_angle_deg"))
-    if cracks is not None and "phase" in cracks:
-        from .crack_phases import RAMP_TIME
-        cracks["creep_time_s"] = cracks["creep_time_s"].where(cracks["phase"] != "ramp", RAMP_TIME)
-    return rescale.scale_times(cracks, time_factor, rescale.CRACK_TIME_COLUMNS)
-
-
-def first_creep_crack(folder, time_factor: float = 1.0) -> float:
-    """Creep time [s] of a run's first creep crack (the first bond broken at the held load; the paper's first
-    microcrack at 0.26 s, section 4.1) from its cracks.csv; NaN without cracks.csv or without creep cracks."""
-    cracks = read_cracks(folder, time_factor)
-    if cracks is None:
-        return np.nan
-    creep = cracks["creep_time_s"][cracks["creep_time_s"] >= 0]
-    return float(creep.min()) if len(creep) else np.nan
+def left_out_note(g: pd.DataFrame) -> str:
+    """The fit note naming the failed runs of ``g`` left out of the fits, each with its lifetime, and why."""
+    out = g[(g["outcome"] == "failed") & ~fitted(g)]
+    if not len(out):
+        return ""
+    runs = ", ".join(f"{r['run']} (t = {_num(r['lifetime_s']):.3g} s)" for r in out.to_dict("records"))
+    reasons = "; ".join(sorted(set(out["fit_left_out"])))
+    return f"; {len(out)} left out of the fit ({reasons}): {runs}"
 
 
 def lifetime_sets(runs: pd.DataFrame) -> list:
-    """One :class:`LifetimeSet` per model variant: failed points (t > 0, fitted) and lower bounds."""
+    """One :class:`LifetimeSet` per model variant: failed points (t > 0, fitted; not those
+    :func:`fitted` leaves out) and lower bounds."""
     sets = []
     for variant, g in runs[runs["outcome"].isin(CREEP_OUTCOMES)].groupby("variant", sort=True):
-        failed = g[(g["outcome"] == "failed") & g["ratio"].notna()]
+        failed = g[(g["outcome"] == "failed") & g["ratio"].notna() & fitted(g)]
         lower = g[(g["outcome"] == "not failed") & g["ratio"].notna()]
         ratio, life = failed["driving_stress_ratio"].to_numpy(float), failed["lifetime_s"].to_numpy(float)
         fit = fit_lifetimes(ratio, life, source=f"{variant} runs") if len(ratio) else None
@@ -267,15 +102,6 @@ def choose_focus(reps: pd.DataFrame, ratio: float | None):
             target = ratio if ratio is not None else float(cand["ratio"].median())
             return cand.loc[(cand["ratio"] - target).abs().idxmin()]
     return None
-
-
-def _check_out(out: Path, study: Path):
-    for p in (out, *out.parents):
-        if (p / "run.json").exists():
-            raise GrainfracError(f"{out}: is inside the run folder {p} (the report never writes into run "
-                                 "folders); fix: give --out DIR outside run folders")
-    if out.exists() and not out.is_dir():
-        raise GrainfracError(f"{out}: exists and is not a folder; fix: choose another --out")
 
 
 def _spread_text(stats: pd.DataFrame, lab_stats: pd.DataFrame | None, reference) -> list:
@@ -392,8 +218,7 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     runs = load_studies(folders, beta1)
     folder = folders[0]
     out = Path(out) if out is not None else folder / "report"
-    for f in folders:
-        _check_out(out.resolve(), f)
+    check_report_folder(out)
     lab_frame = read_lab_csv(lab) if lab is not None else None   # bad lab input fails before anything is written
     if lab is None:
         reference = paper_reference(reference_dir)
@@ -428,6 +253,7 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
         n_load = int((g["outcome"] == "failed at load").sum())
         note = (f"{s.label}: {len(s.ratio)} failed run(s) at {k} distinct ratio(s)"
                 + (" fitted" if s.fit is not None else ": fit skipped (needs failed runs at 2 or more ratios)"))
+        note += left_out_note(g)
         note += f"; {int((g['outcome'] == 'not failed').sum())} run(s) did not fail (lower bounds, drawn, not fitted)"
         note += f"; {n_load} failed at load (t = 0, not in the log fit)" if n_load else ""
         n_num = int((g["outcome"] == "numerical failure").sum())
@@ -508,6 +334,17 @@ def analyze_study(folder, lab=None, out=None, reference_dir=None, focus_ratio=No
     else:
         for name in ("strain_time.png", "strain_time_normalised.png"):
             content.skipped.append((name, "no finished run with a history.csv and a positive end time"))
+    rates = creep_rates.strain_rate_table(runs, lambda r: read_history(r["folder"], _factor(r)))
+    write_csv(out / "strain_rate.csv", rates)
+    content.tables.append("strain_rate.csv")
+    shown = reps[reps["run"].isin(set(rates["run"]))]
+    if len(shown):
+        creep_rates.strain_rate_figure(out / "strain_rate.png", rates, shown)
+        content.figures.append(("strain_rate.png", "Axial creep strain rate vs normalised time, one run per load, "
+                                                   "with the minimum (secondary) creep strain rate"))
+    else:
+        content.skipped.append(("strain_rate.png", "no failed run whose history resolves its creep stages (at least "
+                                                   "9 creep times before the collapse)"))
     failed_curves = [(r, c) for r, c in curves if r["outcome"] == "failed"]
     if failed_curves:
         pick = [failed_curves[0]] if len(failed_curves) == 1 else \

@@ -69,11 +69,18 @@ def crack_initiation_volumetric_stress(stress, axial_strain, lateral_strain, you
 
 
 def crack_damage_stress(stress, axial_strain, lateral_strain):
-    """Axial stress at the onset of volumetric strain reversal [Pa]: max of eps_a + eps_l before peak."""
+    """Axial stress at the onset of volumetric strain reversal [Pa]: max of eps_a + eps_l before peak.
+
+    NaN where the history ends at its largest stress with the volumetric strain still growing there (a test
+    stopped at ``ucs.max_strain`` before its peak): no reversal was seen, and the last point, a lower bound of
+    the strength, is no crack damage stress."""
     stress = np.asarray(stress, float)
     ip = int(np.argmax(stress))
     ev = np.asarray(axial_strain, float)[: ip + 1] + np.asarray(lateral_strain, float)[: ip + 1]
-    return float(stress[int(np.argmax(ev))])
+    top = int(np.argmax(ev))
+    if top == ip == len(stress) - 1:
+        return float("nan")
+    return float(stress[top])
 
 
 def ucs_summary(history: dict) -> dict:

@@ -8,7 +8,7 @@ import sys
 
 from ..engines.registry import engine_for, require_dynamic
 from ..errors import GrainfracError
-from ..params import FlagOverride, load_parameters, override_origin
+from ..params import FlagOverride, check_conflicting_overrides, load_parameters, override_origin
 from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
 
@@ -56,6 +56,7 @@ def load_params_from_args(args):
     """The parameter set of ``args`` (``--params``, ``--set``, shortcuts); sets ``args.resolved_overrides``."""
     args.resolved_overrides = overrides_from_args(args)
     params = load_parameters(extra_files=args.params, overrides=args.resolved_overrides)
+    check_conflicting_overrides(args.resolved_overrides)   # after each value's own check (a NaN named as such)
     sp = params.specimen   # refused before any folder is made or anything allocated
     box = [sp.width, sp.height] if sp.dimension == 2 else [sp.width, sp.height, sp.thickness]
     flags = ", ".join(override_origin(o) for o in args.resolved_overrides

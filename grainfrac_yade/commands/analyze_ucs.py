@@ -1,6 +1,7 @@
 """``analyze-ucs``: table and figure of UCS tests in a study folder (engine, resolution, size, calibration), and
 the peak-strength envelope of confined tests (Mohr-Coulomb and Hoek-Brown fits) where a model variant
-was tested at two confining stresses or more."""
+was tested at two confining stresses or more.  Written into ``STUDY/report/`` (``--out``), as ``analyze``
+writes a creep study's report: never into the study folder among its runs."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -21,6 +22,8 @@ ENGINE = "engine"
 #: The confining stress column: the envelope's abscissa.
 CONFINEMENT = "confinement.stress"
 MEASURES = ("ucs_pa", "young_pa", "poisson", "crack_initiation_pa", "crack_damage_pa", "wall_s", "steps")
+#: The report folder inside the study folder (``analyze``'s too).
+REPORT = "report"
 
 
 def _mean_sd(mean, sd, unit) -> str:
@@ -29,30 +32,48 @@ def _mean_sd(mean, sd, unit) -> str:
 
 
 def register(sub, common):
-    p = sub.add_parser("analyze-ucs", help="summarise UCS runs of a study folder (CSV, markdown, PNG)")
-    p.add_argument("folder")
+    p = sub.add_parser("analyze-ucs", help="summarise UCS runs of a study folder (CSV, markdown, PNG) into "
+                                           "FOLDER/report/")
+    p.add_argument("folder", help="study folder holding UCS run folders (e.g. results/resolution)")
+    p.add_argument("--out", help="report folder (default FOLDER/report, as analyze)")
     p.set_defaults(func=cmd_analyze_ucs)
 
 
 def cmd_analyze_ucs(args) -> int:
     import pandas as pd
 
-    from ..analysis.collect import collect_runs, group_stats
+    from ..analysis.collect import check_report_folder, collect_runs, group_stats
     from ..analysis.study import fill_missing_params
     folder = Path(args.folder)
+    if not folder.is_dir():
+        raise GrainfracError(f"{folder}: study folder not found; fix: give a folder holding UCS run folders "
+                             "(e.g. results/resolution)")
     runs = collect_runs(folder)
-    if runs.empty or "ucs_pa" not in runs:
-        raise GrainfracError(f"{folder}: no finished UCS runs (summary.json with ucs_pa); fix: run the study first")
-    runs = runs[runs["command"] == "ucs"]
+    ucs = runs[runs["command"] == "ucs"] if "command" in runs else runs.iloc[:0]
+    finished = ucs[ucs["status"] == "finished"] if "status" in ucs else ucs.iloc[:0]
+    if finished.empty:
+        kinds = runs["command"].fillna("unknown").value_counts() if "command" in runs else {}
+        held = ", ".join(f"{n} {k}" for k, n in kinds.items()) or "none"
+        hint = (f"analyze a creep study with python3 -m grainfrac_yade analyze {folder}" if "creep" in kinds
+                else "run the UCS study first")
+        raise GrainfracError(f"{folder}: no finished UCS runs (run folders: {held}); fix: {hint}")
+    runs = ucs.copy()
+    for key in MEASURES:   # a study whose every UCS run ended as a numerical failure has null measures
+        if key not in runs:
+            runs[key] = float("nan")
+    out = Path(getattr(args, "out", None) or folder / REPORT)
+    check_report_folder(out)
+    out.mkdir(parents=True, exist_ok=True)
     runs, _ = fill_missing_params(runs)   # keys that older params.json lack: the shipped defaults
     runs[CONFINEMENT] = runs[CONFINEMENT].fillna(0.0).astype(float)   # runs older than the key were uniaxial
     by = (ENGINE,) + VARIANT + tuple(k for k in LOADING_VARIANT if k in runs)
     stats = group_stats(runs, by, MEASURES)
-    runs.to_csv(folder / "ucs_runs.csv", index=False)
-    stats.to_csv(folder / "ucs_stats.csv", index=False)
+    runs.to_csv(out / "ucs_runs.csv", index=False)
+    stats.to_csv(out / "ucs_stats.csv", index=False)
     varying = [k for k in by[1 + len(VARIANT):] if stats[k].astype(str).nunique() > 1]
     lines = ["| engine | cells | spheres/cell | grain [mm] | specimen [mm] | sigma_3 [MPa] | " + ("variant | " if varying else "")
-             + "n | peak [MPa] | E [GPa] | Poisson | CI/peak | CD/peak | DEM steps | wall [s] |",
+             + "n | peak [MPa] | E [GPa] | Poisson | CI/peak | CD/peak | steps (yade: DEM steps; static, hybrid: "
+             "equilibria solved) | wall [s] |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if varying else "")]
     for _, r in stats.iterrows():
         variant = (", ".join(f"{k.split('.', 1)[1]} {_cell(r[k])}" for k in varying) + " | ") if varying else ""
@@ -70,15 +91,17 @@ def cmd_analyze_ucs(args) -> int:
         lines.append("")
         lines += [f"numerical failure (no result, not counted): {r['run']}: {r['end_reason']}"
                   for _, r in failed.iterrows()]
-    lines += envelopes(runs, folder)
-    (folder / "ucs_stats.md").write_text("\n".join(lines) + "\n")
+    lines += envelopes(runs, folder, out)
+    (out / "ucs_stats.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
+    print(f"written: {out}")
     return 0
 
 
-def envelopes(runs, folder) -> list:
+def envelopes(runs, folder, out) -> list:
     """Mohr-Coulomb and Hoek-Brown fits of every model variant tested at two confining stresses or
-    more: envelope.csv (one row per variant), envelope_<k>.png; returns markdown lines."""
+    more: envelope.csv (one row per variant), envelope_<k>.png in ``out``; returns markdown lines (``folder``:
+    the study, named in the fits' refusals)."""
     import pandas as pd
 
     from ..analysis.envelope import fit_hoek_brown, fit_mohr_coulomb
@@ -106,7 +129,7 @@ def envelopes(runs, folder) -> list:
                      "mc_friction_angle_deg": mc.friction_angle_deg, "mc_cohesion_pa": mc.cohesion, "mc_r2": mc.line.r2,
                      "hb_sigma_ci_pa": hb.sigma_ci if hb else None, "hb_m_i": hb.m_i if hb else None,
                      "hb_r2": hb.r2 if hb else None, "figure": f"envelope_{k}.png"})
-        envelope_figure(folder / f"envelope_{k}.png", s3, s1, mc, hb, lab_property("uniaxial_compressive_strength"),
+        envelope_figure(out / f"envelope_{k}.png", s3, s1, mc, hb, lab_property("uniaxial_compressive_strength"),
                         title=f"peak strength envelope: {label}")
         lines += ["", f"Envelope {k} ({label}; {len(group)} tests, sigma_3 0-{s3.max() / 1e6:g} MPa; envelope_{k}.png): "
                   f"Mohr-Coulomb C_0 {mc.unconfined_strength / 1e6:.1f} MPa, q {mc.passive_coefficient:.2f}, "
@@ -114,7 +137,7 @@ def envelopes(runs, folder) -> list:
                   + (f"Hoek-Brown sigma_ci {hb.sigma_ci / 1e6:.1f} MPa, m_i {hb.m_i:.1f} (R^2 {hb.r2:.3f})" if hb
                      else f"Hoek-Brown: no fit ({hb_note})")]
     if rows:
-        pd.DataFrame(rows).to_csv(folder / "envelope.csv", index=False)
+        pd.DataFrame(rows).to_csv(out / "envelope.csv", index=False)
     return lines
 
 

@@ -2,10 +2,14 @@
 
 Every row is checked first as the CLI checks its flags (unknown column, a cell that is not a number
 or quoted text, a missing cell, ratio and stress in one row, a ratio outside (0, 1), a stress or
-confinement out of range, parameters the schema refuses): one line per bad row, exit status 2,
-nothing run.  Then the log folder (``--log-dir``, default ``results/logs/<table name>/``) and each
-row's study folder are made, yade-batch runs the rows, one line per row is printed as it ends, and
-the exit status is 1 when a row did not finish a run, naming those rows.
+confinement out of range, parameters the schema refuses), and the rows together (a row that repeats
+another, two rows that would run into one folder): one line per bad row, exit status 2, nothing run.
+Then the log folder (``--log-dir``, default ``results/logs/<table name>/``) and each row's study
+folder are made, yade-batch runs the rows, and one line per row is printed as it ends: ``ok``,
+``skipped (finished)``, ``numerical failure`` (the run finished without a result: its summary.json
+says ``numerical_failure: true``) or ``FAILED`` (no finished run).  The exit status is 0 when every
+row gave a result, 1 when a row FAILED, else 3 (:data:`~grainfrac_yade.errors.EXIT_NUMERICAL_FAILURE`)
+when rows ended as numerical failures; the last line names those rows.
 """
 from __future__ import annotations
 
@@ -13,14 +17,15 @@ import os
 import re
 from pathlib import Path
 
-from ..errors import GrainfracError
+from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
 from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
 from ..params import load_parameters, require_plane, shipped_values
 from ..params.schema import field_spec
-from ..runs.batchrun import ON_CHANGE, RUN_COLUMNS, cell_value, check_columns, read_table_rows, row_outcomes, run_batch
+from ..runs.batchrun import (ON_CHANGE, RUN_COLUMNS, cell_value, check_columns, read_table_rows, row_outcomes,
+                             run_batch, run_folder_name)
 from .brazilian import require_disc_model
-from .creep import CREEP_ROW_COLUMNS, check_stress_range, outcome, resolve_stress
+from .creep import CREEP_ROW_COLUMNS, check_stress_range, creep_name_parts, outcome, resolve_stress
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}
@@ -152,9 +157,41 @@ def _check_kind(test, params, controls):
         resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
 
 
+def row_out(test: str, overrides, controls: dict) -> Path:
+    """The folder a checked row runs into, named as its row script names it (``out``, else
+    ``results/<study>/<row name>``: :func:`~grainfrac_yade.runs.batchrun.run_folder_name` of the load columns and
+    the parameters in the shipped files' order, as YADE's reader lists them), absolute from the working folder
+    (where yade-batch runs).  A row with ``on_change = 'new_folder'`` may move on from it at run time."""
+    order = {k: i for i, k in enumerate(shipped_values())}
+    ordered = sorted(overrides, key=lambda kv: order[kv[0]])
+    parts = creep_name_parts(controls) if test == "creep" else []
+    out = str(controls["out"]) or f"results/{controls['study']}/{run_folder_name(controls, parts + ordered)}"
+    return Path(out).expanduser().absolute()
+
+
+def repeated_rows(table, test: str, checked: dict) -> list:
+    """One line per row that repeats an earlier one (the same load, seed and parameters: the second run would
+    only find the first finished) or runs into an earlier row's folder (two runs in one folder)."""
+    problems, same, folders = [], {}, {}
+    for line, (overrides, controls) in checked.items():
+        key = repr((sorted(overrides), sorted(controls.items())))
+        if key in same:
+            problems.append(f"{table}:{line}: repeats line {same[key]} (the same run twice: the second would only "
+                            "skip it); fix: remove one, or give it another seed")
+            continue
+        same[key] = line
+        out = row_out(test, overrides, controls)
+        if out in folders:
+            problems.append(f"{table}:{line}: runs into {out}, as line {folders[out]} does (two runs cannot share a "
+                            "folder); fix: give each row its own out (or description)")
+        else:
+            folders[out] = line
+    return problems
+
+
 def check_table(table, test=None) -> tuple:
-    """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row`;
-    else GrainfracError with one line per bad row."""
+    """(kind of rows, {line: (overrides, controls)}) of a table whose every row passes :func:`check_row` and
+    that repeats no row and no folder (:func:`repeated_rows`); else GrainfracError with one line per bad row."""
     columns, rows, problems = read_table_rows(table)
     test = test or guess_test(columns, Path(table).name)
     checked = {}
@@ -163,6 +200,9 @@ def check_table(table, test=None) -> tuple:
             checked[line] = check_row(test, columns, cells, f"{table}:{line}")
         except GrainfracError as exc:
             problems.append(str(exc))
+    problems += repeated_rows(table, test, checked)
+    if len(problems) == 1:   # one bad row: one line
+        raise GrainfracError(f"{table}: 1 bad row, nothing run: {problems[0]}")
     if problems:
         problems.sort(key=_line_of)
         listed = problems[:MAX_LISTED_PROBLEMS]
@@ -215,10 +255,18 @@ def cmd_batch(args) -> int:
               on_row_end=ended)
     for line in rows:
         ended(line)
-    failed = [o for o in done.values() if not o.ok]
-    if failed:
-        print(f"{len(failed)} of {len(rows)} rows failed: lines {', '.join(str(o.line) for o in failed)} of {table}")
-        return EXIT_ROWS_FAILED
+    failed = [o for o in done.values() if not o.ok and not o.numerical]
+    numerical = [o for o in done.values() if o.numerical]
+    if failed or numerical:
+        said = [f"{len(failed)} of {len(rows)} rows failed: lines {_lines(failed)}"] if failed else []
+        said += [f"{len(numerical)} of {len(rows)} rows ended as a numerical failure (no result): lines "
+                 f"{_lines(numerical)}"] if numerical else []
+        print("; ".join(said) + f" of {table}")
+        return EXIT_ROWS_FAILED if failed else EXIT_NUMERICAL_FAILURE
     skipped = sum(o.skipped for o in done.values())
-    print(f"all {len(rows)} rows finished" + (f" ({skipped} skipped: finished before)" if skipped else ""))
+    print(f"all {len(rows)} rows finished with a result" + (f" ({skipped} skipped: finished before)" if skipped else ""))
     return 0
+
+
+def _lines(outcomes) -> str:
+    return ", ".join(str(o.line) for o in outcomes)

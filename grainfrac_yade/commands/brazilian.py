@@ -10,10 +10,12 @@ specimen (:mod:`grainfrac_yade.geometry.disc`), loaded by two rigid jaws
 from __future__ import annotations
 
 import math
+import sys
 
-from ..errors import GrainfracError
+from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
 from ..protocols.brazilian_output import require_disc_model, run_brazilian_to_folder
 from ..protocols.levers import Levers
+from .creep import numerical_failure_line, steps_phrase
 
 
 def register(sub, common):
@@ -67,6 +69,9 @@ def cmd_brazilian(args) -> int:
     out = args.out or f"results/brazilian_seed{args.seed}"
     summary = run_brazilian_to_folder(params, args.seed, out, overwrite=args.overwrite, progress=print, levers=levers,
                                       vtk_every=args.vtk_every)
+    if summary["numerical_failure"]:
+        print(numerical_failure_line("Brazilian", summary, out), file=sys.stderr)
+        return EXIT_NUMERICAL_FAILURE
     print(format_result(summary, out))
     return 0
 
@@ -88,7 +93,7 @@ def format_result(summary, out) -> str:
             f"(P/t {summary['peak_load_per_thickness_n_per_m'] / 1e3:.1f} kN/m, D {summary['diameter_m'] * 1e3:g} mm), "
             f"calibration.reference_ucs / sigma_t {'-' if ratio is None else f'{ratio:.1f}'}; central band "
             f"{summary['central_band_fraction']:.2f} of {summary['broken_total']} broken bonds "
-            f"({summary['steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
+            f"({steps_phrase(summary)}, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
 
 
 def tensile_scale_overrides(params, factor: float) -> list:
@@ -150,3 +155,5 @@ def run_brazilian_in_yade(rows):
         summary = run_brazilian_to_folder(params, int(controls["seed"]), out,
                                           overwrite=(out / "run.json").exists(), resume=action == "resume")
     print(format_result(summary, out))
+    if summary["numerical_failure"]:   # the row's log and yade-batch's status say so; batch reads the summary
+        sys.exit(EXIT_NUMERICAL_FAILURE)

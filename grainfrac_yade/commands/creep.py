@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import math
 
-from ..errors import GrainfracError
+from ..analysis.durations import readable_duration
+from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
 from ..protocols.creep_output import UCS_FROM_CALIBRATION, resume_creep_folder, run_creep_to_folder, ucs_reference
 
 
@@ -56,6 +57,11 @@ PA_PER_MPA = 1e6
 #: meant is 1e6 times too large), not a test.  Confined peak strengths measured here stay below 2 x it
 #: (426 MPa at 20 MPa confinement against 236 MPa).
 MAX_STRESS_OVER_REFERENCE = 4.0
+#: Smallest creep load (and reference strength) accepted [Pa]: 1 MPa.  Creep tests of granite hold 40 % of the UCS
+#: or more (Lajtai & Schmidtke's long-term strength bound lies near 60 %), some 100 MPa; a stress below 1 MPa is a
+#: unit slip (a batch column in Pa given as MPa: 160 for 160e6; a CLI flag in MPa given as Pa: 1e-6), and would
+#: only hold the specimen unloaded to the creep time limit.
+MIN_STRESS_PA = 1e6
 
 
 def add_confinement_option(parser):
@@ -106,6 +112,12 @@ def check_stress_range(params, where: str = "confinement.stress") -> None:
                              "confinement.stress in files and batch columns in Pa (e.g. 20e6)")
 
 
+def seconds(value: float) -> str:
+    """A time in s, with the unit that reads best beside it where that is not s: "1.2e+07 s (140 d)"."""
+    readable = readable_duration(value)
+    return f"{value:.4g} s" + (f" ({readable})" if readable and not readable.endswith(" s") else "")
+
+
 def outcome(summary: dict) -> str:
     """One phrase: numerical failure, lifetime, failure on loading, or not failed by the end."""
     if summary.get("numerical_failure"):
@@ -115,8 +127,23 @@ def outcome(summary: dict) -> str:
     if summary.get("failed_on_loading"):
         return "failed on loading (during the ramp)"
     if summary["failed"]:
-        return f"lifetime {summary['lifetime_s']:.4g} s"
-    return f"not failed by {summary['creep_time_end_s']:.4g} s"
+        first = ", in the relaxation after its first creep event" if summary.get("failed_in_first_relaxation") else ""
+        return f"lifetime {seconds(summary['lifetime_s'])}{first}"
+    return f"not failed by {seconds(summary['creep_time_end_s'])}"
+
+
+def steps_phrase(summary: dict) -> str:
+    """"1234 DEM steps" or, for an engine without dynamics, "170 equilibria solved" (summary ``steps_counted``;
+    "steps" for a run written before the key)."""
+    return f"{summary['steps']} {summary.get('steps_counted', 'steps')}"
+
+
+def numerical_failure_line(test: str, summary: dict, out) -> str:
+    """The one line (stderr) of a run that ended as a numerical failure: the test, the engine, what it did before,
+    the reason, and where its summary.json (``numerical_failure: true``) is."""
+    reason = str(summary.get("failure_reason") or summary.get("end_reason")).removeprefix("numerical failure: ")
+    return (f"numerical failure: {test}, {summary.get('engine', 'yade')} engine: no result ({reason}); exit status "
+            f"{EXIT_NUMERICAL_FAILURE}, summary.json says numerical_failure: true -> {out}")
 
 
 def _positive_int(text: str) -> int:
@@ -179,6 +206,9 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
         if not (math.isfinite(value) and value > 0):
             raise GrainfracError(f"{named(flag, value)}: a stress must be finite and above 0; fix: e.g. "
                                  f"{example[flag]}")
+        if value < MIN_STRESS_PA:
+            raise GrainfracError(f"{named(flag, value)} is below {MIN_STRESS_PA / PA_PER_MPA:g} MPa, no creep load for "
+                                 "granite; fix: CLI stress flags are in MPa, batch columns in Pa: e.g. " + example[flag])
         if value > MAX_STRESS_OVER_REFERENCE * calibrated:
             raise GrainfracError(f"{named(flag, value)} is above {MAX_STRESS_OVER_REFERENCE:g} x the reference "
                                  f"strength (calibration.reference_ucs = {calibrated / PA_PER_MPA:.4g} MPa); fix: "
@@ -197,6 +227,10 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
             raise GrainfracError(f"{given}: a driving-stress ratio must lie in (0, 1); fix: e.g. "
                                  f"{'--ratio' if cli else 'ratio'} 0.7")
         stress = confining + ratio * (ref - confining)
+        if stress < MIN_STRESS_PA:
+            given = f"--ratio {ratio:g}" if cli else f"column ratio = {ratio:g}"
+            raise GrainfracError(f"{given} gives {stress / PA_PER_MPA:.4g} MPa, below {MIN_STRESS_PA / PA_PER_MPA:g} MPa, "
+                                 f"no creep load for granite; fix: e.g. {'--ratio' if cli else 'ratio'} 0.7")
     if not stress > confining:
         raise GrainfracError(f"{named('stress', stress)}: must be above the confining stress "
                              f"({confining / PA_PER_MPA:.4g} MPa); fix: e.g. {example['stress']}")
@@ -243,9 +277,9 @@ def cmd_creep(args, params) -> int:
             print(f"creep run already finished (summary.json): {args.resume}; nothing to resume")
             return 0
         print(f"creep {s['stress_pa'] / 1e6:.1f} MPa (ratio {s['driving_stress_ratio']:.3f}), {s['clock']} clock, "
-              f"resumed: {outcome(s)}, {s['n_events']} events, {s['broken_creep']} creep cracks, {s['steps']} "
-              f"DEM steps -> {args.resume}")
-        return 0
+              f"resumed: {outcome(s)}, {s['n_events']} events, {s['broken_creep']} creep cracks, {steps_phrase(s)} "
+              f"-> {args.resume}")
+        return creep_exit_status(s, args.resume)
     require_plane(params, "creep")
     check_stress_range(params, "--confinement" if args.confinement is not None else "confinement.stress")
     stress, ratio, ref = resolve_stress(params, _pa(args.stress), args.ratio, _pa(args.ucs), cli=True)
@@ -262,7 +296,18 @@ def cmd_creep(args, params) -> int:
         print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}): {outcome(s)} -> {out}")
         return 1
     print(f"creep {stress / 1e6:.1f} MPa (ratio {ratio:.3f}{confined}), {s['clock']} clock: {outcome(s)}, {s['n_events']} events, "
-          f"{s['broken_creep']} creep cracks, {s['steps']} DEM steps, {s['wall_s']:.1f} s -> {out}")
+          f"{s['broken_creep']} creep cracks, {steps_phrase(s)}, {s['wall_s']:.1f} s -> {out}")
+    return creep_exit_status(s, out)
+
+
+def creep_exit_status(summary: dict, out) -> int:
+    """0 for a result (a lifetime, a survival, a failure on loading); :data:`~grainfrac_yade.errors.
+    EXIT_NUMERICAL_FAILURE` with its one line on stderr for a numerical failure (no result)."""
+    import sys
+    if summary.get("numerical_failure"):
+        print(numerical_failure_line(f"creep {summary['stress_pa'] / 1e6:.1f} MPa after {summary['n_events']} events",
+                                     summary, out), file=sys.stderr)
+        return EXIT_NUMERICAL_FAILURE
     return 0
 
 
@@ -273,6 +318,12 @@ def _pa(mpa):
 
 #: yade-batch columns of a creep row that are not model parameters [Pa or 1; 0 = not given].
 CREEP_ROW_COLUMNS = {"ratio": 0.0, "stress": 0.0, "ucs": 0.0}
+
+
+def creep_name_parts(controls: dict) -> list:
+    """The load columns that name a creep row's folder, before its parameters: ratio (or stress), and ucs if given."""
+    parts = [("ratio", controls["ratio"])] if float(controls["ratio"]) else [("stress", controls["stress"])]
+    return parts + ([("ucs", controls["ucs"])] if float(controls["ucs"]) else [])
 
 
 def run_creep_in_yade(rows):
@@ -298,9 +349,7 @@ def run_creep_in_yade(rows):
                                  "(stress in Pa, ratio of the UCS)")
         check_stress_range(params)
         stress, ratio, ref = resolve_stress(params, given["stress"], given["ratio"], given["ucs"])
-        name_parts = [("ratio", controls["ratio"])] if given["ratio"] else [("stress", controls["stress"])]
-        name_parts += [("ucs", controls["ucs"])] if given["ucs"] else []
-        name = run_folder_name(controls, name_parts + overrides)
+        name = run_folder_name(controls, creep_name_parts(controls) + overrides)
         out, action, note = row_plan(controls["out"] or f"results/{controls['study']}/{name}", params, controls,
                                      {"seed": int(controls["seed"]), "stress_pa": stress})
     if action == "skip":
@@ -322,3 +371,6 @@ def run_creep_in_yade(rows):
     if s["failed_before_test"]:
         import sys
         sys.exit(1)
+    if s["numerical_failure"]:   # the row's log and yade-batch's status say so; batch reads the summary
+        import sys
+        sys.exit(creep_exit_status(s, out))

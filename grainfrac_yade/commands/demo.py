@@ -83,8 +83,8 @@ def cmd_demo(args, params) -> int:
     if failed:
         _say(t0, f"report of the finished runs: {report}")
         for row in failed:
-            _say(t0, f"FAILED {row}")
-        _say(t0, f"{len(failed)} rows failed (listed above; their logs say why)")
+            _say(t0, str(row))   # "line N: FAILED: ..." or "line N: numerical failure: ..."
+        _say(t0, f"{len(failed)} rows failed or ended as a numerical failure (listed above; their logs say why)")
         return 1
     _say(t0, f"done. Report: {report}")
     return 0
@@ -105,7 +105,8 @@ def check_demo_arguments(args, params) -> None:
 
 
 def _failed_rows(table, log_dir) -> list:
-    """The rows of ``table`` run into ``log_dir`` that did not finish a run (:func:`row_outcomes`)."""
+    """The rows of ``table`` run into ``log_dir`` that did not finish a run with a result (:func:`row_outcomes`: a
+    numerical failure is not ok)."""
     _, rows, _ = read_table_rows(table)
     return [o for o in row_outcomes(table, log_dir, list(rows)) if not o.ok]
 

@@ -6,7 +6,8 @@ import sys
 import numpy as np
 
 from ..protocols.ucs_output import run_ucs_to_folder
-from .creep import add_confinement_option, check_stress_range, confinement_override
+from ..errors import EXIT_NUMERICAL_FAILURE
+from .creep import add_confinement_option, check_stress_range, confinement_override, numerical_failure_line, steps_phrase
 from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
@@ -48,14 +49,16 @@ def cmd_ucs(args, params) -> int:
         print(f"UCS: failed before the test ({summary['end_reason']}) -> {out}")
         return 1
     if summary["numerical_failure"]:
-        print(f"UCS: no result ({summary['end_reason']}) -> {out}")
-        return 0
+        print(numerical_failure_line("UCS", summary, out), file=sys.stderr)
+        return EXIT_NUMERICAL_FAILURE
     confined = summary["confining_stress_pa"]
     label = f"peak axial stress at confinement {confined / 1e6:g} MPa:" if confined else "UCS"
-    print(f"{label} {summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
+    # a test stopped at ucs.max_strain before its peak: the largest stress is a lower bound (end_reason says why)
+    bound = "" if summary.get("peak_reached", True) else "at least "
+    print(f"{label} {bound}{summary['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(summary['young_pa'], 1e9)} GPa, "
           f"nu {_fmt(summary['poisson'], 1, 3)}, CI {_fmt(summary['crack_initiation_pa'])} MPa, "
           f"CD {_fmt(summary['crack_damage_pa'])} MPa, broken {summary['broken_total']} of {summary['n_bonds']} "
-          f"({summary['steps']} steps, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
+          f"({steps_phrase(summary)}, {summary['wall_s']:.1f} s; {summary['end_reason']}) -> {out}")
     return 0
 
 
@@ -95,3 +98,5 @@ def run_ucs_in_yade(rows):
         sys.exit(1)
     print(f"UCS: no result ({s['end_reason']}) -> {out}" if s["numerical_failure"] else
           f"UCS {s['ucs_pa'] / 1e6:.1f} MPa, E {_fmt(s['young_pa'], 1e9)} GPa -> {out}")
+    if s["numerical_failure"]:   # the row's log and yade-batch's status say so; batch reads the summary
+        sys.exit(EXIT_NUMERICAL_FAILURE)

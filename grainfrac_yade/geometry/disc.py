@@ -96,6 +96,10 @@ def check_disc_size(diameter: float, grain_size: float, where: str = "brazilian.
     if not (math.isfinite(diameter) and diameter > 0):
         raise GrainfracError(f"{where}: {diameter!r} is not a positive diameter; fix: give the disc's diameter in m "
                              "(e.g. 31.7e-3)")
+    ratio = diameter / grain_size
+    if not math.isfinite(ratio * ratio):   # (D / d)^2 cells: the count would overflow a float
+        raise GrainfracError(f"{where}: a disc of {diameter:g} m holds more cells of specimen.grain_size = "
+                             f"{grain_size:g} m than a float counts; fix: give the disc's diameter in m (e.g. 31.7e-3)")
     if grain_size >= diameter or n_cells_for_disc(diameter, grain_size) < 2:
         raise GrainfracError(f"{where}: a disc of {diameter:g} m holds no more than one grain of "
                              f"specimen.grain_size = {grain_size:g} m (a lone cell has no face to bond); fix: make "

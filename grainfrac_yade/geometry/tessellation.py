@@ -85,11 +85,17 @@ class Tessellation:
         return np.unique(self.boundary_cell[self.boundary_side == SIDES.index(side)])
 
 
-def n_cells_for(box, grain_size: float) -> int:
-    """Number of cells whose mean equivalent diameter is ``grain_size``."""
-    box = np.asarray(box, float)
+def cell_count(box, grain_size: float) -> float:
+    """Number of cells whose mean equivalent diameter is ``grain_size``, as a float: the box's area (volume) over a
+    cell's, pi d^2 / 4 (pi d^3 / 6); inf where that overflows a float (a box of 1e308 m), never an error."""
+    box = [float(b) for b in box]
     cell = math.pi / 4 * grain_size**2 if len(box) == 2 else math.pi / 6 * grain_size**3
-    return max(1, int(round(np.prod(box) / cell)))
+    return math.prod(box) / cell
+
+
+def n_cells_for(box, grain_size: float) -> int:
+    """Number of cells whose mean equivalent diameter is ``grain_size`` (:func:`cell_count`, rounded, at least 1)."""
+    return max(1, int(round(cell_count(box, grain_size))))
 
 
 def voronoi_box(box, grain_size: float, rng: np.random.Generator, lloyd_iterations: int = 2) -> Tessellation:

@@ -9,6 +9,7 @@ with one line naming the file, the key and the fix.
 from __future__ import annotations
 
 import dataclasses
+import math
 import tomllib
 from itertools import combinations_with_replacement
 from typing import Mapping
@@ -16,7 +17,7 @@ from typing import Mapping
 from ..arrhenius import betas_from_physical
 from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
-from ..geometry.tessellation import n_cells_for
+from ..geometry.tessellation import cell_count
 from .files import read_toml
 from .schema import (DEFAULT_FILES, FRACTION_SUM_TOLERANCE, PARAMS_DIR, SECTION_CLASSES, ContactParams, GrainParams,
                      Parameters, SpecimenParams, StressCorrosionParams, _check_value, average_contact, field_spec,
@@ -229,6 +230,7 @@ def load_parameters(files=None, overrides=(), extra_files=()) -> Parameters:
             raise ParameterError(origin, key, "no such parameter",
                                  f"did you mean {close}?" if close else "use a dotted key that exists in the "
                                  "parameter files, e.g. stress_corrosion.beta1")
+        _check_override_value(key, value, origin)
         _merge(merged, _nest(key, value), origins, origin)
     return build_parameters(merged, origins, tuple(str(p) for p in files))
 
@@ -248,6 +250,39 @@ def _check_overridden_file_values(merged: Mapping, origins: Mapping, overrides):
         except ParameterError:
             continue
         _check_value(flat[key], spec, origin, key)
+
+
+def _check_override_value(key: str, value, origin: str):
+    """An override's value is checked as it is given, even where a later one (a flag after ``--set``) replaces it:
+    a ``--set specimen.width=nan`` hidden by ``--width`` is refused, not dropped unseen.  Schema keys only."""
+    try:
+        spec = field_spec(key)
+    except ParameterError:
+        return   # a mineral table's key: checked by its own builder
+    _check_value(value, spec, origin, key)
+
+
+def check_conflicting_overrides(overrides) -> None:
+    """ParameterError if one key is given two different values on one command line (``--set`` and a flag that
+    sets it, e.g. ``--set numerics.engine=static --engine yade``, or ``--set`` twice): neither silently wins.
+    ``overrides``: the command line's (``section.key=value`` strings or :class:`FlagOverride` pairs), in order."""
+    first = {}
+    for item in overrides:
+        key, value = parse_override(item) if isinstance(item, str) else item
+        if key not in first:
+            first[key] = (value, item)
+            continue
+        earlier, given = first[key]
+        if earlier != value:
+            raise ParameterError(_typed(item, key, value), key,
+                                 f"also given as {_typed(given, key, earlier)}: two values ({earlier!r} and {value!r})",
+                                 f"give {key} once: drop one of the two")
+
+
+def _typed(item, key: str, value) -> str:
+    """How the user typed override ``item``: ``--set key=value`` or the flag (``--engine``)."""
+    flag = override_origin(item)
+    return f"--set {key}={value}" if flag == "--set" else flag
 
 
 def _is_new_pair_key(key: str) -> bool:
@@ -313,13 +348,27 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
 
 
+def _on_command_line(origin) -> bool:
+    """Whether a value's origin is the command line (``--set`` or a flag such as ``--height``), not a file."""
+    return isinstance(origin, str) and origin.startswith("--")
+
+
 def _check_grain_size(sp: SpecimenParams, origins: Mapping):
     """A grain must be smaller than the specimen's width and height (at or above, the specimen is a few
     cells at most) and leave at least two cells (a lone cell has no face to bond). The 3D box depth may
-    be thinner (one layer)."""
+    be thinner (one layer).  The refusal names what the user gave: the side when the command line gave it
+    and a file the grain size (``--height 1e-5`` is the flag's fault, not the file's), else the grain size.
+    A box whose cell count overflows a float (``--width 1e308``) is refused naming its largest side."""
     name, side = min([("width", sp.width), ("height", sp.height)], key=lambda s: s[1])
+    grain_origin = origins.get("specimen.grain_size", "parameters")
+    side_origin = origins.get(f"specimen.{name}", "parameters")
+    if sp.grain_size >= side and _on_command_line(side_origin) and not _on_command_line(grain_origin):
+        raise ParameterError(side_origin, f"specimen.{name}",
+                             f"{side:g} m is at or below the grain size (specimen.grain_size = {sp.grain_size:g} m, "
+                             f"{grain_origin})", f"give a {name} above the grain size (paper: 31.7 x 63.4 mm with "
+                             "1 mm grains; e.g. 10e-3 m), or a smaller grain size")
     if sp.grain_size >= side:
-        raise ParameterError(origins.get("specimen.grain_size", "parameters"), "specimen.grain_size",
+        raise ParameterError(grain_origin, "specimen.grain_size",
                              f"{sp.grain_size:g} m is at or above the specimen's {name} ({side:g} m)",
                              f"make specimen.grain_size smaller than specimen.{name} (paper: 1 mm in a 31.7 mm "
                              f"wide specimen) or enlarge the specimen")
@@ -328,7 +377,16 @@ def _check_grain_size(sp: SpecimenParams, origins: Mapping):
                              f"{sp.min_edge_fraction:g} with specimen.dimension = 3: edge collapse is built for "
                              "plane (2D) tessellations only", "set specimen.min_edge_fraction = 0 for the 3D box")
     box = [sp.width, sp.height] + ([sp.thickness] if sp.dimension == 3 else [])
-    if n_cells_for(box, sp.grain_size) < 2:
+    count = cell_count(box, sp.grain_size)
+    if not math.isfinite(count):
+        sides = [("width", sp.width), ("height", sp.height)] + ([("thickness", sp.thickness)] if sp.dimension == 3
+                                                                 else [])
+        name, side = max(sides, key=lambda s: s[1])
+        raise ParameterError(origins.get(f"specimen.{name}", "parameters"), f"specimen.{name}",
+                             f"{side:g} m makes a specimen of more cells than a float counts (grain size "
+                             f"{sp.grain_size:g} m)", f"give the {name} in m (paper: 31.7 x 63.4 mm, i.e. "
+                             "31.7e-3 x 63.4e-3)")
+    if round(count) < 2:
         raise ParameterError(origins.get("specimen.grain_size", "parameters"), "specimen.grain_size",
                              f"{sp.grain_size:g} m gives a specimen of one cell (a lone cell has no face to bond)",
                              "make specimen.grain_size smaller or enlarge the specimen")
@@ -422,4 +480,4 @@ def _contacts(table: Mapping, origins: Mapping, minerals: tuple) -> dict:
     return contacts
 
 
-__all__ = ["RENAMED_KEYS", "renamed_key_fix", "ADDED_KEYS", "migrate_tree", "flatten", "parse_override", "FlagOverride", "override_origin", "default_files", "shipped_values", "flat_values", "load_parameters", "LATER_PROTOCOL_SECTIONS", "build_parameters", "require_plane"]
+__all__ = ["RENAMED_KEYS", "renamed_key_fix", "ADDED_KEYS", "migrate_tree", "flatten", "parse_override", "FlagOverride", "check_conflicting_overrides", "override_origin", "default_files", "shipped_values", "flat_values", "load_parameters", "LATER_PROTOCOL_SECTIONS", "build_parameters", "require_plane"]

@@ -11,12 +11,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.creep_analysis import CreepStages, damage_index, resolve_creep_stages
+from ..analysis.creep_analysis import CreepStages, MinimumCreepRate, damage_index, minimum_creep_rate, resolve_creep_stages
+from ..analysis.durations import readable_duration
 from ..analysis.runparams import load_run_parameters
-from ..engines.registry import require_dynamic
+from ..engines.registry import engine_for, require_dynamic
 from ..errors import GrainfracError
 from ..geometry.specimen import build_specimen
 from ..params import load_parameters, require_plane
+from ..runs.columns import STEPS_COUNTED_KEY, steps_counted
 from ..runs.runio import (CHECKPOINT, SUMMARY, check_files, checkpoint_folder, commit_run_dir, comparable_parameters,
                           prepare_run_dir, read_checkpoint_state, remove_checkpoints, summary_header, write_csv,
                           write_json)
@@ -142,17 +144,24 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     broken_creep = hist["broken_total"] - run.ramp_broken
     t_end = float(hist["creep_time_s"][-1])
     lifetime = t_end if run.failed and not numerical else None
-    # stages from the history before the collapse row (the failure itself would dominate every rate)
-    stages = (resolve_creep_stages(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end)
-              if lifetime is not None and len(rows) > 3
-              else CreepStages(None, None, "no lifetime" if lifetime is None else "too short a history"))
+    # stages and the minimum creep rate from the history before the collapse row (the failure itself would
+    # dominate every rate)
+    unresolved = "no lifetime" if lifetime is None else "too short a history"
+    resolvable = lifetime is not None and len(rows) > 3
+    stages = (resolve_creep_stages(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end) if resolvable
+              else CreepStages(None, None, unresolved))
+    min_rate = (minimum_creep_rate(hist["creep_time_s"][:-1], hist["axial_strain"][:-1], t_end) if resolvable
+                else MinimumCreepRate(None, unresolved))
     hist["broken_creep"] = broken_creep
-    hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
+    if not no_test:   # D_n = N(t) / N(t_f): no t_f without a result (a numerical failure's last count is no failure's)
+        hist["damage_index"] = damage_index(broken_creep, broken_creep[-1])
     if run.rows:
         write_csv(out / "history.csv", hist)
     write_crack_list(out / "cracks.csv", run)
     summary = {
-        "lifetime_s": lifetime, "failed": None if no_test else run.failed, "failure_reason": run.failure_reason,
+        "lifetime_s": lifetime, "lifetime_readable": readable_duration(lifetime),
+        "failed": None if no_test else run.failed, "failure_reason": run.failure_reason,
+        "failed_in_first_relaxation": failed_in_first_relaxation(run, params, lifetime),
         "end_reason": end_reason(run, params, t_end),
         "numerical_failure": numerical, "failed_on_loading": run.failed_on_loading,
         "failed_before_test": run.failed_before_test,
@@ -164,10 +173,11 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
         "broken_total": int(hist["broken_total"][-1]), "macrocracks": int(hist["macrocracks"][-1]),
         "n_bonds": run.scene.n_bonds, "bonds_erased_by_sliding": run.scene.sliding_erasures(),
         **budget_fields(getattr(run, "hold_budget", None)),
-        "steps": int(run.scene.steps), "wall_s": time.time() - t0,
-        "cpu_s": time.process_time() - c0, **run.scene.summary_keys(),
+        "steps": int(run.scene.steps), STEPS_COUNTED_KEY: steps_counted(engine_for(params)), "wall_s": time.time() - t0,
+        "cpu_s": time.process_time() - c0, "engine": params.numerics.engine, **run.scene.summary_keys(),
         "primary_end_s": stages.primary_end_s, "tertiary_start_s": stages.tertiary_start_s,
         "creep_stages": stages.unresolved or "resolved",
+        "min_creep_strain_rate_per_s": min_rate.rate_per_s, "min_creep_strain_rate": min_rate.unresolved or "resolved",
         "vtk_creep_times_s": run.vtk_written,
         "vtk_merged_times": run.vtk_merged,
         "vtk_times_not_reached_s": list(run.vtk_times) if run.vtk_folder is not None else [],
@@ -198,6 +208,16 @@ def run_creep_to_folder(params, seed, out, stress, ratio, ref_ucs, overwrite=Fal
     remove_checkpoints(out)                     # a finished run has nothing to resume
     commit_run_dir(out)                         # a replacing run (--overwrite) takes the old one's place
     return summary
+
+
+def failed_in_first_relaxation(run, params, lifetime) -> bool:
+    """Whether a failed event-clock run collapsed in the relaxation after its first creep event: the first bond the
+    law broke brought the specimen down, with no creep damage before it, so its lifetime is that bond's corrosion
+    time, not a creep life (the analysis leaves such runs out of its fits).  False for a run without a lifetime or
+    with a lifetime of 0 (failed at load: no creep event at all), and for the paper clock (no relaxation after an
+    event: it corrodes every step)."""
+    return bool(lifetime is not None and lifetime > 0 and params.stress_corrosion.clock == "event"
+                and run.n_events <= 1)
 
 
 def end_reason(run, params, t_end) -> str:

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import NumericalFailure
 from ..law import check_finite
-from ..runs.columns import STEP, STEPS
+from ..runs.columns import STEP, STEPS, STEPS_COUNTED_KEY, steps_counted
 
 #: Bonds sampled for the mean bond force (every k-th of the given ones, k = len // this).
 BOND_FORCE_SAMPLE = 500
@@ -52,7 +52,8 @@ def held_at_equilibrium(scene, servo, bonds, creep_params) -> bool:
 
 
 class LoadingTest:
-    """The rows and the end of a strain-controlled test; ``strain_column``: the history column of its strain."""
+    """The rows and the end of a strain-controlled test; ``strain_column``: the history column of its strain;
+    ``engine``: the engine module that runs it (set by the test)."""
 
     strain_column = ""
 
@@ -76,15 +77,19 @@ class LoadingTest:
     def result(self, scene, counts: dict, numerical: bool, peak_reached: bool, end: str, cpu: bool = True,
                **extra) -> dict:
         """The result dict of the test (after the VTK series' last snapshot, unless it ended in a numerical
-        failure): steps, wall (and CPU) time, DEM step, bonds and ``counts`` of broken ones, how it ended,
-        then ``extra``, and the checkpoints it went on from."""
+        failure): steps and what they count (``steps_counted``), the engine, wall (and CPU) time, the DEM step
+        (``dem_timestep_s``; a static engine's load increment ``load_increment_s`` instead), bonds and ``counts``
+        of broken ones, how it ended, then ``extra``, and the checkpoints it went on from."""
         cols = self.cols
         if self.snapshot is not None and cols[STEP] and not numerical:
             self.snapshot.write(scene, len(cols[STEP]), cols[self.strain_column][-1])
         result = {STEPS: int(scene.steps), "wall_s": time.time() - self.t0}
         if cpu:
             result["cpu_s"] = time.process_time() - self.c0
-        result.update({"dem_timestep_s": scene.dt, "n_bonds": scene.n_bonds, **counts,
+        engine = self.engine   # the engine module of the run (its NAME, its DYNAMIC flag)
+        step = "dem_timestep_s" if getattr(engine, "DYNAMIC", False) else "load_increment_s"
+        result.update({STEPS_COUNTED_KEY: steps_counted(engine), "engine": engine.NAME,
+                       step: scene.dt, "n_bonds": scene.n_bonds, **counts,
                        "numerical_failure": numerical, "bonds_erased_by_sliding": scene.sliding_erasures(),
                        "peak_reached": peak_reached, "end_reason": end, **extra})
         result.update(scene.summary_keys())

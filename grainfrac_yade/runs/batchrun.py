@@ -103,20 +103,31 @@ def _ended_rows(output: Path) -> list:
     return lines
 
 
+def run_folder_name(controls: dict, overrides) -> str:
+    """Folder name of a batch row: its description, else the overridden values and seed (``overrides``: (key,
+    value) pairs in the order of the shipped parameters, as YADE's reader gives them)."""
+    desc = controls.get("description") or "_".join(f"{k.split('.')[-1]}={v}" for k, v in overrides)
+    desc = f"{desc}_seed{controls['seed']}" if "seed" not in desc else desc
+    return re.sub(r"[^A-Za-z0-9_.=+-]+", "_", desc).strip("_") or f"seed{controls['seed']}"
+
+
 #: What a row script prints (after "creep", "UCS" or "Brazilian") when its folder already holds its finished run.
 ROW_SKIPPED = "row already finished, skipped"
 
 
 class RowOutcome:
-    """What one table row did: ``ok`` (its run folder holds a finished run), ``skipped`` (finished before this
-    batch: the row script found its finished run and did not run it), the folder, and one line."""
+    """What one table row did: ``ok`` (its run folder holds a finished run with a result), ``numerical`` (a
+    finished run that ended as a numerical failure: no result, not ok), ``skipped`` (finished before this batch:
+    the row script found its finished run and did not run it), the folder, and one line."""
 
-    def __init__(self, line: int, ok: bool, text: str, folder=None, log=None, skipped=False):
+    def __init__(self, line: int, ok: bool, text: str, folder=None, log=None, skipped=False, numerical=False):
         self.line, self.ok, self.text, self.folder, self.log = line, ok, text, folder, log
-        self.skipped = skipped
+        self.skipped, self.numerical = skipped, numerical
 
     def __str__(self):
-        state = ("skipped (finished)" if self.skipped else "ok") if self.ok else "FAILED"
+        state = "numerical failure" if self.numerical else "ok" if self.ok else "FAILED"
+        if self.skipped:
+            state = "skipped (finished)" if self.ok else f"skipped (finished before: {state})"
         return f"line {self.line}: {state}: {self.text}"
 
 
@@ -133,7 +144,8 @@ def row_outcomes(table, log_dir, lines, describe=None) -> list:
 
     A row succeeded if the run folder it recorded holds summary.json (and the summary does not say the test
     failed before it began, ``failed_before_test``); otherwise the reason is the row's last ``error:`` line, or
-    the last line of its traceback, in its log.  ``describe(summary)``: the result phrase of a finished row."""
+    the last line of its traceback, in its log.  A finished run whose summary says ``numerical_failure`` is
+    neither: ``numerical`` (no result).  ``describe(summary)``: the result phrase of a finished row."""
     log_dir = Path(log_dir).resolve()
     out = []
     for line in lines:
@@ -150,8 +162,10 @@ def row_outcomes(table, log_dir, lines, describe=None) -> list:
             except (OSError, ValueError):
                 summary = None
         if summary is not None and not summary.get("failed_before_test"):
+            numerical = bool(summary.get("numerical_failure"))
             text = describe(summary) if describe else "finished"
-            out.append(RowOutcome(line, True, f"{text} -> {folder}", folder, log, skipped=_skipped(log)))
+            out.append(RowOutcome(line, not numerical, f"{text} -> {folder}", folder, log, skipped=_skipped(log),
+                                  numerical=numerical))
             continue
         reason = summary.get("end_reason") if summary else _log_reason(log)
         out.append(RowOutcome(line, False, f"{reason} (log {log})", folder, log))

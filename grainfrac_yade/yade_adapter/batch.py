@@ -16,12 +16,11 @@ same parameters and run values goes on from it (:func:`row_plan`); otherwise it 
 from __future__ import annotations
 
 import os
-import re
 import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..runs.batchrun import ON_CHANGE, RUN_COLUMNS, check_columns, read_table_rows  # noqa: F401
+from ..runs.batchrun import ON_CHANGE, RUN_COLUMNS, check_columns, read_table_rows, run_folder_name  # noqa: F401
 from ..errors import GrainfracError
 from ..params import shipped_values
 from ..runs.runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
@@ -77,13 +76,6 @@ def explicit_description_column() -> bool:
     except OSError:
         return False
     return False
-
-
-def run_folder_name(controls: dict, overrides) -> str:
-    """Folder name of a batch row: its description, else the overridden values and seed."""
-    desc = controls.get("description") or "_".join(f"{k.split('.')[-1]}={v}" for k, v in overrides)
-    desc = f"{desc}_seed{controls['seed']}" if "seed" not in desc else desc
-    return re.sub(r"[^A-Za-z0-9_.=+-]+", "_", desc).strip("_") or f"seed{controls['seed']}"
 
 
 #: Environment variable naming a JSON file in which a row records the run folder it chose (set by the SLURM
