@@ -1,7 +1,7 @@
 """``bench --static``: what the static engine costs per creep event, every number from one run of one process.
 
 Finite-element cells (``params/presets/fem.toml``), seed 1 (``--seed``), a creep hold at 160 MPa
-(``--creep-stress``) with the event clock, as the static engine's cost tables (docs/studies/static_engine.md):
+(``--creep-stress``) with the event clock, as the static engine's cost tables (docs/studies/static_bench.md):
 
 1. **Static against YADE per creep event** on 10 x 20 mm (``--quick``: 4 x 8 mm): the creep test of
    :mod:`grainfrac_yade.protocols.creep` on each engine in turn, in this process, for a few events each (ramp, first

@@ -30,7 +30,7 @@ def register(sub, common):
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
                         "--set contacts.<a>/<b>.tensile_strength=F x its value for each row (recorded so in "
                         "params.json)")
-    lv = p.add_argument_group("levers on the bonds and cells (grainfrac_yade.yade_adapter.levers; recorded in "
+    lv = p.add_argument_group("levers on the bonds and cells (grainfrac_yade.protocols.levers; recorded in "
                               "summary.json under 'levers', not parameters: ucs and creep do not know them)")
     lv.add_argument("--slit-fraction", type=float, default=0.0, metavar="F",
                     help="share of faces unbonded before loading (slits: compression and friction, no tension)")
