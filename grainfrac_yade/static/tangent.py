@@ -28,8 +28,10 @@ import scipy.sparse as sp
 #: or below FAST_RESIDUAL, whichever is larger [1].  Direct SuperLU solves leave 6e-16 (median) to 1.2e-15 (max)
 #: at 10 x 20 mm (392 solves of a fem path to 0.25 % strain) and 1.6e-14 to 2.0e-14 at paper size (the first 10
 #: solves); the low-rank solves 7e-16 to 2.4e-15 unrefined at 10 x 20 mm.  An accepted solution is then as exact
-#: as a direct one to within a factor 10 of round-off, far below what the bracketing (1e-9) and the tie rule
-#: (1e-12 relative on stress ratios) look at.
+#: as a direct one to within a factor 10 of round-off, far below what the bracketing and the tie rule look at (1e-9,
+#: :data:`.ties.DECISION_REL_TOL`).  Whether an update is accepted is itself decided on round-off (one CPU's residual
+#: 1.11e-14 against another's 1.19e-14 limit): harmless for a regular tangent, and a singular one is never solved by an
+#: update (:data:`CAPACITANCE_PIVOT_RATIO`).
 RESIDUAL_MARGIN = 10.0
 FAST_RESIDUAL = 1e-14
 #: A refinement step must at least halve the residual [1], else the low-rank solve is refused (it stagnates at
