@@ -25,6 +25,9 @@ path finds bond crossings at anyway (:data:`.cascade.BRACKET_TOL`): two bonds wh
 strength at the same closure to the path's resolution.  What remains is a knife edge of probability ~ round-off /
 tolerance per decision (a value within round-off of a tolerance's edge).  tests/test_static_roundoff.py runs a path
 and a creep hold with every bond's stiffness and strength changed at round-off and asserts the same breaks and end.
+Not covered: a contact next to an unloaded mechanism (a cell held only by the solver's ground springs) moves with the
+solve's round-off over those springs, ~1e-3 of the largest contact force, and its status with it
+(docs/studies/paper_static.md, "Across CPUs").
 """
 from __future__ import annotations
 
