@@ -8,7 +8,7 @@ from grainfrac_yade.static.failure import NO_EQUILIBRIUM
 from grainfrac_yade.static.failure import FailureRule
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, chain, fem_creep_4x8, plain_hold_fails_once, shear_pair
+from static_tiny import KN, chain, creep_giving_out, fem_creep_4x8, plain_hold_fails_once, shear_pair
 
 
 @pytest.mark.parametrize("alpha", [0.3, 1.0, 10.0])
@@ -137,28 +137,47 @@ def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
     assert np.allclose(state.u, plain.u, rtol=1e-9, atol=1e-9 * np.abs(plain.u).max())
 
 
-def test_creep_hold_relaxes_past_a_status_cycle_whatever_the_rest_tolerance(monkeypatch):
-    """Through the protocol: the plain static engine ends that hold as a numerical failure; with
-    ``numerics.static_relaxation = "overdamped"`` the regain relaxes and the hold goes on to the time limit.  The
-    rest tolerance 1e-6 or 1e-9 gives the same events, the same broken bonds at the same creep times and the same
-    end (the relaxed states differ within the tolerance: strains to 1e-4 relative)."""
-    import grainfrac_yade.static.damped as damped
-    plain = fem_creep_4x8("numerics.static_relaxation=none")
+#: Agreement of two relaxed creep runs whose rest tolerances are 1e-6 and 1e-9 [1]: the relaxed states differ within
+#: the looser tolerance's unbalanced force, and the creep law's event times and the strains with them; measured on the
+#: 4 x 8 mm fem hold below, break times 3.2e-6 apart and strains 5.2e-7.
+REST_AGREEMENT = 1e-4
+
+
+def test_creep_hold_relaxes_past_a_status_cycle():
+    """Through the protocol: the plain static engine ends this hold as a numerical failure (a status cycle); with
+    ``numerics.static_relaxation = "overdamped"`` the regain relaxes and the hold goes on to the failure rule (a
+    failure of the specimen, not a numerical one), no earlier than the plain engine gave out."""
+    plain = creep_giving_out()
     assert plain.numerical_failure and "did not settle" in plain.failure_reason
+    run = creep_giving_out("numerics.static_relaxation=overdamped")
+    assert not run.numerical_failure and run.failed and run.scene.path.tally[0] >= 1
+    assert run.scene.summary_keys()["static_relaxations"] == run.scene.path.tally[0]
+    assert run.n_events >= plain.n_events and run.rows[-1]["creep_time_s"] >= plain.rows[-1]["creep_time_s"]
+
+
+def test_creep_hold_relaxes_to_rest_whatever_the_rest_tolerance(monkeypatch):
+    """Through the protocol, the plain regain made to give out at its 6th call (as a status cycle does): the overdamped
+    relaxation comes to rest and the hold goes on to the time limit.  The rest tolerance 1e-6 or 1e-9 gives the same
+    events and the same end, the tighter one in more steps; the break times and the strains agree within
+    REST_AGREEMENT (the relaxed states differ within the tolerance)."""
+    import grainfrac_yade.static.damped as damped
     runs = []
     for tol in (1e-6, 1e-9):
-        monkeypatch.setattr(damped, "REST_TOLERANCE", tol)
-        runs.append(fem_creep_4x8("numerics.static_relaxation=overdamped"))
+        with monkeypatch.context() as m:
+            m.setattr(damped, "REST_TOLERANCE", tol)
+            plain_hold_fails_once(m, at=6)
+            runs.append(fem_creep_4x8("numerics.static_relaxation=overdamped"))
     a, b = runs
     for run in runs:
-        assert not run.numerical_failure and run.scene.path.tally[0] >= 1
-        assert run.scene.summary_keys()["static_relaxations"] == run.scene.path.tally[0]
+        assert not run.numerical_failure and run.scene.path.tally[0] == 1
+        assert run.rows[-1]["creep_time_s"] == run.params.stress_corrosion.creep_time_limit
     assert b.scene.path.tally[1] > a.scene.path.tally[1]        # the tighter tolerance took more steps
     assert (a.n_events, a.failed, a.failure_reason) == (b.n_events, b.failed, b.failure_reason)
-    assert a.rows[-1]["creep_time_s"] == a.params.stress_corrosion.creep_time_limit > plain.rows[-1]["creep_time_s"]
-    assert np.array_equal(a.break_time, b.break_time, equal_nan=True)
+    assert np.array_equal(np.isnan(a.break_time), np.isnan(b.break_time))
+    done = a.break_time > 0
+    assert np.allclose(b.break_time[done], a.break_time[done], rtol=REST_AGREEMENT, atol=0)
     sa, sb = (np.array([r["axial_strain"] for r in run.rows]) for run in runs)
-    assert np.allclose(sa, sb, rtol=1e-4, atol=0)
+    assert np.allclose(sa, sb, rtol=REST_AGREEMENT, atol=0)
 
 
 def _rigid_creep(*extra):

@@ -12,7 +12,7 @@ from grainfrac_yade.static.inertial import (LOST_LOAD, InertialPath, InertialRel
                                             dof_masses)
 from grainfrac_yade.static.solver import Equilibrium
 
-from static_tiny import KN, chain, fem_creep_4x8, plain_hold_fails_once, shear_pair
+from static_tiny import KN, chain, creep_giving_out, plain_hold_fails_once, shear_pair
 
 #: Steps per period of the oscillator in the closed-form test [1]: the damping's switch of sign falls inside one
 #: step, an error of about 2 pi / STEPS of the swing (3e-4 here); the test's tolerance 2e-3 states that.
@@ -95,7 +95,7 @@ def test_creep_hold_goes_on_with_inertia_past_a_status_cycle_and_repeats():
     """Through the protocol: where the plain static engine ends this hold as a numerical failure, the inertial
     relaxation takes it on (no numerical failure, at least one relaxation, its DEM steps in the summary), and the
     same row run twice gives the same history and break times bit for bit (numpy in a fixed order, no YADE)."""
-    a, b = (fem_creep_4x8("numerics.static_relaxation=inertial") for _ in range(2))
+    a, b = (creep_giving_out("numerics.static_relaxation=inertial") for _ in range(2))
     assert not a.numerical_failure and a.scene.path.tally[0] >= 1 and a.scene.path.tally[1] > 0
     assert a.scene.summary_keys()["static_relaxation_steps"] == a.scene.path.tally[1]
     assert (a.n_events, a.failed, a.failure_reason) == (b.n_events, b.failed, b.failure_reason)
@@ -106,11 +106,13 @@ def test_creep_hold_goes_on_with_inertia_past_a_status_cycle_and_repeats():
 
 
 def _rigid_ucs(*extra):
-    """The 4 x 8 mm rigid-cell UCS of seed 4 on the static engine (shipped calibration)."""
+    """The 4 x 8 mm rigid-cell UCS of seed 14 on the static engine (shipped calibration): its plain path ends on a
+    loaded mechanism, the same with every bond's properties changed at round-off and with another CPU's arithmetic
+    (OpenBLAS's Haswell, SkylakeX or Zen kernels, numpy with or without AVX-512; tests/test_static_roundoff.py)."""
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.protocols.ucs import run_ucs
     p = load_parameters(overrides=["numerics.engine=static", "specimen.width=4e-3", "specimen.height=8e-3", *extra])
-    return run_ucs(build_specimen(p, 4), p)
+    return run_ucs(build_specimen(p, 14), p)
 
 
 def test_ucs_past_a_loaded_mechanism_by_inertia_to_a_post_peak_end():
@@ -118,7 +120,7 @@ def test_ucs_past_a_loaded_mechanism_by_inertia_to_a_post_peak_end():
     mechanism); with ``numerics.static_relaxation = "inertial"`` the specimen relaxes there with the platens held,
     loses its load, and the test ends post-peak with a strength, bit for bit the same in a second run."""
     _, plain, _, _ = _rigid_ucs("numerics.static_relaxation=none")
-    assert plain["numerical_failure"] and not plain["peak_reached"]
+    assert plain["numerical_failure"] and "loaded mechanism" in plain["end_reason"] and not plain["peak_reached"]
     runs = [_rigid_ucs("numerics.static_relaxation=inertial") for _ in range(2)]
     (cols, result, scene, _), (cols2, result2, _, _) = runs
     assert not result["numerical_failure"] and result["end_reason"].startswith("post-peak")

@@ -8,9 +8,10 @@ changed on the way (the path bent), the closure where the first bond reaches its
 target) is bracketed (Illinois) until the largest stress-to-strength ratio is 1 within ``bracket_tol``.
 
 There the most overstressed bond breaks, alone, and the equilibrium is restored at the same closure; any bond
-now at its strength breaks next, the most overstressed first, until none is (the cascade).  Ties: ratios within
-``TIE_REL_TOL`` of the largest count as equal, and the first bond in the network's canonical order (by contact
-point) wins, so nothing depends on how the input numbered the bonds.
+now at its strength (its ratio within :data:`.ties.DECISION_REL_TOL` of 1) breaks next, the most overstressed first,
+until none is (the cascade).  Ties: ratios within :data:`.ties.DECISION_REL_TOL` of the largest count as equal, and the
+first bond in the network's canonical order (by contact point, rounded) wins (:func:`.ties.first_of_largest`), so
+nothing depends on how the input numbered the bonds nor on the CPU's round-off.
 
 Control: the closure only grows (a stiff machine).  A snap-back (the load falling while the closure would have to
 fall too) is not followed: the stress drops at fixed closure through the cascade, and the curve continues from
@@ -28,11 +29,11 @@ from ..errors import NumericalFailure
 from . import contacts as cl
 from .failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
 from .solver import Equilibrium, State
+from .ties import DECISION_REL_TOL, first_of_largest
 
-#: Ratios within this relative distance of the largest are tied [1]: a few ulps of the assembly's round-off.
-TIE_REL_TOL = 1e-12
-#: A bond whose ratio is within this of 1 has reached its strength [1] (the round-off of ratio = 1 at a crossing).
-BREAK_RATIO_TOL = 1e-12
+#: A bond whose ratio is within this of 1 has reached its strength [1]: the tie rule's tolerance
+#: (:data:`.ties.DECISION_REL_TOL`), far above the round-off between two CPUs' answers.
+BREAK_RATIO_TOL = DECISION_REL_TOL
 #: Default bracketing tolerance on the largest ratio (and on stress / target) [1].
 BRACKET_TOL = 1e-9
 #: Bracketing iterations before the first state past the crossing is taken [1]; Illinois halves the bracket
@@ -93,11 +94,9 @@ class Path:
 
     @staticmethod
     def pick(ratio: np.ndarray, candidates: np.ndarray) -> int:
-        """The most overstressed of ``candidates``; ties (TIE_REL_TOL) to the first in canonical order."""
-        r = ratio[candidates]
-        top = r.max()
-        tied = candidates[r >= top - TIE_REL_TOL * abs(top)] if math.isfinite(top) else candidates[np.isinf(r)]
-        return int(tied.min())
+        """The most overstressed of ``candidates``, ties to the first in canonical order
+        (:func:`.ties.first_of_largest`)."""
+        return first_of_largest(ratio, candidates)
 
     # ------------------------------------------------------------------ breaking
     def break_bond(self, state: State, bond: int, mode: int) -> State:

@@ -21,14 +21,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..law import failed_now
+from .ties import DECISION_REL_TOL
 
 #: Status of a contact: intact bond, broken and open, broken and sticking, broken and slipping.
 INTACT, OPEN, STICK, SLIP = 0, 1, 2, 3
 #: Names of the contact statuses, by code (what a message says).
 STATUS_NAMES = ("intact", "open", "stick", "slip")
-#: Relative force band [1] within which a contact at the friction limit keeps its status (stick or slip): the
-#: round-off of a solve (~1e-12 of the contact forces) would otherwise flip it back and forth.
-STATUS_HYSTERESIS = 1e-9
+#: Relative force band [1] within which a contact keeps its status: at the friction limit (stick or slip), relative to
+#: its own forces; at the open/close point, relative to the largest normal force of the state.  The round-off of a
+#: solve (~1e-12 of the contact forces, and another on another CPU) would otherwise flip it back and forth, or one way
+#: on one machine and the other way on another (:mod:`.ties`).
+STATUS_HYSTERESIS = DECISION_REL_TOL
 #: Failure modes, the codes of YADE's JCFpm crack file (as :mod:`grainfrac_yade.law`).
 TENSION, SHEAR = 1, 2
 
@@ -57,14 +60,21 @@ def trial_status(du_n, du_s, broken, s_p, kn, ks, tan_r, status=None, sign=None)
     """Statuses the broken contacts take at (du_n, du_s) by the return mapping from their last converged shear
     reference ``s_p``: (status, sign, violation [N]).  Open where du_n > 0; else the trial shear force
     k_s (du_s - s_p) against the friction limit -F_n tan(phi_r) = -k_n du_n tan(phi_r): stick inside, slip
-    (its sign) beyond.  A contact now slipping (``status``, ``sign``: the statuses the solution was made with)
-    stays slipping only while its slip goes its way (sign x trial force beyond the limit); else it sticks first.
+    (its sign) beyond.  Given the statuses the solution was made with (``status``, ``sign``), a contact keeps open or
+    closed, and a closed one stick or slip, within :data:`STATUS_HYSTERESIS` of its switching point; a contact now
+    slipping stays slipping only while its slip goes its way (sign x trial force beyond the limit); else it sticks
+    first.
     ``violation``: how far the contact is from its other status, in force (what orders the status changes of one
     iteration)."""
     fn = kn * np.minimum(du_n, 0.0)
     f_trial = ks * (du_s - s_p)
     cap = -fn * tan_r
-    new = np.where(du_n > 0, OPEN, np.where(np.abs(f_trial) > cap, SLIP, STICK))
+    opening = du_n > 0
+    if status is not None:   # at the open/close point within round-off a contact keeps open or closed
+        band_n = STATUS_HYSTERESIS * float(np.abs(kn * du_n).max(initial=0.0))
+        was_closed = (status == STICK) | (status == SLIP)
+        opening = np.where(was_closed, kn * du_n > band_n, np.where(status == OPEN, kn * du_n > -band_n, opening))
+    new = np.where(opening, OPEN, np.where(np.abs(f_trial) > cap, SLIP, STICK))
     new_sign = np.where(f_trial >= 0, 1.0, -1.0)
     if status is not None:
         reversed_slip = (status == SLIP) & (new == SLIP) & (new_sign != sign)

@@ -12,8 +12,9 @@ rolling regularisation of rigid cells, ``elastic.ROLLING_REGULARISATION``).  Loa
 every node of a cell touching the top (bottom) wall moves with that platen in y by -d/2 (+d/2), d the platen
 closure [m]; rotations of platen cells blocked; lateral motion free (smooth platens).
 
-Bonds are kept in a canonical order (by their contact point, then their nodes' positions), so that
-nothing the engine decides depends on how the input numbered them; ``order`` maps back.
+Bonds are kept in a canonical order (by their contact point, then their nodes' positions, rounded:
+:func:`.ties.canonical_order`), so that nothing the engine decides depends on how the input numbered them; ``order``
+maps back.
 """
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ from ..elastic import (ROLLING_REGULARISATION, Network, _dof_map, _spring_rows, 
                        stiffness_matrix)
 from ..errors import GrainfracError
 from ..layout import bond_properties
+from .ties import canonical_order
 
 
 @dataclass
@@ -100,13 +102,6 @@ def grain_stiffness(net: Network, dofs, ndof) -> sp.csr_matrix:
     tidx = dofs[net.tri_nodes][:, :, :2].reshape(-1, 6)
     rows, cols = np.repeat(tidx, 6, axis=1).ravel(), np.tile(tidx, (1, 6)).ravel()
     return sp.coo_matrix((ke.reshape(len(ke), -1).ravel(), (rows, cols)), shape=(ndof, ndof)).tocsr()
-
-
-def canonical_order(point: np.ndarray, first_node_pos: np.ndarray, second_node_pos: np.ndarray) -> np.ndarray:
-    """Bond order by contact point (x, then y), then by the first and the second node's positions: a
-    numbering-free key (fem bonds of two faces meeting at a corner share the point and may share a node)."""
-    return np.lexsort((second_node_pos[:, 1], second_node_pos[:, 0], first_node_pos[:, 1], first_node_pos[:, 0],
-                       point[:, 1], point[:, 0]))
 
 
 def _side_nodes(specimen, node_cell):

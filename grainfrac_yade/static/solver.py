@@ -9,8 +9,8 @@ linear solve.  The statuses themselves follow from the solution (open/closed, st
 from the last converged state); the active-set iteration (a semi-smooth Newton method on the piecewise linear
 law) solves, re-reads the statuses and repeats until they agree.  A consistent set is the exact solution (to
 round-off): no residual tolerance enters the answer.  The status changes of one iteration are capped, the most
-violated first; the cap halves whenever an iteration does not reduce the number of inconsistent contacts
-(what ends open/close and stick/slip cycling).
+violated first (near-ties in canonical order, :func:`.ties.ranked`); the cap halves whenever an iteration does not
+reduce the number of inconsistent contacts (what ends open/close and stick/slip cycling).
 
 The SuperLU factor of the free block (:data:`DIRECT_FACTOR_OPTIONS`: COLAMD on the direct path; the fast path's
 reference factors :data:`FAST_FACTOR_OPTIONS`) is kept while the tangent does not change (same statuses, same
@@ -34,6 +34,7 @@ from ..errors import NumericalFailure
 from . import contacts as cl
 from .network import StaticNetwork
 from .tangent import MAX_LOW_RANK_CONTACTS, LowRankSolver, TangentPattern
+from .ties import ranked
 
 #: Active-set iterations per equilibrium before giving up [1]: each is one factorisation; a consistent set is
 #: normally found in a handful (measured on 10 x 20 mm, docs/studies/static_bench.md).
@@ -557,7 +558,7 @@ class Equilibrium:
             if best is not None and len(wrong) >= best:
                 cap = max(1, cap // 2)
             best = len(wrong) if best is None else min(best, len(wrong))
-            pick = wrong[np.argsort(-viol[wrong], kind="stable")[:cap]]
+            pick = ranked(viol, wrong)[:cap]
             last = pick
             status[pick], sign[pick] = new[pick], new_sign[pick]
         raise _Cycling(f"{len(wrong)} inconsistent after {self.max_iterations} iterations")
