@@ -40,6 +40,7 @@ declare -A WHAT=(
   [lab_disc_size]="docs/studies/lab_calibration.md disc-size probe: fem Brazilian discs of 10, 20 and 31.7 mm (params/lab_disc_size.table, 14 discs: 43-57 CPU s at 10 mm, 6-12 CPU min at 20 mm, 31.7 mm not measured)"
   [paper_static]="docs/studies/paper_static.md creep rows and docs/studies/paper_static/runs.csv, report/ (params/paper_static_inertial_creep.table: 20 paper-size fem creep rows on the static engine, 5.5-15 CPU min each: about 3.5 h on one core)"
   [lifetime_sensitivity]="docs/studies/paper_static.md lifetime sensitivity, docs/studies/paper_static/lifetime_sensitivity.{csv,md} (params/lifetime_sensitivity_static_small.table and lifetime_mesh_static_small.table: 40 rows of 10 x 20 mm fem creep on the static engine, 10 s to 3 min each: about 35 min on one core)"
+  [model_convergence]="docs/studies/model_convergence.md rows and docs/studies/model_convergence/ucs_runs.csv (params/model_convergence_ucs.table: 10 x 20 mm fem UCS on the static engine at 8-24 bonds per face and 1-2 radial rings, 10-40 CPU min each, one core)"
   [confined]="docs/studies/confined.md (params/confined_*_small.table): about 20 min UCS + 40 min creep on one core"
 )
 
@@ -131,6 +132,9 @@ run_target() {
                           $PY -m grainfrac_yade batch params/lifetime_mesh_static_small.table --jobs 1
                           $PY -m studies.lifetime_sensitivity results/lifetime_sensitivity_static \
                               --out docs/studies/paper_static/lifetime_sensitivity ;;
+    model_convergence) $PY -m grainfrac_yade batch params/model_convergence_ucs.table --test ucs --jobs 1
+                       $PY -m studies.model_convergence results/model_convergence/* \
+                           --out docs/studies/model_convergence/ucs_runs.csv ;;
     *) echo "regenerate.sh: unknown target '$1'; fix: one of: list all ${!WHAT[*]}" >&2; exit 2 ;;
   esac
 }
@@ -143,7 +147,7 @@ targets=("$@")
 [ "$1" = all ] && targets=(elastic bench calibration calibration_check resolution fem_ucs fem_creep lifetime_small
                            lifetime_ldb creep_numerics brazilian confined accuracy_cost accuracy_cost_paper_size step_floor threshold
                            regularisation lab_bands lab_calibration lab_creep lab_disc_size fem_mesh paper_fem paper_static
-                           lifetime_sensitivity)
+                           lifetime_sensitivity model_convergence)
 for t in "${targets[@]}"; do
   echo "== $t: ${WHAT[$t]:-?}"
   start=$(date +%s)

@@ -26,6 +26,10 @@ def _with_inset(p, inset):
     return dataclasses.replace(p, resolution=dataclasses.replace(p.resolution, contact_inset=inset))
 
 
+def _with_rings(p, rings):
+    return dataclasses.replace(p, resolution=dataclasses.replace(p.resolution, cell_rings=rings))
+
+
 def test_element_apex_covers_every_triangle_with_one_node_per_fan():
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 1)
@@ -38,12 +42,14 @@ def test_element_apex_covers_every_triangle_with_one_node_per_fan():
     assert np.array_equal(np.unique(lay.sphere_cell[apex]), np.arange(s.n_cells))
 
 
-def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes():
-    """E and nu of the shrunk mesh approach the reference's linearly in the inset (static solves,
-    10 x 20 mm seed 1: E -3.0 / -1.0 / -0.1 % at insets 0.03 / 0.01 / 0.001, nu within 0.3 %)."""
-    p = load_parameters(overrides=SMALL)
+@pytest.mark.parametrize("rings", [1, 2])
+def test_fem_cluster_converges_to_the_mesh_reference_as_the_inset_vanishes(rings):
+    """E and nu of the shrunk mesh approach the reference's (at the same ``resolution.cell_rings``) linearly
+    in the inset (static solves, 10 x 20 mm seed 1: E -3.0 / -1.0 / -0.1 % at insets 0.03 / 0.01 / 0.001,
+    nu within 0.3 %)."""
+    p = _with_rings(load_parameters(overrides=SMALL), rings)
     s = build_specimen(p, 1)
-    ref = solve_uniaxial(mesh_network(s, p, p.resolution.nodes_per_face), s)
+    ref = solve_uniaxial(mesh_network(s, p, p.resolution.nodes_per_face, "corners", rings), s)
     errors = []
     for inset in (0.03, 0.01, 0.001):
         q = _with_inset(p, inset)
@@ -143,13 +149,15 @@ def test_yade_element_material_gives_an_exact_linear_tetrahedron():
 
 @needs_yade
 @pytest.mark.yade
-def test_fem_scene_agrees_with_the_static_solve_after_a_small_elastic_ramp():
+@pytest.mark.parametrize("rings", [1, 2])
+def test_fem_scene_agrees_with_the_static_solve_after_a_small_elastic_ramp(rings):
     """The YADE scene of finite-element cells is the shrunk mesh that the static solve models, bonds
-    acting along their faces' normals (smooth joints): platen stress and every bond's forces agree
-    (measured on 4 x 8 mm seed 1: 8e-10 on the stress, 5e-9 of the largest bond force; with the
-    bonds along the lines of sphere centres and the static solve along the face normals, 6 %)."""
+    acting along their faces' normals (smooth joints), at one fan of triangles per cell or with a radial
+    ring (``resolution.cell_rings``): platen stress and every bond's forces agree (measured on 4 x 8 mm
+    seed 1: 8e-10 on the stress, 5e-9 of the largest bond force; with the bonds along the lines of
+    sphere centres and the static solve along the face normals, 6 %)."""
     from test_elastic import _assert_yade_ramp_matches_static_solve
-    p = load_parameters(overrides=SMALL + ["numerics.damping=0.7"])
+    p = load_parameters(overrides=SMALL + ["numerics.damping=0.7", f"resolution.cell_rings={rings}"])
     _assert_yade_ramp_matches_static_solve(p, cluster_network, relax_steps=20000)
 
 

@@ -31,7 +31,8 @@ def register(sub, common):
                         "UDEC's corner sub-contacts)")
     p.add_argument("--contacts", choices=CONTACT_PLACEMENTS, default="corners",
                    help="mesh: contact nodes at the face ends (trapezoid shares) or sub-segment centres")
-    p.add_argument("--rings", type=int, default=1, help="mesh: radial mesh refinement of each cell")
+    p.add_argument("--rings", type=int, help="mesh and fem: radial mesh refinement of each cell (fem: "
+                                             "resolution.cell_rings; default 1 = one fan of triangles)")
     p.add_argument("--platens", choices=("cells", "wall"), default="cells",
                    help="cells: the end cells move with the platens, as in the YADE tests; wall: only nodes "
                         "on the walls (triangle meshes only)")
@@ -50,14 +51,18 @@ def _model_overrides(args) -> list:
            if args.nodes_per_face is not None else [])
     if args.grains in CLUSTER_MODELS:
         out.append(f"resolution.grain_model={CLUSTER_MODELS[args.grains]}")
+        if args.rings is not None:
+            out.append(FlagOverride("resolution.cell_rings", args.rings, "--rings"))
     return out
 
 
 def cmd_elastic(args, params) -> int:
     require_plane(params, "elastic")
     out = args.out or f"results/elastic_seed{args.seed}"
+    # the mesh reference takes the fem cells' rings unless --rings says otherwise
+    rings = args.rings if args.rings is not None else params.resolution.cell_rings
     summary = run_elastic_to_folder(params, args.seed, out, args.grains, params.resolution.nodes_per_face, args.contacts,
-                                    args.rings, args.platens, overwrite=args.overwrite)
+                                    rings, args.platens, overwrite=args.overwrite)
     for name, s in summary["models"].items():
         print(f"{name:10s} E {s['young_pa'] / 1e9:6.1f} GPa  nu {s['poisson']:.3f}  shear/applied p50 "
               f"{s['shear_stress_ratio_p50']:.2f} p99 {s['shear_stress_ratio_p99']:.2f} max "

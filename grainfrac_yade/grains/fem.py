@@ -2,7 +2,8 @@
 
 The cluster is an image of the static reference's mesh
 (:func:`grainfrac_yade.geometry.grainmesh.grain_mesh`, contacts at the face corners,
-``resolution.nodes_per_face`` per face):
+``resolution.nodes_per_face`` per face, ``resolution.cell_rings`` radial rings: 1 = one fan of
+triangles about the centroid):
 
 * one sphere per mesh node, the mesh shrunk about the cell's centroid by
   ``1 - inset``, so that the two nodes of a contact pair (one in each cell, at
@@ -90,10 +91,10 @@ class FemLayout(ClumpLayout):
 
 
 def _shrunk_mesh(specimen: Specimen, params: Parameters, inset: float):
-    """The reference's mesh (contacts at the face corners) and its node positions shrunk by
-    1 - inset about each cell's centroid [m]."""
+    """The reference's mesh (contacts at the face corners, ``resolution.cell_rings`` radial rings) and its
+    node positions shrunk by 1 - inset about each cell's centroid [m]."""
     t = specimen.tessellation
-    mesh = grain_mesh(specimen, params.resolution.nodes_per_face, "corners")
+    mesh = grain_mesh(specimen, params.resolution.nodes_per_face, "corners", params.resolution.cell_rings)
     centroid = t.cell_centroid[mesh.node_cell]
     return mesh, centroid + (1.0 - inset) * (mesh.node_pos - centroid)
 

@@ -48,7 +48,8 @@ def renamed_key_fix(dotted: str) -> str | None:
 ADDED_KEYS = {"numerics.engine": "yade", "specimen.min_edge_fraction": 0.0, "numerics.keep_intact_joints": False,
               "creep.servo_response_crossings": 0.0, "creep.max_relaxation_crossings": 0.0,
               "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
-              "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0}
+              "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0,
+              "resolution.cell_rings": 1}
 
 
 def migrate_tree(tree: dict) -> list:
@@ -345,6 +346,7 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
     _check_law(sc, origins)
     _check_grain_size(typed["specimen"], origins)
     _check_weibull_modulus(typed["calibration"], origins)
+    _check_cell_rings(typed["resolution"], origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
 
 
@@ -402,6 +404,16 @@ def _check_weibull_modulus(cal, origins: Mapping):
                              f"{m:g} is below {MIN_WEIBULL_MODULUS:g} (the exponential distribution, CV 1): most faces "
                              "would be all but unbonded", f"give 0 (no scatter) or a modulus >= {MIN_WEIBULL_MODULUS:g} "
                              "(e.g. 3: CV 0.36)")
+
+
+def _check_cell_rings(res, origins: Mapping):
+    """Radial rings refine the triangle mesh of fem cells; a rigid cell has no mesh to refine."""
+    if res.cell_rings > 1 and res.grain_model != "fem":
+        raise ParameterError(origins.get("resolution.cell_rings", "parameters"), "resolution.cell_rings",
+                             f"{res.cell_rings} with resolution.grain_model = {res.grain_model!r}: rings refine the "
+                             "triangle mesh of fem cells, a rigid cell has none",
+                             "set resolution.cell_rings = 1, or resolution.grain_model = \"fem\" "
+                             "(params/presets/fem.toml)")
 
 
 def require_plane(params: Parameters, command: str):

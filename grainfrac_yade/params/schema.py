@@ -105,6 +105,10 @@ class ResolutionParams:
                              "moduli", ("rigid", "fem"))
     nodes_per_face: int = _spec("1", "positive_int", "fem cells: breakable bonds per "
                                 "Voronoi face (ignored by rigid cells)")
+    cell_rings: int = _spec("1", "positive_int", "fem cells: radial refinement of each cell's triangle mesh: the "
+                            "boundary ring of nodes repeated at fractions k / cell_rings of the way to the centroid "
+                            "(grainfrac_yade.geometry.grainmesh); 1 = one fan of triangles about the centroid; "
+                            "rigid cells take only 1")
     contact_inset: float = _spec("1", "unit_interval_open", "fem cells: fraction of the way from a "
                                  "face node to its cell's centroid at which the node's sphere sits (the two "
                                  "spheres of a bond are distinct bodies a short gap apart)")

@@ -1,0 +1,62 @@
+"""The rows of the model convergence study as a CSV (docs/studies/model_convergence.md): one line per finished UCS
+run folder, the discretisation (bonds per face, radial rings, bonds, nodes), the strength, the moduli, the crack
+thresholds, the breaks, the cost (CPU, inertial relaxations) and why the run ended, units in the column names.
+
+    /usr/bin/python3 -m studies.model_convergence results/model_convergence/* --out docs/studies/model_convergence/ucs_runs.csv
+
+A pure reader of run folders (summary.json, params.json; no YADE).
+"""
+import argparse
+import csv
+import json
+import sys
+from pathlib import Path
+
+from grainfrac_yade.params.loading import ADDED_KEYS
+
+#: (column, summary key, factor) of every row: the units are those of the column name.
+COLUMNS = (("ucs_mpa", "ucs_pa", 1e-6), ("peak_axial_strain_percent", "peak_axial_strain", 100.0),
+           ("young_gpa", "young_pa", 1e-9), ("poisson_1", "poisson", 1.0),
+           ("crack_initiation_mpa", "crack_initiation_pa", 1e-6), ("crack_damage_mpa", "crack_damage_pa", 1e-6),
+           ("bonds_1", "n_bonds", 1), ("broken_total_1", "broken_total", 1), ("cpu_s", "cpu_s", 1.0),
+           ("static_relaxations_1", "static_relaxations", 1), ("static_relaxation_steps_1", "static_relaxation_steps", 1),
+           ("static_relaxation_cpu_s", "static_relaxation_cpu_s", 1.0))
+
+
+def row(folder: Path) -> dict | None:
+    """The CSV row of one run folder (None where it holds no finished run)."""
+    try:
+        s = json.loads((folder / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    res = s["params"]["resolution"]
+    out = {"run": folder.name, "seed": s["seed"], "width_mm": 1e3 * s["params"]["specimen"]["width"],
+           "height_mm": 1e3 * s["params"]["specimen"]["height"], "bonds_per_face_1": res["nodes_per_face"],
+           "cell_rings_1": res.get("cell_rings", ADDED_KEYS["resolution.cell_rings"])}
+    for name, key, factor in COLUMNS:
+        v = s.get(key)
+        out[name] = None if v is None else (round(v * factor, 6) if isinstance(factor, float) else int(v))
+    out.update(end_reason=s.get("end_reason"), code_version=s.get("code_version"))
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folders", nargs="+", type=Path)
+    ap.add_argument("--out", type=Path, required=True)
+    a = ap.parse_args(argv)
+    rows = sorted((r for r in map(row, a.folders) if r), key=lambda r: (r["cell_rings_1"], r["bonds_per_face_1"], r["run"]))
+    if not rows:
+        print("error: no finished run among the folders; fix: give run folders that hold a summary.json", file=sys.stderr)
+        return 2
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    with open(a.out, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"{len(rows)} rows -> {a.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
