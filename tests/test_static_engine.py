@@ -331,3 +331,19 @@ def test_creep_resumed_through_the_command_line(capsys, tmp_path, monkeypatch):
     for k in ("lifetime_s", "n_events", "failed", "broken_total", "failure_reason"):
         assert resumed[k] == whole[k], k
     assert (tmp_path / "cut" / "cracks.csv").read_bytes() == (tmp_path / "whole" / "cracks.csv").read_bytes()
+
+
+@pytest.mark.parametrize("model", ["rigid", "fem"])
+def test_the_grain_model_says_whether_its_bonds_lie_on_their_faces(model):
+    """The static scene reads the grain model's ``bonds_on_faces`` (no model name inside the engine): fem bonds carry
+    their face's unit normal in an exported state and a reference gap along it; rigid bonds neither."""
+    from grainfrac_yade.grains import grain_model
+    p = _params(f"resolution.grain_model={model}")
+    scene = engine("static").build_scene(build_specimen(p, 1), p)
+    normal = scene.export_state().bond_plane_normal
+    on_faces = grain_model(model).bonds_on_faces
+    assert on_faces == (model == "fem")
+    if on_faces:
+        assert np.allclose(np.linalg.norm(normal, axis=1), 1.0)
+    else:
+        assert not normal.any()

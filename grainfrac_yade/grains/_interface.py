@@ -30,10 +30,15 @@ class GrainModel:
     resume_note : str
         "" if a resumed run of this model is bit-identical to the uninterrupted one (one thread),
         else why not.
+    bonds_on_faces : bool
+        Its bonds act on their face's plane (a sphere on each side of the face): a bond's reference gap is the
+        spheres' distance along the face normal, and a state carries the plane's normal.  False: bonds between
+        spheres (the gap is their overlap).
     """
     name = ""
     rotating = True
     resume_note = ""
+    bonds_on_faces = False
 
     def build_layout(self, specimen: Specimen, params: Parameters) -> ClumpLayout:
         """The spheres and bonds of ``specimen`` under ``params.resolution``."""

@@ -195,6 +195,7 @@ class FemCells(GrainModel):
     name = NAME
     rotating = "Z" not in BLOCKED_DOFS
     resume_note = RESUME_NOTE
+    bonds_on_faces = True
 
     def build_layout(self, specimen: Specimen, params: Parameters) -> FemLayout:
         return build_fem_layout(specimen, params)

@@ -25,6 +25,8 @@ explicit dynamic relaxation (docs/engines.md).  One module per job:
   static stresses;
 * :mod:`.scene`: :class:`~.scene.StaticScene`, the engine's scene of :class:`grainfrac_yade.engines.Scene` (load
   increments, the held platen stress, save and restore with the kept factor, the state export);
+* :mod:`.platens`: the platens (displacement control of the closure), the held stress of a creep hold and the
+  confinement that the protocols drive;
 * :mod:`.jaws`: the Brazilian disc's jaw cells as prescribed displacements, and the Brazilian levers;
 * :mod:`.settings`: the engine's name and the dynamic-only settings it does not read;
 * :mod:`.bench_timing`: the timings of ``bench --static`` (a network built, a creep hold timed per event);

@@ -42,7 +42,8 @@ from ..geometry.disc import DiscTessellation
 from ..protocols.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
-from .scene import StaticPlatens, StaticScene
+from .platens import StaticPlatens
+from .scene import StaticScene
 from .solver import Equilibrium
 
 #: Lateral conditions of the jaws (``brazilian.platen_lateral``): "fixed" u_x = 0, "free" u_x free.
