@@ -76,7 +76,7 @@ def test_analyze_ucs_writes_the_envelope_of_a_confined_study(tmp_path):
 
 # ------------------------------------------------------------------ load and parameters (no YADE)
 def test_a_confined_ratio_is_deviatoric_and_needs_the_confined_peak():
-    from grainfrac_yade.commands.creep import resolve_stress
+    from grainfrac_yade.commands._loads import resolve_stress
     p = load_parameters(overrides=[("confinement.stress", 20 * MPA)])
     stress, ratio, ref = resolve_stress(p, ratio=0.8, ucs=320 * MPA)
     assert stress == pytest.approx(20 * MPA + 0.8 * 300 * MPA) and ratio == pytest.approx(0.8) and ref == 320 * MPA

@@ -231,7 +231,7 @@ def test_c_a_very_low_load_reaches_the_creep_time_limit_not_failed(tmp_path, cap
         "creep time reached stress_corrosion.creep_time_limit = 1e+09 s: not failed, the lifetime is a lower bound")
     assert outcome_in_analysis(tmp_path) == ["not failed"]
     from grainfrac_yade.analysis.durations import readable_duration
-    from grainfrac_yade.commands.creep import outcome
+    from grainfrac_yade.commands._outcome import outcome
     assert outcome(s) == (f"not failed by {s['creep_time_end_s']:.4g} s "   # the paper clock's last step may pass
                           f"({readable_duration(s['creep_time_end_s'])})")
     assert s["creep_time_end_s"] < 1e9 + p.stress_corrosion.dt_max    # the limit by less than dt_max: 1.076e9 s

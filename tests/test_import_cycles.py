@@ -39,7 +39,7 @@ ALLOWED = {
              ("commands.brazilian", "runs.batchrun"), ("commands.creep", "runs.batchrun"), ("commands.ucs", "runs.batchrun"),
              ("commands.creep", "params"), ("commands.creep", "argparse"), ("commands.creep", "sys"),
              ("commands.specimen", "params"),
-             ("commands.ucs", "commands.creep"), ("commands.ucs", "params"),
+             ("commands.ucs", "params"),
              ("yade_adapter.batch", "runs.runio"),
              ("yade_adapter.bench_timing", "yade_adapter.platens"), ("yade_adapter.bench_timing", "yade_adapter.scene")),
 }

@@ -65,7 +65,7 @@ def test_a_confinement_at_or_below_zero_is_refused(capsys, value):
 
 
 def test_cli_stresses_are_mpa_and_batch_stresses_pa():
-    from grainfrac_yade.commands.creep import resolve_stress
+    from grainfrac_yade.commands._loads import resolve_stress
     p = load_parameters()
     assert resolve_stress(p, stress=160 * MPA, cli=True)[0] == 160 * MPA
     with pytest.raises(GrainfracError, match="column stress = 160 Pa is below 1 MPa, no creep load for granite; fix: "

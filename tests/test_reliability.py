@@ -300,7 +300,7 @@ def test_a_numerical_failure_is_its_own_outcome_in_summary_json(tmp_path, monkey
         assert not (out / "history.csv").exists()
     from grainfrac_yade.analysis import classify_runs, collect_runs
     assert list(classify_runs(collect_runs(tmp_path))["outcome"]) == ["numerical failure"]
-    from grainfrac_yade.commands.creep import outcome
+    from grainfrac_yade.commands._outcome import outcome
     assert outcome(s) == f"no result ({reason})"
 
 

@@ -25,7 +25,9 @@ from ..params.schema import field_spec
 from ..runs.batchrun import (ON_CHANGE, RUN_COLUMNS, cell_value, check_columns, read_table_rows, row_outcomes,
                              run_batch, run_folder_name)
 from .brazilian import require_disc_model
-from .creep import CREEP_ROW_COLUMNS, check_stress_range, creep_name_parts, outcome, resolve_stress
+from ._loads import check_stress_range, resolve_stress
+from ._outcome import outcome
+from .creep import CREEP_ROW_COLUMNS, creep_name_parts
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}

@@ -15,7 +15,7 @@ import sys
 from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
 from ..protocols.brazilian_output import require_disc_model, run_brazilian_to_folder
 from ..protocols.levers import Levers
-from .creep import numerical_failure_line, steps_phrase
+from ._outcome import numerical_failure_line, steps_phrase
 
 
 def register(sub, common):

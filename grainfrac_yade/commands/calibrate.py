@@ -25,7 +25,7 @@ from ..params import load_parameters, require_plane
 from ..protocols.ucs_output import run_ucs_to_folder
 from ..runs.runio import commit_run_dir, prepare_run_dir, write_csv
 from ._args import seed_type
-from .creep import positive_flag, stress_flag
+from ._loads import positive_flag, stress_flag
 
 #: UCS target [Pa]: the paper's simulated UCS, section 3.1 (shared/reference/paper_values.csv).
 TARGET_UCS = 234.5e6

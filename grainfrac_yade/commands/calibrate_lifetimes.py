@@ -25,7 +25,7 @@ from ..params import flat_values, load_parameters, require_plane, write_paramete
 from ..runs.batchrun import run_batch, write_table
 from ..runs.runio import code_version, comparable_parameters, write_csv
 from ._args import float_list_type, seed_list_type
-from .creep import stress_flag
+from ._loads import stress_flag
 
 #: Keys of the fitted parameters, by law.
 BETA2_KEY = {"hillig_charles": "stress_corrosion.beta2", "normalised": "stress_corrosion.beta2_normalised"}

@@ -3,8 +3,10 @@ from __future__ import annotations
 
 import math
 
-from ..analysis.durations import readable_duration
 from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
+from ._loads import (PA_PER_MPA, add_confinement_option, check_stress_range, confinement_override, positive_int,
+                     resolve_stress)
+from ._outcome import numerical_failure_line, outcome, steps_phrase
 from ..protocols.creep_output import UCS_FROM_CALIBRATION, resume_creep_folder, run_creep_to_folder, ucs_reference
 
 
@@ -29,7 +31,7 @@ def register(sub, common):
                    help="write VTK files of cells and bonds (state, remaining strength) for ParaView at these "
                         "creep times [s] and at the end, into DIR/vtk/ (cells.pvd, bonds.pvd: time series in "
                         "creep time; e.g. --vtk-times 0,1e7)")
-    p.add_argument("--vtk-every", type=_positive_int, default=None, metavar="K",
+    p.add_argument("--vtk-every", type=positive_int, default=None, metavar="K",
                    help="also write VTK files at every K-th history row (one row per event of the event clock, "
                         "per creep step of the paper clock) and at the end, into DIR/vtk/")
     p.add_argument("--vtk-fractions", type=_fractions, nargs="?", const=list(LIFE_FRACTIONS), default=False,
@@ -48,114 +50,6 @@ def _clock_override(args) -> list:
     from ..params import FlagOverride
     return ([FlagOverride("stress_corrosion.clock", args.clock, "--clock")] if args.clock else []) + \
         confinement_override(args)
-
-
-#: Pa per MPa: every stress flag of the CLI is in MPa, every file and batch column in Pa.
-PA_PER_MPA = 1e6
-#: Largest load, confining stress or reference strength accepted, as a multiple of the specimen's reference
-#: strength (calibration.reference_ucs): above it a value is taken for a unit slip (Pa given where MPa is
-#: meant is 1e6 times too large), not a test.  Confined peak strengths measured here stay below 2 x it
-#: (426 MPa at 20 MPa confinement against 236 MPa).
-MAX_STRESS_OVER_REFERENCE = 4.0
-#: Smallest creep load (and reference strength) accepted [Pa]: 1 MPa.  Creep tests of granite hold 40 % of the UCS
-#: or more (Lajtai & Schmidtke's long-term strength bound lies near 60 %), some 100 MPa; a stress below 1 MPa is a
-#: unit slip (a batch column in Pa given as MPa: 160 for 160e6; a CLI flag in MPa given as Pa: 1e-6), and would
-#: only hold the specimen unloaded to the creep time limit.
-MIN_STRESS_PA = 1e6
-
-
-def add_confinement_option(parser):
-    """``--confinement MPA``: the confining stress sigma_3 (sets confinement.stress)."""
-    parser.add_argument("--confinement", type=float, metavar="MPA",
-                        help="confining stress sigma_3 [MPa], e.g. 20, held on the side walls (biaxial test; "
-                             "confinement.stress, in Pa in files); omit for a uniaxial test")
-
-
-def confinement_override(args) -> list:
-    """The override of ``--confinement MPA`` (none if not given); refuses a value at or below 0 in one line."""
-    value = getattr(args, "confinement", None)
-    if value is None:
-        return []
-    if not (math.isfinite(value) and value > 0):
-        raise GrainfracError(f"--confinement {value:g} MPa (confinement.stress): a confining stress must be above 0 "
-                             "MPa; fix: e.g. --confinement 20, or omit it for a uniaxial test")
-    from ..params import FlagOverride
-    return [FlagOverride("confinement.stress", value * PA_PER_MPA, "--confinement")]
-
-
-def positive_flag(text: str, what: str, unit: str, si_per_unit: float, example: str) -> float:
-    """A finite positive number of ``unit`` from a flag, returned in SI (x ``si_per_unit``); argparse's
-    ArgumentTypeError naming ``what`` (a stress, a modulus) otherwise."""
-    import argparse
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not {what} in {unit} (e.g. {example})") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"{text!r}: {what} must be finite and above 0 {unit} (e.g. {example})")
-    return value * si_per_unit
-
-
-def stress_flag(text: str) -> float:
-    """argparse type of a stress flag: a number of MPa, returned in Pa."""
-    return positive_flag(text, "a stress", "MPa", PA_PER_MPA, "258")
-
-
-def check_stress_range(params, where: str = "confinement.stress") -> None:
-    """Refuse a confining stress above :data:`MAX_STRESS_OVER_REFERENCE` x calibration.reference_ucs (one line;
-    ``where``: how the user gave it)."""
-    confining, ref = params.confinement.stress, params.calibration.reference_ucs
-    if confining > MAX_STRESS_OVER_REFERENCE * ref:
-        raise GrainfracError(f"{where}: confining stress {confining / PA_PER_MPA:.4g} MPa is above "
-                             f"{MAX_STRESS_OVER_REFERENCE:g} x the reference strength (calibration.reference_ucs = "
-                             f"{ref / PA_PER_MPA:.4g} MPa); fix: --confinement is in MPa (e.g. 20), "
-                             "confinement.stress in files and batch columns in Pa (e.g. 20e6)")
-
-
-def seconds(value: float) -> str:
-    """A time in s, with the unit that reads best beside it where that is not s: "1.2e+07 s (140 d)"."""
-    readable = readable_duration(value)
-    return f"{value:.4g} s" + (f" ({readable})" if readable and not readable.endswith(" s") else "")
-
-
-def outcome(summary: dict) -> str:
-    """One phrase: numerical failure, lifetime, failure on loading, or not failed by the end."""
-    if summary.get("numerical_failure"):
-        return f"no result ({summary['failure_reason']})"
-    if summary.get("failed_before_test"):
-        return f"failed before the test ({summary['failure_reason']})"
-    if summary.get("failed_on_loading"):
-        return "failed on loading (during the ramp)"
-    if summary["failed"]:
-        first = ", in the relaxation after its first creep event" if summary.get("failed_in_first_relaxation") else ""
-        return f"lifetime {seconds(summary['lifetime_s'])}{first}"
-    return f"not failed by {seconds(summary['creep_time_end_s'])}"
-
-
-def steps_phrase(summary: dict) -> str:
-    """"1234 DEM steps" or, for an engine without dynamics, "170 equilibria solved" (summary ``steps_counted``;
-    "steps" for a run written before the key)."""
-    return f"{summary['steps']} {summary.get('steps_counted', 'steps')}"
-
-
-def numerical_failure_line(test: str, summary: dict, out) -> str:
-    """The one line (stderr) of a run that ended as a numerical failure: the test, the engine, what it did before,
-    the reason, and where its summary.json (``numerical_failure: true``) is."""
-    reason = str(summary.get("failure_reason") or summary.get("end_reason")).removeprefix("numerical failure: ")
-    return (f"numerical failure: {test}, {summary.get('engine', 'yade')} engine: no result ({reason}); exit status "
-            f"{EXIT_NUMERICAL_FAILURE}, summary.json says numerical_failure: true -> {out}")
-
-
-def _positive_int(text: str) -> int:
-    """An integer >= 1 (argparse type)."""
-    import argparse
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1 (e.g. 10)")
-    return value
 
 
 def _fractions(text: str) -> list:
@@ -181,65 +75,6 @@ def _times(text: str) -> list:
     if any(not math.isfinite(t) or t < 0 for t in times):
         raise argparse.ArgumentTypeError(f"{text!r}: creep times must be finite and >= 0 s")
     return times
-
-
-def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
-    """(axial stress sigma_1 [Pa], ratio, strength used [Pa]); ``stress`` and ``ucs`` in Pa.
-
-    Uniaxial: the ratio is sigma_1 / UCS, the UCS being ``ucs`` or the calibrated mean UCS.  Confined
-    (``confinement.stress`` sigma_3 > 0): the ratio is the deviatoric one, (sigma_1 - sigma_3) /
-    (sigma_peak - sigma_3), and ``ucs`` must be given: the peak axial stress sigma_peak of the
-    compression test at the same sigma_3 (``ucs --confinement``).  ``cli``: name the values as the
-    CLI flags give them (MPa) in the messages, else as batch columns (Pa).
-    """
-    def named(flag, value):   # how the user gave a stress [Pa]
-        return f"--{flag} {value / PA_PER_MPA:.4g} MPa" if cli else f"column {flag} = {value:.4g} Pa"
-    example = {"stress": "--stress 160" if cli else "stress 160e6", "ucs": "--ucs 258" if cli else "ucs 258e6"}
-    confining = params.confinement.stress
-    calibrated = params.calibration.reference_ucs
-    if stress is None and ratio is None:
-        raise GrainfracError("no creep load: give a stress or a driving-stress ratio (CLI --stress MPA / --ratio, "
-                             "batch column stress [Pa] / ratio); fix: e.g. ratio 0.7")
-    for flag, value in (("stress", stress), ("ucs", ucs)):
-        if value is None:
-            continue
-        if not (math.isfinite(value) and value > 0):
-            raise GrainfracError(f"{named(flag, value)}: a stress must be finite and above 0; fix: e.g. "
-                                 f"{example[flag]}")
-        if value < MIN_STRESS_PA:
-            raise GrainfracError(f"{named(flag, value)} is below {MIN_STRESS_PA / PA_PER_MPA:g} MPa, no creep load for "
-                                 "granite; fix: CLI stress flags are in MPa, batch columns in Pa: e.g. " + example[flag])
-        if value > MAX_STRESS_OVER_REFERENCE * calibrated:
-            raise GrainfracError(f"{named(flag, value)} is above {MAX_STRESS_OVER_REFERENCE:g} x the reference "
-                                 f"strength (calibration.reference_ucs = {calibrated / PA_PER_MPA:.4g} MPa); fix: "
-                                 "CLI stress flags are in MPa, batch columns in Pa: e.g. " + example[flag])
-    if confining > 0 and ucs is None:
-        raise GrainfracError(f"confinement.stress = {confining:.4g} Pa: the driving-stress ratio refers to the peak "
-                             "strength at this confinement; fix: give --ucs (batch column ucs), the peak axial stress "
-                             "of `ucs --confinement` at the same confining stress")
-    ref = ucs if ucs is not None else calibrated
-    if not ref > confining:
-        raise GrainfracError(f"{named('ucs', ref)} is not above the confining stress {confining / PA_PER_MPA:.4g} MPa; "
-                             "fix: give the peak axial stress at this confinement")
-    if stress is None:
-        if not (0 < ratio < 1):
-            given = f"--ratio {ratio:g}" if cli else f"column ratio = {ratio:g}"
-            raise GrainfracError(f"{given}: a driving-stress ratio must lie in (0, 1); fix: e.g. "
-                                 f"{'--ratio' if cli else 'ratio'} 0.7")
-        stress = confining + ratio * (ref - confining)
-        if stress < MIN_STRESS_PA:
-            given = f"--ratio {ratio:g}" if cli else f"column ratio = {ratio:g}"
-            raise GrainfracError(f"{given} gives {stress / PA_PER_MPA:.4g} MPa, below {MIN_STRESS_PA / PA_PER_MPA:g} MPa, "
-                                 f"no creep load for granite; fix: e.g. {'--ratio' if cli else 'ratio'} 0.7")
-    if not stress > confining:
-        raise GrainfracError(f"{named('stress', stress)}: must be above the confining stress "
-                             f"({confining / PA_PER_MPA:.4g} MPa); fix: e.g. {example['stress']}")
-    if stress >= ref:
-        strength = "the UCS" if confining == 0 else "the peak strength at this confinement"
-        raise GrainfracError(f"{named('stress', stress)} is at or above {strength} it refers to "
-                             f"({ref / PA_PER_MPA:.4g} MPa): the specimen fails during the ramp; fix: give a stress "
-                             "below it (or --ucs)")
-    return stress, (stress - confining) / (ref - confining), ref
 
 
 def warn_reference(reference: dict) -> None:

@@ -20,7 +20,7 @@ from ..errors import GrainfracError
 from ..params import flat_values, require_plane
 from ..runs.batchrun import read_table_rows, row_outcomes, run_batch, write_table
 from ._args import float_list_type, seed_list_type
-from .creep import outcome
+from ._outcome import outcome
 
 #: Demo defaults: a 10 x 20 mm specimen (about 200 cells; a creep run takes 15-40 s on one core).
 DEMO_WIDTH_M, DEMO_HEIGHT_M = 10e-3, 20e-3
