@@ -136,7 +136,7 @@ def _log_traceback(command: str) -> str:
 
 
 def main(argv=None) -> int:
-    from .yade_adapter import use_default_threads
+    from .engines.yade import use_default_threads
     use_default_threads()   # before any command module loads the OpenMP runtime
     # this module's own imports load no numpy (nor OpenBLAS, which reads OMP_NUM_THREADS once) before this line
     from .commands._args import load_params_from_args

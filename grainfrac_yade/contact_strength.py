@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 #: Second word of the seed of the contact-strength stream (the first is the specimen's seed); any fixed
-#: number distinct from the other streams' (yade_adapter.levers.LEVER_STREAM) would do.
+#: number distinct from the other streams' (engines.yade.levers.LEVER_STREAM) would do.
 CONTACT_STRENGTH_STREAM = 20261202
 #: Weibull modulus meaning "no scatter" (every multiplier 1).
 NO_SCATTER = 0.0

@@ -29,7 +29,7 @@ models of one specimen, all linear, all solved exactly by one sparse solve:
 
 Loading: the cells with a face on the top (bottom) wall form rigid-in-y
 platens closing by ``strain`` x height (rotation blocked, lateral motion free,
-as :mod:`grainfrac_yade.yade_adapter.platens`); one lateral degree of freedom
+as :mod:`grainfrac_yade.engines.yade.platens`); one lateral degree of freedom
 is pinned.  Ratios do not depend on the applied strain (linear model).
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Lever study beyond the parameters: Brazilian 15 mm discs and UCS 10 x 20 mm with the levers of
-grainfrac_yade.yade_adapter.levers (slits, strength scatter, blocked rotation), the contacts' J^T at 0.1,
+grainfrac_yade.engines.yade.levers (slits, strength scatter, blocked rotation), the contacts' J^T at 0.1,
 the face-lined clumps' UCS (8 spheres per cell), and rotational resistance with J^T x 0.25 and 0.1.  Run by studies/brazilian_study.sh (one YADE run at a
 time, in this process); a finished run (summary.json) is skipped.
 
@@ -15,7 +15,7 @@ from grainfrac_yade.params import load_parameters
 from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.analysis.ucs_analysis import ucs_summary
-from grainfrac_yade.yade_adapter.levers import Levers, apply_levers
+from grainfrac_yade.engines.yade.levers import Levers, apply_levers
 
 SEEDS = (1, 2, 3)
 DISC = [("brazilian.diameter", 15e-3)]
@@ -24,7 +24,7 @@ BLOCK = [("specimen.width", 10e-3), ("specimen.height", 20e-3)]
 
 def ucs_with_levers(params, seed, out, levers):
     """A UCS test whose scene gets ``levers`` before loading (as the brazilian command does)."""
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     from grainfrac_yade.protocols.ucs import run_ucs
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=True)
     specimen = build_specimen(params, seed)

@@ -1,5 +1,5 @@
 """A static creep hold whose regains relax by overdamped implicit steps where the static statuses do not settle
-(grainfrac_yade.static.damped): one JSON line (no YADE).
+(grainfrac_yade.engines.static.damped): one JSON line (no YADE).
 
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.damped_relaxation_probe --params params/presets/fem.toml \
         --width 10e-3 --height 20e-3 --seed 1 --creep-stress 160e6 [--plain]
@@ -24,11 +24,11 @@ import numpy as np
 
 from grainfrac_yade.clocks import EventClock
 from grainfrac_yade.law import build_law
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.creep import creep_hold
-from grainfrac_yade.static.damped import MAX_RELAXATION_STEPS, REST_TOLERANCE, AnchoredEquilibrium, RelaxingPath
-from grainfrac_yade.static.failure import FailureRule
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.creep import creep_hold
+from grainfrac_yade.engines.static.damped import MAX_RELAXATION_STEPS, REST_TOLERANCE, AnchoredEquilibrium, RelaxingPath
+from grainfrac_yade.engines.static.failure import FailureRule
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 from .static_engine_probe import specimen_arguments, specimen_network
 

@@ -7,7 +7,7 @@ Runs the hybrid engine's UCS (cascade limit ``--handover``, ``numerics.handover_
 dynamic stint that starts with at least ``--min-broken`` bonds broken, and takes that stint's start state (the state the
 hybrid engine hands to YADE).  From it, with the platens fixed, both engines run the same number of steps at
 YADE's time step, with the same damping: YADE's scene built from the state (``scene_from_state``) and the static
-engine's inertial relaxation (:class:`grainfrac_yade.static.inertial.InertialRelaxation`, its masses and contact
+engine's inertial relaxation (:class:`grainfrac_yade.engines.static.inertial.InertialRelaxation`, its masses and contact
 law).  At each step count it prints the bonds each has broken, the platen stress and the distance between their
 displacement fields: where two models of the same network part, and by how much.
 """
@@ -22,10 +22,10 @@ import shutil
 import numpy as np
 
 from grainfrac_yade import cli
-from grainfrac_yade.hybrid import scene as hybrid_scene
-from grainfrac_yade.static.cascade import LargeCascade
-from grainfrac_yade.static.inertial import FixedPlatens, InertialRelaxation
-from grainfrac_yade.yade_adapter import engine as dynamic_engine
+from grainfrac_yade.engines.hybrid import scene as hybrid_scene
+from grainfrac_yade.engines.static.cascade import LargeCascade
+from grainfrac_yade.engines.static.inertial import FixedPlatens, InertialRelaxation
+from grainfrac_yade.engines.yade import engine as dynamic_engine
 from studies.pass_through_probe import initial_gap
 
 

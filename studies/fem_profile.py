@@ -38,7 +38,7 @@ def main(argv=None):
     p = load_parameters(extra_files=[FEM_PRESET, *a.params],
                         overrides=[("specimen.width", w), ("specimen.height", h), *a.overrides])
     from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.yade_adapter.bench_timing import loading_step_cost
+    from grainfrac_yade.engines.yade.bench_timing import loading_step_cost
     cost = loading_step_cost(build_specimen(p, a.seed), p, a.warmup, a.steps, engine_timing=True)
     print(json.dumps({"size": a.size, "seed": a.seed, "overrides": a.overrides, **cost}))
 

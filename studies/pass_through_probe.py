@@ -19,10 +19,10 @@ import math
 
 import numpy as np
 
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.scene import StaticScene
-from grainfrac_yade.static.solver import Equilibrium
-from grainfrac_yade.static.ucs import ucs_path
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.scene import StaticScene
+from grainfrac_yade.engines.static.solver import Equilibrium
+from grainfrac_yade.engines.static.ucs import ucs_path
 from studies.static_engine_probe import specimen_arguments, specimen_layout
 
 #: Axial strain between two reports [1].

@@ -3,7 +3,7 @@
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.static_buckling_probe --params params/presets/fem.toml \
         --width 10e-3 --height 20e-3 --seed 1 --strains 0.001,0.002,0.003,0.004,0.005,0.006
 
-Follows the static UCS path (:mod:`grainfrac_yade.static.ucs`'s sequentially linear path, small strain) and, at
+Follows the static UCS path (:mod:`grainfrac_yade.engines.static.ucs`'s sequentially linear path, small strain) and, at
 each strain asked, computes the critical load factor lambda of the linearised buckling problem
 
     (K_t + lambda K_sigma) phi = 0   on the free dofs,
@@ -26,8 +26,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from grainfrac_yade.elastic import _triangle_b, build_network
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.solver import Equilibrium
 from studies.static_engine_probe import specimen_arguments, specimen_layout
 
 #: Eigenvalues of K_t^-1 (-K_sigma) asked of ARPACK [1]: the largest few (the smallest load factors).

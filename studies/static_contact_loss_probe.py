@@ -20,11 +20,11 @@ import time
 
 import numpy as np
 
-from grainfrac_yade.static import contacts as cl
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static import contacts as cl
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.solver import Equilibrium
 from studies.static_engine_probe import specimen_arguments, specimen_layout
-from grainfrac_yade.static.ucs import ucs_path
+from grainfrac_yade.engines.static.ucs import ucs_path
 
 
 class LossPath(Path):

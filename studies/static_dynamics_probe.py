@@ -24,11 +24,11 @@ import time
 import numpy as np
 
 from grainfrac_yade.elastic import _triangle_b, build_network
-from grainfrac_yade.static import contacts as cl
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static import contacts as cl
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.solver import Equilibrium
 from studies.static_engine_probe import specimen_arguments, specimen_layout
-from grainfrac_yade.static.ucs import ucs_path
+from grainfrac_yade.engines.static.ucs import ucs_path
 
 #: Fraction of the critical step (Gershgorin bound on M^-1 K) [1].
 STEP_SAFETY = 0.8

@@ -21,10 +21,10 @@ from grainfrac_yade.errors import NumericalFailure
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static.bench_timing import counters, sequence_hash, timed_creep_hold
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.bench_timing import counters, sequence_hash, timed_creep_hold
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.network import build_static_network
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 from .static_engine_probe import specimen_arguments
 

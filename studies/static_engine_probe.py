@@ -22,12 +22,12 @@ from grainfrac_yade.grains import layout_for
 from grainfrac_yade.law import build_law
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.creep import creep_hold
-from grainfrac_yade.static.failure import FailureRule
-from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import MAX_ACTIVE_SET_ITERATIONS, STATUS_CHANGES_PER_ITERATION, Equilibrium
-from grainfrac_yade.static.ucs import ucs_path
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.creep import creep_hold
+from grainfrac_yade.engines.static.failure import FailureRule
+from grainfrac_yade.engines.static.network import build_static_network
+from grainfrac_yade.engines.static.solver import MAX_ACTIVE_SET_ITERATIONS, STATUS_CHANGES_PER_ITERATION, Equilibrium
+from grainfrac_yade.engines.static.ucs import ucs_path
 
 #: Axial strains at which the geometry is read [1]: around the YADE peaks of 10 x 20 mm seed 1 (fem 0.38 %,
 #: docs/studies/paper_fem/mesh/ucs_runs.csv) and beyond.

@@ -31,8 +31,8 @@ QUANTILES = (0.0, 0.05, 0.5)
 
 
 def measure(files, width, height, seed, quantile, steps):
-    from grainfrac_yade.yade_adapter.platens import Platens
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.platens import Platens
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(extra_files=files, overrides=[f"specimen.width={width!r}", f"specimen.height={height!r}",
                                                       f"numerics.step_floor_quantile={quantile!r}"])
     scene = build_scene(build_specimen(p, seed), p)

@@ -15,7 +15,7 @@ from grainfrac_yade.params import load_parameters  # noqa: E402
 
 def yade_available() -> bool:
     try:
-        from grainfrac_yade.yade_adapter import load_yade
+        from grainfrac_yade.engines.yade import load_yade
         load_yade()
         return True
     except Exception:

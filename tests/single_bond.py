@@ -12,8 +12,8 @@ import numpy as np
 from grainfrac_yade.grains.rigid import build_layout
 from grainfrac_yade.geometry.specimen import specimen_from_tessellation
 from grainfrac_yade.geometry.tessellation import tessellate_seeds
-from grainfrac_yade.yade_adapter.corrosion_engine import StressCorrosion, add_stiffness_restorer
-from grainfrac_yade.yade_adapter.scene import build_scene
+from grainfrac_yade.engines.yade.corrosion_engine import StressCorrosion, add_stiffness_restorer
+from grainfrac_yade.engines.yade.scene import build_scene
 
 #: Relative unbalanced force on the loaded cell at which the pair counts as relaxed.
 BOND_EQUILIBRIUM_TOLERANCE = 1e-9

@@ -4,7 +4,7 @@ import pytest
 
 from grainfrac_yade.elastic import Network
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static.network import from_network
+from grainfrac_yade.engines.static.network import from_network
 
 #: Bond stiffnesses [N/m] and strengths [Pa] of the tiny networks: Table 2's orders of magnitude.
 KN, KS = 5e9, 2e9
@@ -76,7 +76,7 @@ def plain_hold_fails_once(monkeypatch, at: int = 1):
     """Make the plain static regain (``Path.hold``) give out once, at its ``at``-th call, from its start state, as a
     status cycle does (helper of the relaxation tests: the next regain is the plain one)."""
     from grainfrac_yade.errors import NumericalFailure
-    from grainfrac_yade.static.cascade import Path
+    from grainfrac_yade.engines.static.cascade import Path
     calls = {"n": 0}
     original = Path.hold
 

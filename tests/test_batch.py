@@ -87,7 +87,7 @@ def test_a_row_without_load_is_one_clear_line(tmp_path):
 
 
 def test_only_an_explicit_description_column_names_the_folder(tmp_path, monkeypatch):
-    from grainfrac_yade.yade_adapter.batch import explicit_description_column
+    from grainfrac_yade.engines.yade.batch import explicit_description_column
     named = tmp_path / "named.table"
     named.write_text("# a comment\ndescription ratio seed\n'slow_ramp' 0.7 1\n")
     plain = tmp_path / "plain.table"

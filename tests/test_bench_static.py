@@ -75,10 +75,10 @@ def test_timed_hold_is_the_cores_hold():
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.law import build_law
     from grainfrac_yade.params import load_parameters
-    from grainfrac_yade.static.bench_timing import timed_creep_hold, timed_network
-    from grainfrac_yade.static.creep import creep_hold
-    from grainfrac_yade.static.failure import FailureRule
-    from grainfrac_yade.static.solver import Equilibrium
+    from grainfrac_yade.engines.static.bench_timing import timed_creep_hold, timed_network
+    from grainfrac_yade.engines.static.creep import creep_hold
+    from grainfrac_yade.engines.static.failure import FailureRule
+    from grainfrac_yade.engines.static.solver import Equilibrium
     p = load_parameters(extra_files=[FEM], overrides=["specimen.width=4e-3", "specimen.height=8e-3"])
     net, _ = timed_network(build_specimen(p, 1), p)
     timed = timed_creep_hold(net, p, 160e6, 4)

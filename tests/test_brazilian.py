@@ -298,8 +298,8 @@ def test_levers_off_change_nothing_and_slits_are_not_cracks():
     """Levers() leaves a run bit-identical; slits start broken (mode PRE_EXISTING), are left out of the crack
     counts, and lower the strength; blocked rotation blocks every cell's Z rotation (8 mm disc, seed 1)."""
     from grainfrac_yade.protocols.brazilian import run_brazilian
-    from grainfrac_yade.yade_adapter.levers import PRE_EXISTING, Levers, apply_levers
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.levers import PRE_EXISTING, Levers, apply_levers
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=TINY)
     sp = build_disc_specimen(p, 1)
     plain, r_plain, _, _ = run_brazilian(sp, p)

@@ -16,7 +16,7 @@ from grainfrac_yade.clocks import PaperClock
 from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.protocols.creep_loops import CollapseWatch, collapsing
-from grainfrac_yade.yade_adapter.platens import StressServo
+from grainfrac_yade.engines.yade.platens import StressServo
 from test_reliability import JC, JT, StandInBonds, StandInHolder, loop_params
 
 

@@ -105,8 +105,8 @@ def test_a_negative_confinement_is_one_line(capsys):
 def test_confinement_forces_consolidation_and_a_higher_peak(tmp_path):
     from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
     from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.yade_adapter.confinement import Confinement
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.confinement import Confinement
+    from grainfrac_yade.engines.yade.scene import build_scene
     p20 = load_parameters(overrides=TINY + [("confinement.stress", 20 * MPA)])
     specimen = build_specimen(p20, 1)
     scene = build_scene(specimen, p20)

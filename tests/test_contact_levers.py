@@ -246,7 +246,7 @@ def test_levers_reach_yades_bonds(fem):
     """FnMax = J^T A and FsMax = J^C A of every interaction are Table 2's strengths with every lever, exactly
     (J^T x ratio x inter-mineral factor x strength_scale x the face's Weibull multiplier, in that order);
     k_n and k_s are the bond arrays, k_s above the no-lever value (k_s/k_n x 2)."""
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     ratio, inter, modulus = 0.6, 0.7, 3.0
     p = tiny_params(f"calibration.tensile_cohesion_ratio_scale={ratio}", f"calibration.inter_mineral_strength_ratio={inter}",
                     "calibration.shear_stiffness_ratio_scale=2.0", f"calibration.strength_weibull_modulus={modulus}",

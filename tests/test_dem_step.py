@@ -33,7 +33,7 @@ MODELS = {
 @pytest.mark.yade
 @pytest.mark.parametrize("model", sorted(MODELS))
 def test_core_step_is_the_scene_step(model):
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=TINY + MODELS[model])
     s = build_specimen(p, 2)
     core = critical_dem_step(s, p)

@@ -116,8 +116,8 @@ def test_rigid_solve_agrees_with_yade_after_a_small_elastic_ramp():
 
 def _assert_yade_ramp_matches_static_solve(p, network, relax_steps):
     """Ramp seed 1 of ``p`` in YADE slowly to a strain of 2e-4, relax, compare with ``network``'s solve."""
-    from grainfrac_yade.yade_adapter.platens import Platens
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.platens import Platens
+    from grainfrac_yade.engines.yade.scene import build_scene
     s = build_specimen(p, 1)
     scene = build_scene(s, p)
     net = network(s, p, scene.layout)

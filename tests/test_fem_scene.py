@@ -110,8 +110,8 @@ def test_node_stiffness_bounds_the_fastest_mode():
 def test_yade_element_material_gives_an_exact_linear_tetrahedron():
     """One Lin4NodeTetra with :func:`fem_element_material`: nodal forces = -K u of a tetrahedron
     built by hand from the shape-function gradients and the 3D isotropic elasticity matrix."""
-    from grainfrac_yade.yade_adapter import load_yade
-    from grainfrac_yade.yade_adapter.fem_cells import fem_element_material
+    from grainfrac_yade.engines.yade import load_yade
+    from grainfrac_yade.engines.yade.fem_cells import fem_element_material
     load_yade()
     from yade import O, utils, Vector3
     from yade import wrapper as w
@@ -180,8 +180,8 @@ def test_a_verlet_distance_of_the_median_sphere_stops_the_resorting():
     often than with YADE's rule (0.5 x the smallest sphere, which fem cells make tiny next to sliver
     faces).  10 x 20 mm seed 3 with the fem preset (smallest sphere 2.7e-3 of the median): 543 sorts
     in 1,000 steps after 200 warm-up steps with YADE's rule, 1 with the median's."""
-    from grainfrac_yade.yade_adapter.platens import Platens
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.platens import Platens
+    from grainfrac_yade.engines.yade.scene import build_scene
     sorts = {}
     for name, extra in (("yade_rule", ["numerics.verlet_radius_quantile=0"]), ("median", MEDIAN_VERLET)):
         q = load_parameters(extra_files=[FEM_PRESET], overrides=["specimen.width=10e-3", "specimen.height=20e-3",
@@ -203,7 +203,7 @@ def test_a_verlet_distance_of_the_median_sphere_stops_the_resorting():
 @needs_yade
 @pytest.mark.yade
 def test_fem_scene_lists_the_element_engine_and_moves_clumped_apexes():
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=SMALL)
     s = build_specimen(p, 1)
     scene = build_scene(s, p)

@@ -32,7 +32,7 @@ def fem():
 
 def test_scene_takes_its_layout_from_layout_for():
     from grainfrac_yade import grains
-    from grainfrac_yade.yade_adapter import scene
+    from grainfrac_yade.engines.yade import scene
     assert scene.layout_for is grains.layout_for
 
 
@@ -181,7 +181,7 @@ def test_ucs_and_creep_summaries_name_the_grain_model(tmp_path, monkeypatch, fem
 def test_batch_row_sets_the_grain_model(tmp_path, monkeypatch):
     """YADE's table reader (no simulation): a quoted text cell and an integer cell become overrides."""
     from grainfrac_yade.runs.batchrun import write_table
-    from grainfrac_yade.yade_adapter.batch import read_table, run_folder_name
+    from grainfrac_yade.engines.yade.batch import read_table, run_folder_name
     table = write_table(tmp_path / "grains.table", [
         {"resolution.grain_model": "rigid", "resolution.nodes_per_face": 2, "seed": 1},
         {"resolution.grain_model": "fem", "resolution.nodes_per_face": 3, "seed": 2}])

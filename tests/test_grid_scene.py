@@ -28,7 +28,7 @@ def grid_specimen(params, nx, ny, mineral="quartz"):
 
 
 def test_vtk_cell_motion_follows_a_rotated_cell(params):
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     fem = load_parameters(overrides=["resolution.grain_model=fem"])
     s = grid_specimen(fem, 2, 1)
     sc = build_scene(s, fem)
@@ -48,7 +48,7 @@ def test_vtk_cell_motion_follows_a_rotated_cell(params):
 def test_rigid_default_scene_is_unchanged(params):
     """Two square rigid cells (one sphere each): bond stiffness (series formula) and time step
     (min over cells of sqrt(m/K), sqrt(I/(K l^2)), l = SIZE/2 from centroid to face) as before."""
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     assert params.resolution.grain_model == "rigid"
     s = grid_specimen(params, 2, 1)
     sc = build_scene(s, params)
@@ -69,7 +69,7 @@ def test_rigid_default_scene_is_unchanged(params):
 
 
 def test_rigid_layout_comes_from_layout_for(params):
-    from grainfrac_yade.yade_adapter.scene import layout_for
+    from grainfrac_yade.engines.yade.scene import layout_for
     s = build_specimen(load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3"]), 1)
     a, b = layout_for(s, params), build_layout(s, params.resolution.spheres_per_cell)
     assert a.model == "rigid" and a.n_bonds == b.n_bonds

@@ -128,7 +128,7 @@ def outcome_in_analysis(folder) -> list:
 def step_ten_times_critical(monkeypatch):
     """Scenes built for UCS and creep runs step at 10 x their critical DEM step (timestep_safety <= 1
     cannot ask for it: the step is set after the scene is built)."""
-    from grainfrac_yade.yade_adapter import engine
+    from grainfrac_yade.engines.yade import engine
 
     def stepping_up(build):
         def build_then_step_up(*args, **kwargs):
@@ -286,8 +286,8 @@ def test_e_a_sliver_cell_builds_a_stable_scene_and_compresses_finitely(width):
     """A cell 1/100 and 1/100,000 of a grain wide (width/length 0.01 and 1e-5): the critical DEM step is
     finite and positive (1.9e-8 s and 5.9e-10 s, against 3.8e-7 s without the sliver; it falls as the
     square root of the width), and 20,000 DEM steps of compression stay finite (1 s each)."""
-    from grainfrac_yade.yade_adapter.platens import Platens
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.platens import Platens
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=TINY)
     specimen = sliver_specimen(p, width)
     eq_width = specimen.tessellation.cell_measure / np.array([np.ptp(v[:, 1]) for v in

@@ -191,8 +191,8 @@ def test_the_hybrid_relaxes_by_its_stints_not_by_the_static_relaxation():
     from grainfrac_yade.engines.registry import engine
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.params import load_parameters
-    from grainfrac_yade.static.cascade import Path
-    from grainfrac_yade.static.inertial import InertialPath
+    from grainfrac_yade.engines.static.cascade import Path
+    from grainfrac_yade.engines.static.inertial import InertialPath
     p = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     assert p.numerics.static_relaxation == "inertial"
     specimen = build_specimen(p, 1)

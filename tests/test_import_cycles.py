@@ -28,8 +28,8 @@ ALLOWED = {
              ("cli", "commands._args")),
     **_group("guarded by ImportError: a cluster's batch code may predate checkpoints",
              ("runs.slurm", "runs.runio")),
-    **_group("cli.py sets the one-thread default of YADE's OpenMP runtime (yade_adapter.use_default_threads) "
-             "before anything loads it", ("cli", "yade_adapter")),
+    **_group("cli.py sets the one-thread default of YADE's OpenMP runtime (engines.yade.use_default_threads) "
+             "before anything loads it", ("cli", "engines.yade")),
     **_group(_RESTRUCTURED,
              ("commands.bench", "commands._args"), ("commands.bench", "errors"), ("commands.bench", "numpy"),
              ("commands.bench", "geometry.specimen"), ("commands.bench", "grains"), ("commands.bench", "params"),
@@ -40,8 +40,8 @@ ALLOWED = {
              ("commands.creep", "params"), ("commands.creep", "argparse"), ("commands.creep", "sys"),
              ("commands.specimen", "params"),
              ("commands.ucs", "params"),
-             ("yade_adapter.batch", "runs.runio"),
-             ("yade_adapter.bench_timing", "yade_adapter.platens"), ("yade_adapter.bench_timing", "yade_adapter.scene")),
+             ("engines.yade.batch", "runs.runio"),
+             ("engines.yade.bench_timing", "engines.yade.platens"), ("engines.yade.bench_timing", "engines.yade.scene")),
 }
 
 

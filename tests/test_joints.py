@@ -1,4 +1,4 @@
-"""Intact bonds on face planes against YADE's smooth-joint sliding rule (yade_adapter/joints.py).
+"""Intact bonds on face planes against YADE's smooth-joint sliding rule (engines/yade/joints.py).
 
 One bond of a tiny finite-element scene is sheared back and forth, elastically (a quarter of its
 cohesion), with every body held by its velocity: its faces' sliding path grows by four amplitudes a
@@ -26,7 +26,7 @@ AMPLITUDE_FRACTION = 0.25
 def _sheared_bond(keep: bool):
     """Build the scene, shear its bond of the smallest spheres until its path is 3 x YADE's limit;
     (scene, bond, phys, amplitude [m], slip direction)."""
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(extra_files=[FEM_PRESET], overrides=[*TINY, f"numerics.keep_intact_joints={str(keep).lower()}"])
     sc = build_scene(build_specimen(p, 1), p)
     lay = sc.layout
@@ -74,7 +74,7 @@ def test_without_the_guard_yade_erases_the_intact_bond_and_the_scene_counts_it()
 
 @needs_yade
 def test_the_guard_is_in_fem_scenes_only():
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     fem = load_parameters(extra_files=[FEM_PRESET], overrides=TINY)
     rigid = load_parameters(overrides=TINY)
     assert "IntactJointGuard" in build_scene(build_specimen(fem, 1), fem).engine_names()

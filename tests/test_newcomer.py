@@ -123,7 +123,7 @@ def test_a_cli_run_uses_one_yade_thread_unless_told_otherwise(tmp_path):
     threads (the README's UCS gave 280.4 and 282.0 MPa in two runs, at 16 x the CPU time)."""
     code = ("import sys; from grainfrac_yade.cli import main\n"
             f"main(['specimen', '--width', '3e-3', '--height', '6e-3', '--out', {str(tmp_path / 's')!r}])\n"
-            "from grainfrac_yade.yade_adapter import load_yade; load_yade(); from yade import O; print(O.numThreads)")
+            "from grainfrac_yade.engines.yade import load_yade; load_yade(); from yade import O; print(O.numThreads)")
     env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
     assert res.returncode == 0, res.stderr[-2000:]

@@ -389,7 +389,7 @@ def finished_folder(path, params, values=VALUES, drop=()):
 
 
 def test_a_finished_row_is_skipped_only_with_equal_parameters(tmp_path):
-    from grainfrac_yade.yade_adapter.batch import row_folder
+    from grainfrac_yade.engines.yade.batch import row_folder
     params = load_parameters(overrides=TINY)
     out = finished_folder(tmp_path / "row", params)
     assert row_folder(out, params, {"on_change": "stop"}, VALUES) == (out, True)
@@ -407,7 +407,7 @@ def test_a_finished_row_is_skipped_only_with_equal_parameters(tmp_path):
 
 def test_on_change_new_folder_runs_into_a_folder_named_by_the_parameters(tmp_path):
     from grainfrac_yade.runs.runio import run_digest
-    from grainfrac_yade.yade_adapter.batch import row_folder
+    from grainfrac_yade.engines.yade.batch import row_folder
     params = load_parameters(overrides=TINY)
     out = finished_folder(tmp_path / "row", params)
     edited = load_parameters(overrides=TINY + ["stress_corrosion.beta1=2e-3"])
@@ -419,7 +419,7 @@ def test_on_change_new_folder_runs_into_a_folder_named_by_the_parameters(tmp_pat
 
 
 def test_a_key_older_params_files_lack_counts_as_its_default(tmp_path):
-    from grainfrac_yade.yade_adapter.batch import row_folder
+    from grainfrac_yade.engines.yade.batch import row_folder
     params = load_parameters(overrides=TINY)
     out = finished_folder(tmp_path / "old", params, drop=("resolution.nodes_per_face",))
     assert row_folder(out, params, {"on_change": "stop"}, VALUES) == (out, True)
@@ -433,7 +433,7 @@ def test_a_key_older_params_files_lack_counts_as_its_default(tmp_path):
                                              ("on_chnage", "on_change"), ("specimen.widht", "specimen.width")])
 def test_a_misspelt_column_names_the_nearest_valid_key(column, nearest):
     from grainfrac_yade.params import shipped_values
-    from grainfrac_yade.yade_adapter.batch import RUN_COLUMNS, check_columns
+    from grainfrac_yade.engines.yade.batch import RUN_COLUMNS, check_columns
     valid = {**shipped_values(), **RUN_COLUMNS, "ratio": 0.0}
     check_columns(["specimen.width", "seed", "description", "!note"], valid, "t.table:2")   # all valid: quiet
     with pytest.raises(GrainfracError) as err:
@@ -442,7 +442,7 @@ def test_a_misspelt_column_names_the_nearest_valid_key(column, nearest):
 
 
 def test_a_column_like_no_key_lists_what_columns_may_be():
-    from grainfrac_yade.yade_adapter.batch import RUN_COLUMNS, check_columns
+    from grainfrac_yade.engines.yade.batch import RUN_COLUMNS, check_columns
     with pytest.raises(GrainfracError) as err:
         check_columns(["qqqq"], dict(RUN_COLUMNS), "t.table:2")
     assert str(err.value) == ("batch table t.table:2: unknown column 'qqqq'; fix: columns are parameter paths "

@@ -165,7 +165,7 @@ def _unfinished(path, params, values=VALUES, phase="event"):
 
 def test_a_batch_row_skips_resumes_or_starts_by_its_folder(tmp_path):
     from grainfrac_yade.runs.runio import write_json
-    from grainfrac_yade.yade_adapter.batch import row_plan
+    from grainfrac_yade.engines.yade.batch import row_plan
     params = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     stop = {"on_change": "stop"}
     out = _unfinished(tmp_path / "a", params)
@@ -217,7 +217,7 @@ def test_the_old_interval_key_is_refused_in_one_line_and_migrated_in_older_runs(
     from grainfrac_yade.errors import GrainfracError, ParameterError
     from grainfrac_yade.params import migrate_tree
     from grainfrac_yade.runs.runio import checkpoint_differences
-    from grainfrac_yade.yade_adapter.batch import check_columns
+    from grainfrac_yade.engines.yade.batch import check_columns
     for given in (["creep.checkpoint_interval=60"], ):
         with pytest.raises(ParameterError, match="moved to numerics.checkpoint_interval"):
             load_parameters(overrides=given)

@@ -50,7 +50,7 @@ def one_error_line(res):
 # ---------------------------------------------------------------- tables and scripts (no SLURM)
 
 def test_table_reader_reads_every_shipped_table_as_yade_does():
-    from grainfrac_yade.yade_adapter import load_yade
+    from grainfrac_yade.engines.yade import load_yade
     try:
         load_yade()
         from yade.utils import TableParamReader
@@ -288,7 +288,7 @@ def test_sigterm_marks_the_row_failed_and_ends_the_yade_process(tmp_path):
 
 def test_a_batch_row_records_its_folder_for_the_wrapper(tmp_path, monkeypatch):
     from grainfrac_yade.runs import slurm
-    from grainfrac_yade.yade_adapter import batch
+    from grainfrac_yade.engines.yade import batch
     assert batch.ROW_FOLDER_ENV == slurm.ROW_FOLDER_ENV
     target = tmp_path / "tasks" / "row1_folder.json"
     monkeypatch.setenv(slurm.ROW_FOLDER_ENV, str(target))

@@ -1,4 +1,4 @@
-"""The Brazilian test on the static engine: the disc's jaws of grainfrac_yade.static.jaws, driven by the unchanged
+"""The Brazilian test on the static engine: the disc's jaws of grainfrac_yade.engines.static.jaws, driven by the unchanged
 protocol (pure, tiny discs, seconds each; no YADE)."""
 import json
 import math
@@ -205,9 +205,9 @@ def test_jaws_on_a_box_or_a_loaded_disc_are_one_line():
 def test_bond_numbering_does_not_change_the_path():
     """The same disc with its bonds numbered otherwise (the network's input permuted): the same broken bonds, in the
     same order, at the same closures, the same loads."""
-    from grainfrac_yade.static.jaws import jaw_network, JawEquilibrium, jaw_cells
-    from grainfrac_yade.static.network import build_static_network
-    from grainfrac_yade.static.cascade import Path
+    from grainfrac_yade.engines.static.jaws import jaw_network, JawEquilibrium, jaw_cells
+    from grainfrac_yade.engines.static.network import build_static_network
+    from grainfrac_yade.engines.static.cascade import Path
     p = _params()
     scene, jaws = _jawed(p)
     perm = np.random.default_rng(3).permutation(scene.n_bonds)

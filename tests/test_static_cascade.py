@@ -6,12 +6,12 @@ from grainfrac_yade.errors import NumericalFailure
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static import contacts as cl
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.failure import FailureRule
-from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import Equilibrium
-from grainfrac_yade.static.ucs import ucs_path
+from grainfrac_yade.engines.static import contacts as cl
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.failure import FailureRule
+from grainfrac_yade.engines.static.network import build_static_network
+from grainfrac_yade.engines.static.solver import Equilibrium
+from grainfrac_yade.engines.static.ucs import ucs_path
 from static_tiny import KN, network
 
 #: Tiny specimens per grain model: fem 3 x 6 mm; rigid 4 x 8 mm (on 3 x 6 mm seed 1 a rigid cell's mechanism

@@ -41,7 +41,7 @@ def test_factor_state_rebuilds_the_kept_factor_bit_for_bit():
     assert scene.broken.any() and scene.eq._lr is not None      # past the first breaks, a reference factor kept
     saved = {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in scene.eq.factor_state().items()}
     assert "reference_columns" in saved
-    from grainfrac_yade.static.solver import Equilibrium
+    from grainfrac_yade.engines.static.solver import Equilibrium
     twin = Equilibrium(scene.net)
     twin.restore_factor_state(saved)
     state = scene.state

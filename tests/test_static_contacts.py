@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from grainfrac_yade.static import contacts as cl
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static import contacts as cl
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.solver import Equilibrium
 from static_tiny import JC, JT, PHI, PHI_R, shear_pair, tension_pair
 
 #: Closed forms hold to round-off: a handful of float operations on numbers of order 1e7 Pa (1e-12 relative).

@@ -10,11 +10,11 @@ from grainfrac_yade.grains import layout_for
 from grainfrac_yade.law.hillig_charles import HilligCharles
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.creep import creep_hold
-from grainfrac_yade.static.failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
-from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.creep import creep_hold
+from grainfrac_yade.engines.static.failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
+from grainfrac_yade.engines.static.network import build_static_network
+from grainfrac_yade.engines.static.solver import Equilibrium
 from static_tiny import JC, PHI, PHI_R, network, shear_pair
 
 #: Paper section 4.1: beta1 [Pa/s], beta2 [1/Pa].

@@ -1,12 +1,12 @@
-"""Overdamped implicit relaxation (grainfrac_yade.static.damped) against closed forms and the static solve (no YADE)."""
+"""Overdamped implicit relaxation (grainfrac_yade.engines.static.damped) against closed forms and the static solve (no YADE)."""
 import numpy as np
 import pytest
 
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.damped import AnchoredEquilibrium, intact_diagonal, relax_held
-from grainfrac_yade.static.failure import NO_EQUILIBRIUM
-from grainfrac_yade.static.failure import FailureRule
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.damped import AnchoredEquilibrium, intact_diagonal, relax_held
+from grainfrac_yade.engines.static.failure import NO_EQUILIBRIUM
+from grainfrac_yade.engines.static.failure import FailureRule
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 from static_tiny import KN, chain, creep_giving_out, fem_creep_4x8, plain_hold_fails_once, shear_pair
 
@@ -119,7 +119,7 @@ def test_anchor_must_be_positive():
 def test_relaxing_path_relaxes_where_the_plain_hold_gives_out(monkeypatch):
     """A plain regain that gives out (made to fail once here) is relaxed from the last converged state and ends on
     the plain static hold's state; a regain that does not give out is the plain one's, bit for bit."""
-    from grainfrac_yade.static.damped import RelaxingPath
+    from grainfrac_yade.engines.static.damped import RelaxingPath
 
     net = chain(jt=1e12, jc=1e12)
     target = 50e6
@@ -160,7 +160,7 @@ def test_creep_hold_relaxes_to_rest_whatever_the_rest_tolerance(monkeypatch):
     relaxation comes to rest and the hold goes on to the time limit.  The rest tolerance 1e-6 or 1e-9 gives the same
     events and the same end, the tighter one in more steps; the break times and the strains agree within
     REST_AGREEMENT (the relaxed states differ within the tolerance)."""
-    import grainfrac_yade.static.damped as damped
+    import grainfrac_yade.engines.static.damped as damped
     runs = []
     for tol in (1e-6, 1e-9):
         with monkeypatch.context() as m:
@@ -194,7 +194,7 @@ def test_a_relaxation_decides_collapse_whatever_its_budget():
     event, docs/studies/static_engine.md); relaxing, the hold fails by the collapse rule, with the same lifetime,
     events and broken bonds for budgets of 1000 and 3000 steps (the hybrid engine's YADE stint gave the same creep
     time).  A rest tolerance's reach is the 4 x 8 mm test's above."""
-    import grainfrac_yade.static.damped as damped
+    import grainfrac_yade.engines.static.damped as damped
     runs = [_rigid_creep("numerics.static_relaxation=overdamped", f"numerics.static_relaxation_steps={n}")
             for n in (1000, 3000)]
     for run in runs:

@@ -6,8 +6,8 @@ from grainfrac_yade.elastic import DEFAULT_STRAIN, build_network, solve_uniaxial
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.network import build_static_network
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 TINY = ["specimen.width=4e-3", "specimen.height=8e-3"]
 #: Round-off: the same matrices summed in another order and factorised by SuperLU instead of spsolve; measured

@@ -248,7 +248,7 @@ def test_creep_killed_and_resumed_gives_the_uninterrupted_run(tmp_path, monkeypa
 
 
 def test_dynamic_only_setting_warns_once():
-    from grainfrac_yade.static.engine import warn_dynamic_only
+    from grainfrac_yade.engines.static.engine import warn_dynamic_only
     given = ["numerics.damping=0.5", "specimen.width=3e-3", ("creep.servo_response_steps", 5),
              "numerics.verlet_fraction=0.2"]
     lines = warn_dynamic_only(given, _params("numerics.static_relaxation=none"))

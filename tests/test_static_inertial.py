@@ -1,4 +1,4 @@
-"""Explicit dynamic relaxation of the static network (grainfrac_yade.static.inertial) against closed forms, the
+"""Explicit dynamic relaxation of the static network (grainfrac_yade.engines.static.inertial) against closed forms, the
 static solve and the protocol (no YADE)."""
 import math
 
@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.failure import COLLAPSE, FailureRule
-from grainfrac_yade.static.inertial import (LOST_LOAD, InertialPath, InertialRelaxation, critical_step, damped_step,
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.failure import COLLAPSE, FailureRule
+from grainfrac_yade.engines.static.inertial import (LOST_LOAD, InertialPath, InertialRelaxation, critical_step, damped_step,
                                             dof_masses)
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 from static_tiny import KN, chain, creep_giving_out, plain_hold_fails_once, shear_pair
 
@@ -40,7 +40,7 @@ def test_dof_masses_carry_the_cells_masses(model):
     masses, density x numerics.density_scale x area x thickness (to 1e-12); rotations carry an inertia."""
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.grains import layout_for
-    from grainfrac_yade.static.network import build_static_network
+    from grainfrac_yade.engines.static.network import build_static_network
     p = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3", f"resolution.grain_model={model}"])
     s = build_specimen(p, 1)
     lay = layout_for(s, p)

@@ -5,9 +5,9 @@ import scipy.sparse.linalg as spla
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.static import contacts as cl
-from grainfrac_yade.static.network import build_static_network
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static import contacts as cl
+from grainfrac_yade.engines.static.network import build_static_network
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 #: Relative agreement [1] of a Woodbury solve (unrefined) with a direct SuperLU solve of the assembled changed
 #: tangent: both are exact algebra carried out in float64, each leaves a relative residual of ~1e-15
@@ -93,7 +93,7 @@ def test_groups_of_fixed_dofs_are_the_connected_node_groups():
     nodes joined by the grain stiffness and by the closed contacts (the same partition), with some contacts open."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
-    from grainfrac_yade.static.solver import net_tri_edges
+    from grainfrac_yade.engines.static.solver import net_tri_edges
     net, eq, state = _equilibrium()
     rng = np.random.default_rng(7)
     closed = rng.random(net.n_bonds) > 0.4

@@ -1,4 +1,4 @@
-"""The static engine's discrete decisions do not flip on round-off (grainfrac_yade.static.ties; no YADE).
+"""The static engine's discrete decisions do not flip on round-off (grainfrac_yade.engines.static.ties; no YADE).
 
 Another x86-64 CPU computes the same specimen only to round-off: numpy's SIMD kernels with and without AVX-512 give
 every bond's stiffness, area and friction coefficient another last bit, OpenBLAS's kernels per CPU sum in another
@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.static import contacts as cl
-from grainfrac_yade.static import tangent as tg
-from grainfrac_yade.static import ties
-from grainfrac_yade.static.cascade import Path
-from grainfrac_yade.static.solver import Equilibrium
+from grainfrac_yade.engines.static import contacts as cl
+from grainfrac_yade.engines.static import tangent as tg
+from grainfrac_yade.engines.static import ties
+from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.solver import Equilibrium
 
 #: Relative change of every bond's properties that models another CPU's round-off [1] (module doc).
 ROUNDOFF = 1e-14
@@ -36,7 +36,7 @@ PROPERTIES = ("kn", "ks", "area", "tan_friction", "tan_residual", "tensile_stren
 
 def _perturb(monkeypatch, rel):
     """Every static network built from now on with its bonds' PROPERTIES times (1 + rel x U(-1, 1)), seeded."""
-    import grainfrac_yade.static.scene as scene_mod
+    import grainfrac_yade.engines.static.scene as scene_mod
     build = scene_mod.build_static_network
 
     def perturbed(*args, **kw):
@@ -132,7 +132,7 @@ def test_a_singular_update_is_refused_and_the_factor_decides(monkeypatch):
     with the ground springs (the mechanism carries no load here)."""
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.grains import layout_for
-    from grainfrac_yade.static.network import build_static_network
+    from grainfrac_yade.engines.static.network import build_static_network
     p = load_parameters(overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     s = build_specimen(p, 1)
     net = build_static_network(s, p, layout_for(s, p))
@@ -232,7 +232,7 @@ import json, sys
 sys.path.insert(0, {tests!r})
 import numpy as np
 from test_static_roundoff import _kind, _ucs
-import grainfrac_yade.static.cascade as cascade
+import grainfrac_yade.engines.static.cascade as cascade
 seq = []
 original = cascade.Path.break_bond
 def recording(self, state, bond, mode):

@@ -54,7 +54,7 @@ def test_scene_step_rises_to_the_quantile_and_only_cells_below_get_heavier(model
     from grainfrac_yade.grains.fem import sphere_mass_inertia
     from grainfrac_yade.grains.rigid import body_steps
     from grainfrac_yade.layout import cell_mass_inertia
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     q = 0.3
     base = load_parameters(overrides=SMALL + [f"resolution.grain_model={model}"])
     floored = load_parameters(overrides=SMALL + [f"resolution.grain_model={model}",

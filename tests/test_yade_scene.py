@@ -16,7 +16,7 @@ PLAIN_ENGINES = ["ForceResetter", "InsertionSortCollider", "InteractionLoop", "N
 
 @pytest.mark.parametrize("spheres_per_cell", [1, 8])
 def test_bonds_match_faces(small_params, spheres_per_cell):
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=["specimen.width=6e-3", "specimen.height=8e-3",
                                    f"resolution.spheres_per_cell={spheres_per_cell}"])
     s = build_specimen(p, 2)
@@ -39,7 +39,7 @@ def test_bonds_match_faces(small_params, spheres_per_cell):
 
 
 def test_plain_scene_engine_list(small_params):
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=4e-3"])
     sc = build_scene(build_specimen(p, 1), p)
     assert sc.engine_names() == PLAIN_ENGINES
@@ -71,7 +71,7 @@ def _drive(sc, velocity, max_steps=200000):
 
 @pytest.mark.parametrize("velocity,mode", [((1e-3, 0, 0), 1), ((0, 1e-3, 0), 2)])
 def test_broken_bond_switches_to_residual_friction(params, velocity, mode):
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     s = _two_cells(params)
     sc = build_scene(s, params)
     c = params.contact("quartz", "quartz")
@@ -86,7 +86,7 @@ def test_broken_bond_switches_to_residual_friction(params, velocity, mode):
 
 def test_bond_stress_does_not_depend_on_layer_thickness(params):
     """Same displacement, thickness 1 and 3 mm: force triples, stress F/A is the same."""
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     stresses = []
     for thickness in (1e-3, 3e-3):
         sc = build_scene(_two_cells(params, thickness), params)
@@ -103,7 +103,7 @@ def test_bond_stress_does_not_depend_on_layer_thickness(params):
 
 def test_tensile_break_at_the_tensile_strength(params):
     """Pulling the bond apart breaks it when sigma = F_n/A reaches J^T (Table 2)."""
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     sc = build_scene(_two_cells(params), params)
     O = sc.O
     for cell in (0, 1):
@@ -121,7 +121,7 @@ def test_tensile_break_at_the_tensile_strength(params):
 
 
 def test_3d_box_scene_builds_with_one_sphere_per_cell():
-    from grainfrac_yade.yade_adapter.scene import build_scene
+    from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=["specimen.dimension=3", "specimen.width=3e-3", "specimen.height=4e-3",
                                    "specimen.thickness=3e-3"])
     s = build_specimen(p, 1)

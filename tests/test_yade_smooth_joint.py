@@ -17,7 +17,7 @@ KN = 1e8             # N/m, the bond's normal stiffness (written per bond, as th
 
 def _normal_force_at(compressions):
     """The smooth joint's normal force [N] (compression positive) at each of ``compressions`` [m] of closing."""
-    from grainfrac_yade.yade_adapter import load_yade
+    from grainfrac_yade.engines.yade import load_yade
     load_yade()
     from yade import O, utils, Vector3
     from yade import wrapper as w

@@ -11,7 +11,7 @@ defaults form the setting ``default``, a point of every knob's series.
 
 Every row of a yade-batch table must give every column, so keys that some settings override get the
 shipped value in the rows of the others: the same run as leaving them out (a batch row counts as an
-override only what differs from the shipped files, :mod:`grainfrac_yade.yade_adapter.batch`).
+override only what differs from the shipped files, :mod:`grainfrac_yade.engines.yade.batch`).
 """
 from __future__ import annotations
 

@@ -11,7 +11,7 @@ Finite-element cells (``params/presets/fem.toml``), seed 1 (``--seed``), a creep
    event is formed within the run; the steps per event are DEM steps (YADE) and equilibria solved (static).
 2. **Static CPU per event against specimen size** (10 x 20, 20 x 40 and the paper's 31.7 x 63.4 mm; 63.4 x 126.8
    mm with ``--static-large``; ``--quick``: 3 x 6, 4 x 8 and 6 x 12 mm): the core's own creep hold
-   (:func:`grainfrac_yade.static.bench_timing.timed_creep_hold`, reached through the engine registry, as the study
+   (:func:`grainfrac_yade.engines.static.bench_timing.timed_creep_hold`, reached through the engine registry, as the study
    ``studies/static_engine_cost.py`` runs it), the same number of events from the start of each hold: dofs, the
    network's build, the ramp (CPU, equilibria, bonds broken), events, CPU, equilibria and active-set iterations per
    event, CPU per quiet event (one that breaks only what the creep law took to failure), the peak memory so far

@@ -168,7 +168,7 @@ def run_creep_in_yade(rows):
     ratio refers to (default: calibration.reference_ucs), ``seed``, ``study``, ``out``, and any
     parameter path.  A row whose folder already holds a summary.json is skipped (a study can be
     rerun to complete it) if its stored parameters, seed and load equal the row's, else the row
-    stops with one line (see :mod:`grainfrac_yade.yade_adapter.batch`, column ``on_change``); an
+    stops with one line (see :mod:`grainfrac_yade.engines.yade.batch`, column ``on_change``); an
     unfinished folder goes on from its checkpoint if that is of this row (same parameters, seed and
     load), else it is started again.
     """

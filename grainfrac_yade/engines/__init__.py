@@ -3,12 +3,12 @@
 Three engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep``, ``brazilian``; docs/engines.md):
 
 * ``"yade"`` (the default): YADE's explicit DEM with dynamic relaxation
-  (:mod:`grainfrac_yade.yade_adapter.engine`, which alone imports YADE);
+  (:mod:`grainfrac_yade.engines.yade.engine`, which alone imports YADE);
 * ``"static"``: static equilibrium between bond failures, bonds broken one at a time, relaxing where no static
-  equilibrium settles (:mod:`grainfrac_yade.static.engine`, pure numpy and scipy; UCS, confined, Brazilian and
+  equilibrium settles (:mod:`grainfrac_yade.engines.static.engine`, pure numpy and scipy; UCS, confined, Brazilian and
   creep tests);
 * ``"hybrid"``: the static engine with YADE's dynamic stints where the statics give out
-  (:mod:`grainfrac_yade.hybrid.engine`; UCS, confined and creep tests).
+  (:mod:`grainfrac_yade.engines.hybrid.engine`; UCS, confined and creep tests).
 
 Every engine module offers ``NAME``, ``build_scene(specimen, params, layout=None)`` and
 ``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements
@@ -17,11 +17,25 @@ and the commands call on it by name (``consolidate``, ``apply_levers``, ``stress
 series, the timings of ``bench``; listed in the interface's docstring).  :func:`.registry.engine_for` finds the engine of a run's
 parameters; a command never imports an engine's package itself.  Adding an engine: a module
 implementing the interface, its name in :data:`.registry.ENGINE_MODULES` and among the choices of
-``numerics.engine`` (docs/maintainers.md).  This ``__init__`` imports no engine (the registry does,
+``numerics.engine`` (docs/maintainers.md).  Each engine is a sub-package beside the interface and the registry
+(``yade/``, ``static/``, ``hybrid/``) and imports only the pure core and ``_interface`` (the hybrid also the
+static engine, whose scene it extends).  This ``__init__`` imports no engine (the registry does,
 by name), so that an engine may import the interface.
 """
 from __future__ import annotations
 
-from ._interface import PlatenDrive, Scene, SceneState
+from importlib import import_module
 
 __all__ = ["PlatenDrive", "Scene", "SceneState"]
+
+
+def __getattr__(name):
+    """The interface's names, loaded on first use: importing an engine's sub-package (``engines.yade``, whose
+    ``use_default_threads`` must run before numpy loads OpenBLAS) loads no numpy through this package."""
+    if name in __all__:
+        return getattr(import_module(f"{__name__}._interface"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + __all__)

@@ -4,7 +4,7 @@ An engine turns a specimen, its parameters and a grain layout (:mod:`grainfrac_y
 *scene*: bodies (the grain model's nodes) joined by breakable bonds (one per layout bond, Table 2),
 loaded by platens.  Two kinds are meant to implement it:
 
-* a dynamic engine (YADE, :mod:`grainfrac_yade.yade_adapter`): explicit integration of Newton's law
+* a dynamic engine (YADE, :mod:`grainfrac_yade.engines.yade`): explicit integration of Newton's law
   with Cundall's non-viscous damping; :meth:`Scene.run` advances DEM steps and
   :meth:`Scene.equilibrate` is dynamic relaxation until the project's equilibrium criterion (mean
   resultant force on the free bodies over the mean bond force, ``creep.equilibrium_tolerance``);

@@ -8,8 +8,8 @@ import importlib
 from ..errors import ParameterError
 
 #: Values of ``numerics.engine``, each with the module that implements it.
-ENGINE_MODULES = {"yade": "grainfrac_yade.yade_adapter.engine", "static": "grainfrac_yade.static.engine",
-                  "hybrid": "grainfrac_yade.hybrid.engine"}
+ENGINE_MODULES = {"yade": "grainfrac_yade.engines.yade.engine", "static": "grainfrac_yade.engines.static.engine",
+                  "hybrid": "grainfrac_yade.engines.hybrid.engine"}
 #: The names of :data:`ENGINE_MODULES` (the choices of ``numerics.engine``).
 ENGINE_NAMES = tuple(ENGINE_MODULES)
 

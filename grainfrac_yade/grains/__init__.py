@@ -10,7 +10,7 @@ One module per model, selected by ``resolution.grain_model``:
 Every model implements :class:`GrainModel` (``_interface.py``: layout, masses and critical step,
 kinematics) as the object ``MODEL`` of its module; :func:`grain_model` finds it by name and
 :func:`model_of` by the layout it built.  The YADE side of each model is the module of the same
-name in :mod:`grainfrac_yade.yade_adapter` (``rigid_cells``, ``fem_cells``).  Adding a model: a new
+name in :mod:`grainfrac_yade.engines.yade` (``rigid_cells``, ``fem_cells``).  Adding a model: a new
 module here with a ``MODEL``, its name in :data:`GRAIN_MODEL_NAMES` and among the choices of
 ``resolution.grain_model``, and its YADE module (docs/maintainers.md).
 """

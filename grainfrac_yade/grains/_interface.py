@@ -4,7 +4,7 @@ A grain model decides how a Voronoi cell becomes DEM bodies: its sphere layout (
 :class:`~grainfrac_yade.layout.ClumpLayout`, or a subclass of it that carries what the model adds),
 its bonds (:func:`~grainfrac_yade.layout.bond_properties` on that layout), its bodies' masses and
 its critical DEM step.  The YADE side of each model (bodies, elements, kinematics) is the module
-of the same name in :mod:`grainfrac_yade.yade_adapter` (``rigid_cells``, ``fem_cells``), which sets
+of the same name in :mod:`grainfrac_yade.engines.yade` (``rigid_cells``, ``fem_cells``), which sets
 the masses and the step that :meth:`GrainModel.masses_and_step` computes, so that
 :func:`grainfrac_yade.grains.critical_dem_step` (``specimen.json``) equals the scene's
 ``dt_critical`` by construction.

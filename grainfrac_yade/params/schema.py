@@ -118,16 +118,16 @@ class ResolutionParams:
 class NumericsParams:
     """DEM integration knobs, and the engine that computes the scene."""
     engine: str = _spec("", "choice", "mechanical engine of the scene (grainfrac_yade.engines): yade = YADE's "
-                        "explicit DEM with dynamic relaxation; static = static equilibrium between bond failures (grainfrac_yade.static: "
+                        "explicit DEM with dynamic relaxation; static = static equilibrium between bond failures (grainfrac_yade.engines.static: "
                         "no inertia, no loading rate); hybrid = static, with YADE's dynamics where the static "
-                        "equilibrium gives out or a cascade grows (grainfrac_yade.hybrid)", ("yade", "static", "hybrid"))
+                        "equilibrium gives out or a cascade grows (grainfrac_yade.engines.hybrid)", ("yade", "static", "hybrid"))
     static_relaxation: str = _spec("", "choice", "static engine: what a held-load regain or a displacement-"
                                    "controlled path does where no static status set settles: inertial (the default) = "
                                    "explicit dynamics of the same network (masses of the grain model with "
                                    "numerics.density_scale, numerics.damping, the creep protocol's servo, equilibrium "
-                                   "and collapse criteria and relaxation budget; grainfrac_yade.static.inertial); "
+                                   "and collapse criteria and relaxation budget; grainfrac_yade.engines.static.inertial); "
                                    "overdamped = implicit overdamped relaxation to rest or to the failure rule "
-                                   "(grainfrac_yade.static.damped), and only then the engine gives out; none = the "
+                                   "(grainfrac_yade.engines.static.damped), and only then the engine gives out; none = the "
                                    "engine gives out there (a numerical failure).  The hybrid engine does not read it "
                                    "(YADE's dynamic stints relax there)", ("none", "overdamped", "inertial"))
     static_relaxation_steps: int = _spec("1", "positive_int", "static_relaxation = overdamped: pseudo-time steps one "

@@ -5,7 +5,7 @@ until it splits; its tensile strength is sigma_t = 2 P / (pi D t) at the peak lo
 (:mod:`grainfrac_yade.analysis.brazilian_analysis`).
 
 The jaws are cells of the disc, as the UCS test's platens are (the scene's ``attach_jaws``; YADE's:
-:mod:`grainfrac_yade.yade_adapter.jaws`): the cells whose
+:mod:`grainfrac_yade.engines.yade.jaws`): the cells whose
 rim arc overlaps an arc of ``brazilian.loading_arc_deg`` about the top (bottom) end of the
 vertical diameter move together at a constant speed along it, their rotation blocked, and across
 it fixed (``platen_lateral = "fixed"``, the default: rough steel jaws, and no rigid rotation of

@@ -1,5 +1,5 @@
 """Confined tests, the engine-neutral part: whether a specimen survived the isotropic stage (sigma_1 = sigma_3)
-that an engine brings it to (YADE: :func:`grainfrac_yade.yade_adapter.confinement.consolidate`)."""
+that an engine brings it to (YADE: :func:`grainfrac_yade.engines.yade.confinement.consolidate`)."""
 from __future__ import annotations
 
 import numpy as np

@@ -6,8 +6,8 @@ numpy.  :class:`BondCorrosion` keeps them with each bond's intact values (area A
 friction) and the creep time, steps the law under frozen stresses and gives its state for checkpoints.
 The stresses it steps the law under are read off the scene's bond forces (:meth:`BondCorrosion.stresses`,
 through the scene interface); what the law says a bond can carry is written into an engine's bonds by that
-engine's subclass (YADE: :class:`grainfrac_yade.yade_adapter.corrosion_engine.StressCorrosion`; static:
-:class:`grainfrac_yade.static.engine.StaticCorrosion`).
+engine's subclass (YADE: :class:`grainfrac_yade.engines.yade.corrosion_engine.StressCorrosion`; static:
+:class:`grainfrac_yade.engines.static.engine.StaticCorrosion`).
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Levers of a grain-based model on its tensile strength: what they are and which breaks they leave out of
 a test's crack counts (engine-neutral; an engine applies them to its scene before the first step,
-:func:`grainfrac_yade.yade_adapter.levers.apply_levers` for YADE, whose docstring says what each does)."""
+:func:`grainfrac_yade.engines.yade.levers.apply_levers` for YADE, whose docstring says what each does)."""
 from __future__ import annotations
 
 import math

@@ -23,7 +23,7 @@ from ..params import nearest_key, renamed_key_fix
 #: (a fixed sleep made every call last a multiple of it: a 6.6 s batch took 10 s).
 POLL_S = 5.0
 #: Environment variable naming the folder where each row records its run folder as ``<line>.json``
-#: (``grainfrac_yade.yade_adapter.batch.ROW_FOLDERS_ENV``, the same name).
+#: (``grainfrac_yade.engines.yade.batch.ROW_FOLDERS_ENV``, the same name).
 ROW_FOLDERS_ENV = "GRAINFRAC_ROW_FOLDERS"
 #: Subfolder of a batch's log folder holding the rows' ``<line>.json`` records.
 ROW_RECORDS = "rows"

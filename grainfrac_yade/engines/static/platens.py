@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from ..errors import GrainfracError
+from ...errors import GrainfracError
 
 
 class StaticPlatens:

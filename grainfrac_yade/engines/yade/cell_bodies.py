@@ -5,7 +5,7 @@ Each grain model of :mod:`grainfrac_yade.grains` has its YADE side in a module o
 ``engines``, ``collider_mask_bit``, ``append_bodies`` (returning :class:`CellBodies`),
 ``bond_kinematics``, ``finish``, and the readers ``bodies_of``, ``cell_positions``, ``cell_motion``
 and ``bond_shift``, and the flag ``BONDS_ON_FACES`` (the bonds act on their face's plane, YADE's smooth
-joint, rather than along the line of the sphere centres).  :func:`grainfrac_yade.yade_adapter.scene.build_scene` calls them.
+joint, rather than along the line of the sphere centres).  :func:`grainfrac_yade.engines.yade.scene.build_scene` calls them.
 """
 from __future__ import annotations
 

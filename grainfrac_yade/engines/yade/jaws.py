@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from ..geometry.disc import DiscTessellation
-from ..errors import GrainfracError
+from ...geometry.disc import DiscTessellation
+from ...errors import GrainfracError
 
 #: DOFs blocked on jaw cells: y prescribed, z and all rotations blocked; x too when fixed.
 JAW_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}

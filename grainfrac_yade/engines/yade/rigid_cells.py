@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..grains.rigid import MODEL
+from ...grains.rigid import MODEL
 from .cell_bodies import CellBodies, cell_spheres, set_mass_inertia
 
 #: The bonds act along the line of the two sphere centres (YADE's default JCFpm kinematics), not on

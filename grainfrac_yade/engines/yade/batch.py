@@ -20,10 +20,10 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..runs.batchrun import ON_CHANGE, RUN_COLUMNS, check_columns, read_table_rows, run_folder_name  # noqa: F401
-from ..errors import GrainfracError
-from ..params import shipped_values
-from ..runs.runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
+from ...runs.batchrun import ON_CHANGE, RUN_COLUMNS, check_columns, read_table_rows, run_folder_name  # noqa: F401
+from ...errors import GrainfracError
+from ...params import shipped_values
+from ...runs.runio import SUMMARY, checkpoint_differences, run_digest, stored_run_differences
 from . import load_yade
 
 def read_table(extra_columns=None) -> tuple:
@@ -98,12 +98,12 @@ def record_row_folder(out: Path) -> Path:
     spec = os.environ.get("YADE_BATCH", "")
     folders = os.environ.get(ROW_FOLDERS_ENV)
     if folders and ":" in spec:
-        from ..runs.runio import write_json
+        from ...runs.runio import write_json
         Path(folders).mkdir(parents=True, exist_ok=True)
         write_json(Path(folders) / f"{spec.rsplit(':', 1)[1]}.json", {"folder": str(Path(out).resolve())})
     target = os.environ.get(ROW_FOLDER_ENV)
     if target:
-        from ..runs.runio import write_json
+        from ...runs.runio import write_json
         Path(target).parent.mkdir(parents=True, exist_ok=True)
         write_json(target, {"folder": str(Path(out).resolve())})
     return out

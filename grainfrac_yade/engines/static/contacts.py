@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..law import failed_now
+from ...law import failed_now
 from .ties import DECISION_REL_TOL
 
 #: Status of a contact: intact bond, broken and open, broken and sticking, broken and slipping.

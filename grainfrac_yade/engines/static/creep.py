@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..clocks import EventClock, PaperClock
-from ..errors import GrainfracError, NumericalFailure
-from ..law import Stresses, creep_step
+from ...clocks import EventClock, PaperClock
+from ...errors import GrainfracError, NumericalFailure
+from ...law import Stresses, creep_step
 from .cascade import Path
 from .failure import FailureRule
 from .solver import Equilibrium, State

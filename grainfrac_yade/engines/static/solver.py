@@ -30,7 +30,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import NumericalFailure
+from ...errors import NumericalFailure
 from . import contacts as cl
 from .network import StaticNetwork
 from .tangent import MAX_LOW_RANK_CONTACTS, LowRankSolver, TangentPattern

@@ -18,9 +18,9 @@ import sys
 
 import numpy as np
 
-from ..errors import GrainfracError
-from ..grains.fem import BLOCKED_DOFS, MODEL, element_apex
-from ..vtkio import cluster_rigid_motion
+from ...errors import GrainfracError
+from ...grains.fem import BLOCKED_DOFS, MODEL, element_apex
+from ...vtkio import cluster_rigid_motion
 from .cell_bodies import CellBodies, cell_spheres, set_mass_inertia, sphere_positions
 
 #: ``Ig2_Sphere_Sphere_ScGeom.avoidGranularRatcheting`` in fem scenes.  YADE's default (True)

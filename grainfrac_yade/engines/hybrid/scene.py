@@ -1,15 +1,15 @@
 """The hybrid engine's scene: the static scene, with YADE's dynamic relaxation where statics give out.
 
-:class:`HybridScene` is a :class:`grainfrac_yade.static.scene.StaticScene` (the protocols drive it the same way:
+:class:`HybridScene` is a :class:`grainfrac_yade.engines.static.scene.StaticScene` (the protocols drive it the same way:
 displacement control along the sequentially linear path, the held platen stress of a creep hold) that hands its
-state to the dynamic engine (YADE's engine module, :mod:`grainfrac_yade.yade_adapter.engine`, through the engine-neutral
+state to the dynamic engine (YADE's engine module, :mod:`grainfrac_yade.engines.yade.engine`, through the engine-neutral
 :class:`grainfrac_yade.engines.SceneState`) at two points:
 
 * **the static equilibrium gives out**: no set of frictional contact statuses settles (the core's
   :class:`~grainfrac_yade.errors.NumericalFailure`; frictional equilibria with non-associated slip need not be
   unique or exist), from the last converged state the path stood on;
 * **a cascade grows**: more than ``numerics.handover_cascade_bonds`` bonds broken at one closure (0: never), from
-  the state after the last of them (:class:`~grainfrac_yade.static.cascade.LargeCascade`): the released energy may
+  the state after the last of them (:class:`~grainfrac_yade.engines.static.cascade.LargeCascade`): the released energy may
   break more under inertia than the static cascade does.
 
 A **dynamic stint** then relaxes YADE's scene from that state under the control the protocol had set: the platens
@@ -48,15 +48,15 @@ import time
 
 import numpy as np
 
-from ..engines import SceneState
-from ..errors import NumericalFailure
-from ..protocols.creep_loops import CollapseWatch, collapsing
-from ..protocols.loading import held_at_equilibrium, relaxed
+from .._interface import SceneState
+from ...errors import NumericalFailure
+from ...protocols.creep_loops import CollapseWatch, collapsing
+from ...protocols.loading import held_at_equilibrium, relaxed
 from ..static.cascade import LargeCascade
 from ..static.scene import StaticScene
 from .settings import not_used_settings
-from ..wave import hold_budget, scene_density
-from ..yade_adapter import engine as dynamic_engine
+from ...wave import hold_budget, scene_density
+from ..yade import engine as dynamic_engine
 
 #: Dynamic stints one static solve may call before the run ends as a numerical failure [1]: each stint leaves a
 #: new broken set; where statics give out again at once, three stints in a row say that the hand-back does not
@@ -264,7 +264,7 @@ class HybridScene(StaticScene):
     def _take_state(self, state: SceneState) -> None:
         """YADE's relaxed ``state``: nodes, broken set and strengths as YADE left them, each broken contact's shear
         reference from YADE's shear force (s_p = du_s - F_s / k_s along the static tangent,
-        :mod:`grainfrac_yade.static.contacts`), the static equilibrium solved there and its cascade.  With fem cells
+        :mod:`grainfrac_yade.engines.static.contacts`), the static equilibrium solved there and its cascade.  With fem cells
         a relaxed YADE state is a static equilibrium of the same model (the hand-over check: 2e-10), so the solve
         starts settled; NumericalFailure where it does not settle (LargeCascade where its cascade grows)."""
         net = self.net

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..law import check_finite
-from ..protocols.loading import BOND_FORCE_SAMPLE, check_value, mean_bond_force  # noqa: F401
+from ...law import check_finite
+from ...protocols.loading import BOND_FORCE_SAMPLE, check_value, mean_bond_force  # noqa: F401
 
 
 def resultant_forces(scene, body_ids) -> tuple:

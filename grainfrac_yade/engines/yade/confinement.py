@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.tessellation import SIDES
-from ..wave import hold_budget, scene_density
-from ..protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
-from ..protocols.loading import held_at_equilibrium
+from ...geometry.tessellation import SIDES
+from ...wave import hold_budget, scene_density
+from ...protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
+from ...protocols.loading import held_at_equilibrium
 from .platens import StressServo
 
 

@@ -28,14 +28,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..engines import SceneState
-from ..errors import GrainfracError, NumericalFailure
-from ..grains import GrainModel, layout_for, model_of
-from ..law import MODE_NEVER, MODE_SHEAR, MODE_TENSION
-from ..layout import BondProperties, ClumpLayout, bond_properties
-from ..params import Parameters
-from ..protocols.cracks import bond_is_inter
-from ..geometry.specimen import Specimen
+from .._interface import SceneState
+from ...errors import GrainfracError, NumericalFailure
+from ...grains import GrainModel, layout_for, model_of
+from ...law import MODE_NEVER, MODE_SHEAR, MODE_TENSION
+from ...layout import BondProperties, ClumpLayout, bond_properties
+from ...params import Parameters
+from ...protocols.cracks import bond_is_inter
+from ...geometry.specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
 from .confinement import Confinement
 from .jaws import DiscJaws

@@ -11,7 +11,7 @@ import io
 import os
 import sys
 
-from ..errors import GrainfracError
+from ...errors import GrainfracError
 
 #: Where Debian's yade package installs its Python modules (double precision build).
 YADE_PY_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"

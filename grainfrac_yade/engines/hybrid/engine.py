@@ -1,6 +1,6 @@
 """The hybrid engine: what :func:`grainfrac_yade.engines.engine` returns for ``numerics.engine = "hybrid"``.
 
-The static engine's scene, tests and bond writer (:mod:`grainfrac_yade.static.engine`), with dynamic stints on
+The static engine's scene, tests and bond writer (:mod:`grainfrac_yade.engines.static.engine`), with dynamic stints on
 YADE where statics give out (:class:`.scene.HybridScene`).  Between stints nothing moves in time: the paper clock
 (Eq. 8 measures an unbalanced force at every creep step) is refused as on the static engine.  The dynamic settings
 (damping, mass scaling, the servo and the relaxation budgets) are used by the stints, so none is reported unused;

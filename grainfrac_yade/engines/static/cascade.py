@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NumericalFailure
+from ...errors import NumericalFailure
 from . import contacts as cl
 from .failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
 from .solver import Equilibrium, State

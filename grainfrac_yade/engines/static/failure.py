@@ -2,7 +2,7 @@
 
 A specimen under a held platen stress S fails when it cannot hold S: after an event (a bond broken by creep,
 and the cascade it sets off at the reached closure) the engine follows the loading path in the platen closure
-until the platen stress is S again (:func:`grainfrac_yade.static.cascade.Path.hold`).  It fails when
+until the platen stress is S again (:func:`grainfrac_yade.engines.static.cascade.Path.hold`).  It fails when
 
 1. **no equilibrium is ahead**: the path's tangent stiffness (dS/dd at the current contact statuses) is not
    positive and no intact bond can reach its strength along it, so the stress can never climb back to S; or

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..elastic import (ROLLING_REGULARISATION, Network, _dof_map, _spring_rows, _triangle_b, build_network,
+from ...elastic import (ROLLING_REGULARISATION, Network, _dof_map, _spring_rows, _triangle_b, build_network,
                        stiffness_matrix)
-from ..errors import GrainfracError
-from ..layout import bond_properties
+from ...errors import GrainfracError
+from ...layout import bond_properties
 from .ties import canonical_order
 
 

@@ -39,11 +39,11 @@ import time
 
 import numpy as np
 
-from ..errors import NumericalFailure
-from ..grains import model_of
-from ..layout import bond_properties
-from ..protocols.creep_loops import CollapseWatch, collapsing
-from ..wave import hold_budget, scene_density
+from ...errors import NumericalFailure
+from ...grains import model_of
+from ...layout import bond_properties
+from ...protocols.creep_loops import CollapseWatch, collapsing
+from ...wave import hold_budget, scene_density
 from . import contacts as cl
 from .cascade import Path, Record
 from .damped import Relaxation, RelaxingPath, relative_force

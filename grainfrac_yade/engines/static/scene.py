@@ -43,11 +43,11 @@ import math
 
 import numpy as np
 
-from ..engines import SceneState
-from ..errors import GrainfracError, NumericalFailure
-from ..grains import layout_for, model_of
-from ..layout import bond_properties
-from ..vtkio import cluster_rigid_motion
+from .._interface import SceneState
+from ...errors import GrainfracError, NumericalFailure
+from ...grains import layout_for, model_of
+from ...layout import bond_properties
+from ...vtkio import cluster_rigid_motion
 from . import contacts as cl
 from .inertial import dof_masses
 from .paths import path_for

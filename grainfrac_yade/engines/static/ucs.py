@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NumericalFailure
+from ...errors import NumericalFailure
 from .cascade import Path
 from .failure import FailureRule
 from .solver import Equilibrium

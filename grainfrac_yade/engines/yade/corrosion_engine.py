@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..law import MODE_CORRODED, MODE_TENSION, Stresses, check_finite
-from ..protocols.corrosion import STATE_KEYS, BondCorrosion  # noqa: F401
+from ...law import MODE_CORRODED, MODE_TENSION, Stresses, check_finite
+from ...protocols.corrosion import STATE_KEYS, BondCorrosion  # noqa: F401
 from .scene import SHEAR
 
 #: Relative margin below the current load given to a bond that has reached its strength,

@@ -1,7 +1,7 @@
 """The static engine: what :func:`grainfrac_yade.engines.engine` returns for ``numerics.engine = "static"``.
 
 Quasi-static: the same specimen, bonds and laws as the YADE scene, solved by static equilibrium between bond
-failures (:mod:`grainfrac_yade.static`: no inertia, no loading rate, deterministic).  A scene
+failures (:mod:`grainfrac_yade.engines.static`: no inertia, no loading rate, deterministic).  A scene
 (:class:`.scene.StaticScene`, which implements :class:`grainfrac_yade.engines.Scene`) advances load increments,
 each followed along the sequentially linear path with bonds broken one at a time.  Pure numpy and scipy: never
 imports YADE.
@@ -29,10 +29,10 @@ import importlib.metadata
 
 import numpy as np
 
-from ..errors import GrainfracError
-from ..law import MODE_CORRODED, Stresses, check_finite
-from ..protocols.corrosion import BondCorrosion
-from ..geometry.disc import DiscTessellation
+from ...errors import GrainfracError
+from ...law import MODE_CORRODED, Stresses, check_finite
+from ...protocols.corrosion import BondCorrosion
+from ...geometry.disc import DiscTessellation
 from .bench_timing import timed_creep_hold, timed_network  # noqa: F401
 from .jaws import DiscScene
 from .jaws import apply_levers as _apply_levers

@@ -17,9 +17,9 @@ import time
 
 import numpy as np
 
-from ..clocks import EventClock
-from ..grains import layout_for
-from ..law import build_law
+from ...clocks import EventClock
+from ...grains import layout_for
+from ...law import build_law
 from .cascade import Path
 from .creep import creep_hold
 from .failure import FailureRule

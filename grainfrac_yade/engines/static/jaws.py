@@ -1,7 +1,7 @@
 """The Brazilian disc's jaws on the static engine, and the levers of the Brazilian test (pure numpy/scipy).
 
 **The jaws are cells of the disc, as on YADE** (:mod:`grainfrac_yade.protocols.brazilian`; YADE's
-``yade_adapter/jaws.py``): the cells whose rim arc overlaps an arc of ``loading_arc`` about the top (bottom) end
+``engines/yade/jaws.py``): the cells whose rim arc overlaps an arc of ``loading_arc`` about the top (bottom) end
 of the vertical diameter move together along it, rotations blocked, and across it fixed (``lateral = "fixed"``,
 rough steel jaws) or free (``"free"``, smooth).  There is no jaw-cell contact law on either engine: the load goes
 into the disc through the same Table 2 bonds as everywhere else.  In the static core every node of a top (bottom)
@@ -37,9 +37,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import GrainfracError
-from ..geometry.disc import DiscTessellation
-from ..protocols.levers import PRE_EXISTING, Levers, lever_draws
+from ...errors import GrainfracError
+from ...geometry.disc import DiscTessellation
+from ...protocols.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
 from .platens import StaticPlatens

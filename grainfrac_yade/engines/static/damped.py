@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import NumericalFailure
+from ...errors import NumericalFailure
 from . import contacts as cl
 from .cascade import Path
 from .failure import COLLAPSE, FailureRule
