@@ -36,6 +36,33 @@ def test_engine_module_loads_without_yade():
     assert e.NAME == "yade" and callable(e.build_scene) and callable(e.scene_from_state)
 
 
+def test_the_dynamic_engines_are_the_registry_s_dynamic_ones():
+    """The table an engine looks a dynamic engine up in names the registry's modules, and exactly those that
+    integrate motion in time; a quasi-static name there is one line naming the choices."""
+    from grainfrac_yade.engines.dynamic import DYNAMIC_ENGINE_MODULES, dynamic_engine
+    from grainfrac_yade.engines.registry import ENGINE_MODULES
+    assert DYNAMIC_ENGINE_MODULES.items() <= ENGINE_MODULES.items()
+    assert {n for n in ENGINE_NAMES if getattr(engine(n), "DYNAMIC", False)} == set(DYNAMIC_ENGINE_MODULES)
+    assert dynamic_engine("yade") is engine("yade")
+    with pytest.raises(ParameterError) as err:
+        dynamic_engine("static")
+    assert "numerics.engine" in str(err.value) and "'yade'" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_the_engines_load_apart():
+    """The static and hybrid engines load without YADE's engine module (the hybrid fetches it by name at its
+    first dynamic stint); YADE's engine module loads without YADE itself."""
+    import subprocess
+    import sys
+    from pathlib import Path
+    code = ("import sys; import grainfrac_yade.engines.hybrid.engine, grainfrac_yade.engines.static.engine; "
+            "print('grainfrac_yade.engines.yade.engine' in sys.modules, 'yade' in sys.modules); "
+            "import grainfrac_yade.engines.yade.engine; print('yade' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=Path(__file__).resolve().parent.parent).stdout
+    assert out.split() == ["False", "False", "False"]
+
+
 @needs_yade
 @pytest.mark.yade
 @pytest.mark.parametrize("model", ["rigid", "fem"])

@@ -160,3 +160,41 @@ def test_the_cli_module_loads_no_numpy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=Path(__file__).resolve().parent.parent).stdout
     assert out.strip() == "[]"
+
+
+#: The engines' sub-packages under ``engines/`` (docs/maintainers.md, "The layers"), each with the other engines
+#: it may import: the hybrid extends the static engine's scene.
+ENGINE_PACKAGES = {"yade": (), "static": (), "hybrid": ("static",)}
+#: What an engine may import of ``engines/`` itself: the scene interface, and the dynamic engines by name.
+ENGINE_SHARED = ("engines", "engines._interface", "engines.dynamic")
+#: Imports of an engine's sub-package from outside ``engines/``, each with its reason.
+OUTSIDE_ENGINE_IMPORTS = {("cli", "engines.yade"): "the one-thread default, set before numpy loads (ALLOWED)"}
+
+
+def _engine_of(short):
+    return next((e for e in ENGINE_PACKAGES if short == f"engines.{e}" or short.startswith(f"engines.{e}.")), None)
+
+
+def test_the_engines_stand_side_by_side():
+    """The engines are one family: one sub-package each under ``engines/``, the registry naming a module of
+    each; an engine imports the pure core, the interface and the dynamic engines by name, never the registry,
+    the commands, the CLI or another engine (but the hybrid the static one); nothing outside ``engines/``
+    imports an engine's sub-package but :data:`OUTSIDE_ENGINE_IMPORTS` (the commands go through the registry)."""
+    from grainfrac_yade.engines.registry import ENGINE_MODULES
+    assert {name: module.split(".")[2] for name, module in ENGINE_MODULES.items()} == {e: e for e in ENGINE_PACKAGES}
+    g = graph()
+    assert {_short(m).split(".")[1] for m in g if _engine_of(_short(m))} == set(ENGINE_PACKAGES)
+    wrong = []
+    for module, targets in g.items():
+        mine = _engine_of(_short(module))
+        for target in map(_short, targets):
+            theirs = _engine_of(target)
+            if mine:
+                core = not (target.startswith("engines") or target.startswith("commands") or target == "cli")
+                ok = core or target in ENGINE_SHARED or theirs in (mine,) + ENGINE_PACKAGES[mine]
+            else:
+                ok = theirs is None or _short(module).startswith("engines.") or \
+                    (_short(module), target) in OUTSIDE_ENGINE_IMPORTS
+            if not ok:
+                wrong.append(f"{_short(module)} imports {target}")
+    assert not wrong, "\n".join(sorted(wrong))

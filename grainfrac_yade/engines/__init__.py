@@ -19,8 +19,9 @@ parameters; a command never imports an engine's package itself.  Adding an engin
 implementing the interface, its name in :data:`.registry.ENGINE_MODULES` and among the choices of
 ``numerics.engine`` (docs/maintainers.md).  Each engine is a sub-package beside the interface and the registry
 (``yade/``, ``static/``, ``hybrid/``) and imports only the pure core and ``_interface`` (the hybrid also the
-static engine, whose scene it extends).  This ``__init__`` imports no engine (the registry does,
-by name), so that an engine may import the interface.
+static engine, whose scene it extends, and YADE's by name through :mod:`.dynamic`, the registry's dynamic
+engines).  This ``__init__`` imports no engine (the registry does, by name), so that an engine may import the
+interface.
 """
 from __future__ import annotations
 

@@ -7,7 +7,9 @@ import importlib
 
 from ..errors import ParameterError
 
-#: Values of ``numerics.engine``, each with the module that implements it.
+#: Values of ``numerics.engine``, each with the module that implements it (the dynamic ones as in
+#: :data:`.dynamic.DYNAMIC_ENGINE_MODULES`, which an engine may look up itself; ``tests/test_engines.py`` holds
+#: the two alike).
 ENGINE_MODULES = {"yade": "grainfrac_yade.engines.yade.engine", "static": "grainfrac_yade.engines.static.engine",
                   "hybrid": "grainfrac_yade.engines.hybrid.engine"}
 #: The names of :data:`ENGINE_MODULES` (the choices of ``numerics.engine``).

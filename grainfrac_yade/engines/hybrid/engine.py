@@ -1,4 +1,4 @@
-"""The hybrid engine: what :func:`grainfrac_yade.engines.engine` returns for ``numerics.engine = "hybrid"``.
+"""The hybrid engine: what :func:`grainfrac_yade.engines.registry.engine` returns for ``numerics.engine = "hybrid"``.
 
 The static engine's scene, tests and bond writer (:mod:`grainfrac_yade.engines.static.engine`), with dynamic stints on
 YADE where statics give out (:class:`.scene.HybridScene`).  Between stints nothing moves in time: the paper clock

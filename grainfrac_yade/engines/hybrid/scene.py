@@ -2,7 +2,8 @@
 
 :class:`HybridScene` is a :class:`grainfrac_yade.engines.static.scene.StaticScene` (the protocols drive it the same way:
 displacement control along the sequentially linear path, the held platen stress of a creep hold) that hands its
-state to the dynamic engine (YADE's engine module, :mod:`grainfrac_yade.engines.yade.engine`, through the engine-neutral
+state to the dynamic engine (YADE's engine module, :mod:`grainfrac_yade.engines.yade.engine`, looked up by name at the
+first stint, :func:`grainfrac_yade.engines.dynamic.dynamic_engine`; through the engine-neutral
 :class:`grainfrac_yade.engines.SceneState`) at two points:
 
 * **the static equilibrium gives out**: no set of frictional contact statuses settles (the core's
@@ -56,7 +57,7 @@ from ..static.cascade import LargeCascade
 from ..static.scene import StaticScene
 from .settings import not_used_settings
 from ...wave import hold_budget, scene_density
-from ..yade import engine as dynamic_engine
+from ..dynamic import dynamic_engine
 
 #: Dynamic stints one static solve may call before the run ends as a numerical failure [1]: each stint leaves a
 #: new broken set; where statics give out again at once, three stints in a row say that the hand-back does not
@@ -70,6 +71,10 @@ RETRY_CROSSINGS = 1.0
 #: Smallest axial strain taken for the secant modulus that sets the servo's gain and the wave-crossing budget [1]
 #: (the creep protocol's floor, so that a hand-over at zero strain still has a finite modulus).
 SERVO_STRAIN_FLOOR = 1e-6
+
+#: The engine of the dynamic stints (a name of :data:`grainfrac_yade.engines.dynamic.DYNAMIC_ENGINE_MODULES`),
+#: imported at the first stint.
+DYNAMIC_ENGINE = "yade"
 
 
 class HybridScene(StaticScene):
@@ -153,8 +158,8 @@ class HybridScene(StaticScene):
         platens = self._platens()
         log = {"reason": str(exc).split(";")[0][:200], "held": held, "closure_m": float(start.closure),
                "stress_pa": float(start.stress), "broken_before": int(self.broken.sum()) + len(pending)}
-        dyn = dynamic_engine.scene_from_state(self.specimen, self.params, self.export_state(platens),
-                                                             self.layout)
+        dyn = dynamic_engine(DYNAMIC_ENGINE).scene_from_state(self.specimen, self.params,
+                                                              self.export_state(platens), self.layout)
         ypl = dyn.attach_platens("free")
         if len(pending):
             _, mode = self.path.ratios(start)

@@ -1,4 +1,4 @@
-"""The static engine: what :func:`grainfrac_yade.engines.engine` returns for ``numerics.engine = "static"``.
+"""The static engine: what :func:`grainfrac_yade.engines.registry.engine` returns for ``numerics.engine = "static"``.
 
 Quasi-static: the same specimen, bonds and laws as the YADE scene, solved by static equilibrium between bond
 failures (:mod:`grainfrac_yade.engines.static`: no inertia, no loading rate, deterministic).  A scene

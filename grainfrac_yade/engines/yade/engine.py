@@ -1,4 +1,4 @@
-"""The YADE engine: what :func:`grainfrac_yade.engines.engine` returns for ``numerics.engine = "yade"``.
+"""The YADE engine: what :func:`grainfrac_yade.engines.registry.engine` returns for ``numerics.engine = "yade"``.
 
 Explicit DEM (YADE's JCFpm bonds, Cundall's non-viscous damping) with dynamic relaxation: a scene
 (:class:`.scene.GrainScene`, which implements :class:`grainfrac_yade.engines.Scene`) advances DEM
