@@ -237,6 +237,7 @@ def test_creep_with_a_law_that_changes_stiffness_is_one_line():
     assert "\n" not in str(exc.value)
 
 
+@pytest.mark.slow        # the same path as tests/test_static_checkpoints.py's creep runs (killed at the fifth checkpoint)
 def test_creep_killed_and_resumed_gives_the_uninterrupted_run(tmp_path, monkeypatch):
     """Checkpoints at every safe point (ramp, events, relaxations), the run killed after the sixth and resumed from
     it: history (but for wall times), events, failure and break times as the uninterrupted run's."""
