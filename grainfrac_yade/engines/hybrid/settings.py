@@ -5,6 +5,8 @@ static engine's own relaxation settings mean nothing to it.  Every dynamic setti
 """
 from __future__ import annotations
 
+from ..static.settings import override_key
+
 #: Settings of the static engine's relaxation that the hybrid engine does not read.
 NOT_USED = ("numerics.static_relaxation", "numerics.static_relaxation_steps")
 
@@ -17,9 +19,5 @@ def not_used_settings(params) -> dict:
 def warn_not_used(overrides) -> list:
     """One warning line per setting among ``overrides`` (``(key, value)`` pairs or ``section.key=value`` strings)
     that the hybrid engine does not read."""
-    out = []
-    for item in overrides:
-        key = item.split("=", 1)[0].strip() if isinstance(item, str) else item[0]
-        if key in NOT_USED:
-            out.append(f"warning: --set {key}: the hybrid engine relaxes by YADE's dynamics and does not use it")
-    return out
+    return [f"warning: --set {key}: the hybrid engine relaxes by YADE's dynamics and does not use it"
+            for key in map(override_key, overrides) if key in NOT_USED]

@@ -48,12 +48,18 @@ def summary_keys(params) -> dict:
     return {"engine": NAME, "settings_not_used": {k: _value(params, k) for k in not_used(params)}}
 
 
+def override_key(item) -> str:
+    """The parameter key of an override: a ``(key, value)`` pair or a ``section.key=value`` string as ``--set`` gives
+    it."""
+    return item.split("=", 1)[0].strip() if isinstance(item, str) else item[0]
+
+
 def warn_dynamic_only(overrides, params) -> list:
     """One warning line per dynamic-only setting among ``overrides`` (``(key, value)`` pairs or
     ``section.key=value`` strings as ``--set`` gives them) that a run with ``params`` does not read."""
     out, unused = [], not_used(params)
     for item in overrides:
-        key = item.split("=", 1)[0].strip() if isinstance(item, str) else item[0]
+        key = override_key(item)
         if key in unused:
             out.append(f"warning: --set {key}: the static engine has no dynamics and does not use it")
     return out
