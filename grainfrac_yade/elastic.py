@@ -364,11 +364,11 @@ def _require_2d(t):
 
 
 def mesh_network(specimen: Specimen, params: Parameters, nodes_per_face: int = 2,
-                       contacts: str = "corners", rings: int = 1) -> Network:
+                       contacts: str = "corners", rings: int = 1, ring_growth: float = 1.0) -> Network:
     """The deformable-block reference: triangles with their mineral's Table 1 moduli (plane strain),
     cells joined at face nodes by Table 2 springs (k_n, k_s [Pa/m] x the node's share of the face)."""
     _require_2d(specimen.tessellation)
-    mesh = grain_mesh(specimen, nodes_per_face, contacts, rings)
+    mesh = grain_mesh(specimen, nodes_per_face, contacts, rings, ring_growth)
     names = specimen.mineral_names
     grains = [params.grains[m] for m in names]
     d_min = plane_strain_matrix([g.young for g in grains], [g.poisson for g in grains]) * specimen.thickness
@@ -403,7 +403,7 @@ def build_network(specimen: Specimen, params: Parameters, grains: str, layout: C
     """The network of one model (see module doc): the mesh reference, or the layout of a DEM grain model
     (``layout``, built by :mod:`grainfrac_yade.grains`; required for ``rigid`` and ``fem``)."""
     if grains == "mesh":
-        return mesh_network(specimen, params, nodes_per_face, contacts, rings)
+        return mesh_network(specimen, params, nodes_per_face, contacts, rings, params.resolution.cell_ring_growth)
     if grains not in LAYOUT_NETWORKS:
         raise GrainfracError(f"elastic: grains {grains!r} unknown; fix: use one of {list(GRAIN_MODELS)}")
     if layout is None or layout.model != grains:

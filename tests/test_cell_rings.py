@@ -7,6 +7,7 @@ import pytest
 
 from grainfrac_yade.elastic import cluster_network, plane_strain_matrix, stiffness_matrix
 from grainfrac_yade.errors import ParameterError
+from grainfrac_yade.geometry.grainmesh import ring_fractions
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.grains.fem import build_fem_layout
 from grainfrac_yade.params import load_parameters
@@ -24,13 +25,14 @@ def _grain_energy(net, displacement: np.ndarray) -> float:
     return 0.5 * u @ (k @ u)
 
 
-@pytest.mark.parametrize("rings", [1, 2, 4])
-def test_a_uniform_strain_stores_the_exact_plane_strain_energy_for_any_rings(rings):
+@pytest.mark.parametrize("rings,growth", [(1, 1.0), (2, 1.0), (4, 1.0), (3, 2.0)])
+def test_a_uniform_strain_stores_the_exact_plane_strain_energy_for_any_rings(rings, growth):
     """Constant-strain triangles reproduce a linear displacement field exactly, so the cells' triangles
     (however many rings) hold sum over cells of 0.5 t A' eps^T D eps, A' = (1 - inset)^2 A the shrunk
     cell's area and D its mineral's plane-strain matrix (Table 1): true only if the rings tile each cell
     without gap or overlap. Tolerance 1e-12 relative: a sum of a few thousand float64 terms."""
-    p = load_parameters(overrides=SMALL + [f"resolution.cell_rings={rings}"])
+    grading = [f"resolution.cell_ring_growth={growth}"] if growth != 1.0 else []
+    p = load_parameters(overrides=SMALL + [f"resolution.cell_rings={rings}"] + grading)
     s = build_specimen(p, 1)
     lay = build_fem_layout(s, p)
     net = cluster_network(s, p, lay)
@@ -54,6 +56,36 @@ def test_rings_refine_the_cells_interior_not_their_contacts():
     assert len(two.element_spheres) == 3 * len(fan.element_spheres)
     assert np.array_equal(two.sphere_center[two.bond_spheres], fan.sphere_center[fan.bond_spheres])
     assert np.array_equal(two.bond_area, fan.bond_area) and np.array_equal(two.bond_face, fan.bond_face)
+
+
+def test_graded_rings_thicken_inwards_in_the_given_ratio():
+    """ring_fractions: layer thicknesses t_i = q^(i-1) / sum_j q^(j-1) from the boundary inwards (closed form:
+    with 3 rings and q = 2 the layers are 1/7, 2/7 and 4/7 of the way, the rings at 6/7 and 4/7 from the
+    centroid); q = 1 gives k / rings exactly, as every mesh before the grading. Tolerance 1e-15: two roundings."""
+    assert ring_fractions(4) == [0.75, 0.5, 0.25] and ring_fractions(4, 1.0) == [3 / 4, 2 / 4, 1 / 4]
+    assert ring_fractions(3, 2.0) == pytest.approx([6 / 7, 4 / 7], abs=1e-15)
+    frac = [1.0] + ring_fractions(5, 1.5) + [0.0]
+    layers = -np.diff(frac)
+    assert layers[1:] / layers[:-1] == pytest.approx([1.5] * 4, rel=1e-12)
+    assert ring_fractions(1, 2.0) == []
+
+
+def test_graded_rings_move_only_the_inner_nodes():
+    """The grading moves the inner rings; the boundary nodes, bonds and element count stay those of uniform rings."""
+    uniform, graded = (build_fem_layout(build_specimen(q, 1), q) for q in
+                       (load_parameters(overrides=SMALL + ["resolution.cell_rings=3"]),
+                        load_parameters(overrides=SMALL + ["resolution.cell_rings=3", "resolution.cell_ring_growth=2"])))
+    assert np.array_equal(graded.sphere_center[graded.bond_spheres], uniform.sphere_center[uniform.bond_spheres])
+    assert np.array_equal(graded.element_spheres, uniform.element_spheres)
+    assert not np.array_equal(graded.sphere_center, uniform.sphere_center)
+
+
+def test_a_grading_without_rings_is_refused_in_one_line():
+    with pytest.raises(ParameterError, match=r"resolution.cell_ring_growth: 2 with resolution.cell_rings = 1.*"
+                                             r"; fix: set resolution.cell_rings >= 2"):
+        load_parameters(overrides=SMALL + ["resolution.cell_ring_growth=2"])
+    with pytest.raises(ParameterError, match=r"resolution.cell_ring_growth"):
+        load_parameters(overrides=SMALL + ["resolution.cell_rings=2", "resolution.cell_ring_growth=0"])
 
 
 def test_rigid_cells_refuse_rings_in_one_line():

@@ -16,7 +16,7 @@ from ..runs.slurm import FAILED, rows_without_runs
 #: Parameter paths copied from each run's params.json into the table (older params.json are read through
 #: :func:`~grainfrac_yade.params.migrate_tree`: ``stress_corrosion.mode`` becomes ``stress_corrosion.law``).
 PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resolution.nodes_per_face",
-                 "resolution.cell_rings",
+                 "resolution.cell_rings", "resolution.cell_ring_growth",
                  "specimen.grain_size", "specimen.width", "specimen.height",
                  "calibration.strength_scale", "calibration.stiffness_scale", "calibration.shear_stiffness_ratio_scale",
                  "calibration.tensile_cohesion_ratio_scale", "calibration.inter_mineral_strength_ratio",

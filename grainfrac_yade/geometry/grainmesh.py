@@ -82,16 +82,35 @@ def _edge_faces(t):
     return out, scale
 
 
+def ring_fractions(rings: int, growth: float = 1.0) -> list:
+    """Where the inner rings sit, outermost first, as fractions of the way from the centroid to the boundary.
+
+    The ``rings`` layers between the boundary and the centroid's fan have thicknesses in the geometric
+    ratio ``growth`` from the boundary inwards, t_i = q^(i-1) / sum_j q^(j-1), i = 1..rings: layer k ends
+    at 1 - sum_{i<=k} t_i. ``growth`` = 1 gives the uniform rings k / rings exactly; ``growth`` > 1 puts
+    thin layers at the boundary, where the bonds read the stress, and thick ones inside.
+    """
+    if growth == 1.0:
+        return [k / rings for k in range(rings - 1, 0, -1)]
+    weights = growth ** np.arange(rings)
+    depth = np.cumsum(weights)[:-1] / weights.sum()
+    return [float(1.0 - d) for d in depth]
+
+
 def grain_mesh(specimen: Specimen, nodes_per_face: int = 2, contacts: str = "corners",
-               rings: int = 1) -> GrainMesh:
+               rings: int = 1, ring_growth: float = 1.0) -> GrainMesh:
     """Mesh every cell of a 2D specimen (see module doc).
 
     ``rings`` > 1 refines each cell radially: the boundary ring is repeated at
-    fractions k/rings of the way to the centroid and neighbouring rings are
-    joined by triangles (the angular resolution is set by ``nodes_per_face``).
+    the fractions :func:`ring_fractions` (``ring_growth`` = 1: k/rings) of the
+    way to the centroid and neighbouring rings are joined by triangles (the
+    angular resolution is set by ``nodes_per_face``).
     """
     if rings < 1:
         raise GrainfracError("grain mesh: rings must be >= 1; fix: give a whole number >= 1")
+    if not ring_growth > 0:
+        raise GrainfracError(f"grain mesh: ring growth {ring_growth} must be > 0; fix: give 1 for uniform rings")
+    fractions = ring_fractions(rings, ring_growth)
     t = specimen.tessellation
     if t.dim != 2:
         raise GrainfracError("grain mesh: built for 2D specimens only; fix: use specimen.dimension = 2")
@@ -142,14 +161,14 @@ def grain_mesh(specimen: Specimen, nodes_per_face: int = 2, contacts: str = "cor
         centre = len(pos)
         pos.append(t.cell_centroid[c])
         cell_of.append(c)
-        # inner rings at fractions k/rings of the way from the centroid to the boundary ring
+        # inner rings at the fractions of the way from the centroid to the boundary ring
         outer = ring
         levels = [outer]
-        for k in range(rings - 1, 0, -1):
+        for fraction in fractions:
             level = []
             for n in outer:
                 level.append(len(pos))
-                pos.append(t.cell_centroid[c] + k / rings * (pos[n] - t.cell_centroid[c]))
+                pos.append(t.cell_centroid[c] + fraction * (pos[n] - t.cell_centroid[c]))
                 cell_of.append(c)
             levels.append(level)
         inner = levels[-1]

@@ -94,7 +94,8 @@ def _shrunk_mesh(specimen: Specimen, params: Parameters, inset: float):
     """The reference's mesh (contacts at the face corners, ``resolution.cell_rings`` radial rings) and its
     node positions shrunk by 1 - inset about each cell's centroid [m]."""
     t = specimen.tessellation
-    mesh = grain_mesh(specimen, params.resolution.nodes_per_face, "corners", params.resolution.cell_rings)
+    mesh = grain_mesh(specimen, params.resolution.nodes_per_face, "corners", params.resolution.cell_rings,
+                      params.resolution.cell_ring_growth)
     centroid = t.cell_centroid[mesh.node_cell]
     return mesh, centroid + (1.0 - inset) * (mesh.node_pos - centroid)
 

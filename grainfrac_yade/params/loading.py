@@ -49,7 +49,7 @@ ADDED_KEYS = {"numerics.engine": "yade", "specimen.min_edge_fraction": 0.0, "num
               "creep.servo_response_crossings": 0.0, "creep.max_relaxation_crossings": 0.0,
               "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
               "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0,
-              "resolution.cell_rings": 1}
+              "resolution.cell_rings": 1, "resolution.cell_ring_growth": 1.0}
 
 
 def migrate_tree(tree: dict) -> list:
@@ -414,6 +414,11 @@ def _check_cell_rings(res, origins: Mapping):
                              "triangle mesh of fem cells, a rigid cell has none",
                              "set resolution.cell_rings = 1, or resolution.grain_model = \"fem\" "
                              "(params/presets/fem.toml)")
+    if res.cell_ring_growth != 1.0 and res.cell_rings == 1:
+        raise ParameterError(origins.get("resolution.cell_ring_growth", "parameters"), "resolution.cell_ring_growth",
+                             f"{res.cell_ring_growth:g} with resolution.cell_rings = 1: the grading spaces the rings "
+                             "of a cell, one ring (the fan of triangles) has none to space",
+                             "set resolution.cell_rings >= 2, or resolution.cell_ring_growth = 1")
 
 
 def require_plane(params: Parameters, command: str):

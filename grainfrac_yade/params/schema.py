@@ -109,6 +109,9 @@ class ResolutionParams:
                             "boundary ring of nodes repeated at fractions k / cell_rings of the way to the centroid "
                             "(grainfrac_yade.geometry.grainmesh); 1 = one fan of triangles about the centroid; "
                             "rigid cells take only 1")
+    cell_ring_growth: float = _spec("1", "positive", "fem cells with cell_rings > 1: thickness ratio of successive "
+                                    "rings from the boundary inwards (geometric grading; "
+                                    "grainfrac_yade.geometry.grainmesh.ring_fractions); 1 = uniform rings")
     contact_inset: float = _spec("1", "unit_interval_open", "fem cells: fraction of the way from a "
                                  "face node to its cell's centroid at which the node's sphere sits (the two "
                                  "spheres of a bond are distinct bodies a short gap apart)")
