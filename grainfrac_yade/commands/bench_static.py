@@ -214,7 +214,7 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
         "event_cpu_s": cpu_ev.tolist(), "event_equilibria": eqs.astype(int).tolist(),
         "event_iterations": its.astype(int).tolist(), "event_broken": broken.astype(int).tolist(),
         "counters": c, "sequence_hash": path["sequence_hash"],
-        "times": [float(r["creep_time_s"]) for r in run.rows[1:]],
+        "times": [float(r["creep_time_s"]) for r in run.rows[2:]],   # the events' (rows 0, 1: the ramp's end, the hold)
     }
 
 

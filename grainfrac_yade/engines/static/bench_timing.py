@@ -50,12 +50,15 @@ def solver_counters(scene) -> dict:
 
 def path_summary(scene) -> dict:
     """What a static ``scene``'s path recorded (and its network's dofs): its breaks (records: a crossing and its cascade), the bonds broken
-    along them, the break sequence's hash, the largest cascade and every cascade of :data:`LARGE_CASCADE` bonds or
+    along them, the break sequence's hash, the largest platen stress at which a bond reached its strength (with
+    its axial strain), the largest cascade and every cascade of :data:`LARGE_CASCADE` bonds or
     more as (axial strain, bonds, platen stress before and after [Pa])."""
     recs, height = scene.path.records, scene.net.height
     h, n = sequence_hash(recs)
     sizes = [len(r.bonds) for r in recs]
+    top = max(recs, key=lambda r: r.stress_before, default=None)
     return {"dofs": scene.net.ndof, "records": len(recs), "bonds": n, "sequence_hash": h, "largest_cascade": max(sizes, default=0),
+            "largest_stress_before_break": (top.stress_before, top.closure / height) if top else (None, None),
             "large_cascades": [(r.closure / height, len(r.bonds), r.stress_before, r.stress_after)
                                for r in recs if len(r.bonds) >= LARGE_CASCADE]}
 
