@@ -168,7 +168,8 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
     the ramp's cost (CPU from the built scene to the end of the event loop's first relaxation, equilibria, active-set
     iterations, bonds broken, strain), the end, per-event lists (``event_cpu_s``, ``event_equilibria``,
     ``event_iterations``, ``event_broken``), their means, the CPU per quiet event (one that breaks only the bonds the
-    law took to failure; None without one), the solver's counters and the path's break sequence hash.  ``progress``:
+    law took to failure; None without one), the solver's counters, the path's break sequence hash, what the scene
+    adds to a run's summary (``engine_keys``: e.g. its relaxations) and the events' creep times (``times``).  ``progress``:
     called with a dict after the ramp (event 0) and after each event."""
     static = engine_for(params)
     c0 = time.process_time()
@@ -213,7 +214,7 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
         "bonds_per_event": mean(broken), "quiet_events": int(quiet.sum()), "cpu_per_quiet_event_s": mean(cpu_ev[quiet]),
         "event_cpu_s": cpu_ev.tolist(), "event_equilibria": eqs.astype(int).tolist(),
         "event_iterations": its.astype(int).tolist(), "event_broken": broken.astype(int).tolist(),
-        "counters": c, "sequence_hash": path["sequence_hash"],
+        "counters": c, "sequence_hash": path["sequence_hash"], "engine_keys": run.scene.summary_keys(),
         "times": [float(r["creep_time_s"]) for r in run.rows[2:]],   # the events' (rows 0, 1: the ramp's end, the hold)
     }
 
