@@ -172,6 +172,9 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
     adds to a run's summary (``engine_keys``: e.g. its relaxations) and the events' creep times (``times``).  ``progress``:
     called with a dict after the ramp (event 0) and after each event."""
     static = engine_for(params)
+    if not hasattr(static, "solver_counters"):
+        raise GrainfracError(f"a timed static hold: numerics.engine = {params.numerics.engine!r} has no static solver "
+                             "to count; fix: numerics.engine=static")
     c0 = time.process_time()
     specimen = build_specimen(params, seed)
     t0 = time.process_time()
