@@ -9,13 +9,9 @@ import sys
 from pathlib import Path
 
 
-from grainfrac_yade.commands.brazilian import tensile_scale_overrides
-from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
-from grainfrac_yade.params import load_parameters
-from grainfrac_yade.runs.runio import prepare_run_dir, summary_header, write_json
-from grainfrac_yade.geometry.specimen import build_specimen
-from grainfrac_yade.analysis.ucs_analysis import ucs_summary
-from grainfrac_yade.engines.yade.levers import Levers, apply_levers
+from grainfrac_yade.api import (Levers, build_specimen, engine_for, load_parameters, prepare_run_dir,
+                                run_brazilian_to_folder, run_ucs, summary_header, tensile_scale_overrides, ucs_summary,
+                                write_json)
 
 SEEDS = (1, 2, 3)
 DISC = [("brazilian.diameter", 15e-3)]
@@ -24,12 +20,11 @@ BLOCK = [("specimen.width", 10e-3), ("specimen.height", 20e-3)]
 
 def ucs_with_levers(params, seed, out, levers):
     """A UCS test whose scene gets ``levers`` before loading (as the brazilian command does)."""
-    from grainfrac_yade.engines.yade.scene import build_scene
-    from grainfrac_yade.protocols.ucs import run_ucs
     out = prepare_run_dir(out, "ucs", params, seed, overwrite=True)
     specimen = build_specimen(params, seed)
-    scene = build_scene(specimen, params)
-    applied = apply_levers(scene, levers, seed)
+    mechanics = engine_for(params)
+    scene = mechanics.build_scene(specimen, params)
+    applied = mechanics.apply_levers(scene, levers, seed)
     hist, result, _, _ = run_ucs(specimen, params, scene=scene)
     summary = ucs_summary(hist)
     summary.update(result, **applied)

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from grainfrac_yade.analysis.brazilian_analysis import split_peak_index
+from grainfrac_yade.api import split_peak_index
 
 LAB_TENSILE, LAB_UCS = 9.0e6, 200e6   # shared/reference/ldb_lab_properties.csv
 

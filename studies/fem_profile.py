@@ -19,7 +19,7 @@ from pathlib import Path
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 ROOT = Path(__file__).resolve().parents[1]
 
-from grainfrac_yade.params import load_parameters
+from grainfrac_yade.api import load_parameters
 
 SIZES = {"small": (10e-3, 20e-3), "mid": (20e-3, 40e-3), "paper": (31.7e-3, 63.4e-3)}
 FEM_PRESET = ROOT / "params" / "presets" / "fem.toml"
@@ -37,9 +37,8 @@ def main(argv=None):
     w, h = SIZES[a.size]
     p = load_parameters(extra_files=[FEM_PRESET, *a.params],
                         overrides=[("specimen.width", w), ("specimen.height", h), *a.overrides])
-    from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.engines.yade.bench_timing import loading_step_cost
-    cost = loading_step_cost(build_specimen(p, a.seed), p, a.warmup, a.steps, engine_timing=True)
+    from grainfrac_yade.api import build_specimen, engine
+    cost = engine("yade").loading_step_cost(build_specimen(p, a.seed), p, a.warmup, a.steps, engine_timing=True)
     print(json.dumps({"size": a.size, "seed": a.seed, "overrides": a.overrides, **cost}))
 
 

@@ -14,7 +14,7 @@ import json
 import sys
 from pathlib import Path
 
-from grainfrac_yade.params.loading import flatten
+from grainfrac_yade.api import flatten
 
 #: Parameter columns copied from each UCS run into its creep rows (the specimen, the mesh, the numerics).
 COPIED = ("resolution.grain_model", "resolution.nodes_per_face", "resolution.contact_inset",

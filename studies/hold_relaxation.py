@@ -26,7 +26,7 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from grainfrac_yade.params import load_parameters
+from grainfrac_yade.api import load_parameters
 
 FIELDS = ("hold_steps", "crossings", "axial_strain", "axial_stress_pa", "broken_total", "unbalanced_ratio",
           "at_equilibrium", "servo_clipped", "cpu_s")
@@ -48,20 +48,16 @@ def main(argv=None) -> int:
         print(f"{out}: exists; fix: another --out (earlier results are never replaced)", file=sys.stderr)
         return 1
     params = load_parameters(extra_files=a.params, overrides=[*a.overrides, "stress_corrosion.enabled=false"])
-    from grainfrac_yade.runs.runio import code_version
-    from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.protocols.creep import CreepRun
-    from grainfrac_yade.wave import scene_density
-    from grainfrac_yade.protocols.loading import mean_bond_force
+    from grainfrac_yade.api import CreepRun, build_specimen, code_version, mean_bond_force, scene_density
     import numpy as np
     out.mkdir(parents=True)
     c0 = time.process_time()
     run = CreepRun(build_specimen(params, a.seed), params, a.stress * 1e6)
     run.ramp()
     summary = {"seed": a.seed, "stress_pa": a.stress * 1e6, "params_files": a.params, "overrides": a.overrides,
-               "code_version": code_version(), "ramp_steps": int(run.scene.O.iter),
+               "code_version": code_version(), "ramp_steps": int(run.scene.steps),
                "ramp_failed": bool(run.failed), "ramp_broken": run.ramp_broken,
-               "strain_after_ramp": run.platens.axial_strain(), "dem_step_s": run.scene.O.dt}
+               "strain_after_ramp": run.platens.axial_strain(), "dem_step_s": run.scene.dt}
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     if run.failed:
         print(f"ramp failed: {run.failure_reason}")
@@ -69,7 +65,7 @@ def main(argv=None) -> int:
     run.hold_servo()
     crossing_steps = run.hold_budget.crossing_steps   # the servo's: its modulus estimate, the scene's density
     summary.update(servo_young_pa=run.servo.platens.height / (run.servo.gain * run.hold_budget.servo_response_steps),
-                   density_kg_m3=scene_density(params), crossing_time_s=crossing_steps * run.scene.O.dt,
+                   density_kg_m3=scene_density(params), crossing_time_s=crossing_steps * run.scene.dt,
                    crossing_steps=crossing_steps, **run.hold_budget.as_dict())
     done, equilibrium_at = 0, None
     with open(out / "relaxation.csv", "w", newline="") as f:

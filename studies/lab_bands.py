@@ -26,8 +26,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 
-from grainfrac_yade.params import load_parameters
-from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.api import build_specimen, load_parameters
 
 GRAIN_SIZE_CSV = ROOT / "docs" / "studies" / "lab_bands_grain_size.csv"
 LEVERS_CSV = ROOT / "docs" / "studies" / "lab_bands_levers.csv"
@@ -91,7 +90,7 @@ def run_setting(name, extra_files, out: Path, seed: int = SEED) -> list:
 def volumetric_crack_initiation(folder: Path, summary: dict) -> float:
     """Crack initiation read from the crack volumetric strain of the UCS run in ``folder`` (as the lab
     reads it: grainfrac_yade.analysis.ucs_analysis.crack_initiation_volumetric_stress) [Pa]."""
-    from grainfrac_yade.analysis.ucs_analysis import crack_initiation_volumetric_stress
+    from grainfrac_yade.api import crack_initiation_volumetric_stress
     rows = list(csv.DictReader((Path(folder) / "history.csv").open()))
     col = {k: np.array([float(r[k]) for r in rows]) for k in ("axial_stress_pa", "axial_strain", "lateral_strain")}
     return crack_initiation_volumetric_stress(col["axial_stress_pa"], col["axial_strain"], col["lateral_strain"],
@@ -103,8 +102,7 @@ def measure(extra_files, overrides, seed: int, prefix: Path, ucs_size=UCS_SIZE, 
     (``disc_diameter`` [m]) into ``prefix``_brazilian with ``overrides``: their two rows of
     :data:`LEVER_FIELDS` (without the setting's name; the UCS row also has ``crack_initiation_volumetric_pa``, the Brazilian
     row ``broken_total``)."""
-    from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
-    from grainfrac_yade.protocols.ucs_output import run_ucs_to_folder
+    from grainfrac_yade.api import run_brazilian_to_folder, run_ucs_to_folder
     rows, prefix = [], Path(prefix)
     w, h = ucs_size
     p = load_parameters(extra_files=extra_files, overrides=[f"specimen.width={w}", f"specimen.height={h}", *overrides])

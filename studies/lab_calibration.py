@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from grainfrac_yade.analysis import lab_fit
+from grainfrac_yade.api import lab_fit
 from studies.lab_bands import LEVER_FIELDS, measure
 
 ROOT = Path(__file__).resolve().parents[1]

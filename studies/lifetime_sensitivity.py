@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from grainfrac_yade.law.hillig_charles import time_to_failure
+from grainfrac_yade.api import time_to_failure
 
 #: The k of the tail's k-th shortest contact time to failure [1].
 TAIL_RANK = 10

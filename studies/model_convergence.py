@@ -12,7 +12,7 @@ import json
 import sys
 from pathlib import Path
 
-from grainfrac_yade.params.loading import ADDED_KEYS
+from grainfrac_yade.api import ADDED_KEYS
 
 #: (column, summary key, factor) of every row: the units are those of the column name.
 COLUMNS = (("ucs_mpa", "ucs_pa", 1e-6), ("peak_axial_strain_percent", "peak_axial_strain", 100.0),

@@ -17,9 +17,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 
-from grainfrac_yade.grains import critical_dem_step, layout_for
-from grainfrac_yade.params import PARAMS_DIR, load_parameters
-from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.api import PARAMS_DIR, build_specimen, critical_dem_step, layout_for, load_parameters
 
 CSV = ROOT / "docs" / "regularisation_steps.csv"
 FRACTIONS = (0.0, 0.01, 0.02, 0.05, 0.10)

@@ -18,10 +18,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-from grainfrac_yade.elastic import elastic_summary
-from grainfrac_yade.grains import grain_model
-from grainfrac_yade.params import PARAMS_DIR, load_parameters
-from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.api import PARAMS_DIR, build_specimen, elastic_summary, grain_model, load_parameters
 
 CSV = ROOT / "docs" / "regularisation_tails.csv"
 FEM_PRESET = PARAMS_DIR / "presets" / "fem.toml"

@@ -19,8 +19,7 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from grainfrac_yade.params import load_parameters
-from grainfrac_yade.geometry.specimen import build_specimen
+from grainfrac_yade.api import build_specimen, load_parameters
 
 #: (model label, parameter files) of the scenes measured.
 MODELS = (("rigid, 1 sphere per cell (default)", []),
@@ -31,19 +30,17 @@ QUANTILES = (0.0, 0.05, 0.5)
 
 
 def measure(files, width, height, seed, quantile, steps):
-    from grainfrac_yade.engines.yade.platens import Platens
-    from grainfrac_yade.engines.yade.scene import build_scene
+    from grainfrac_yade.api import engine
     p = load_parameters(extra_files=files, overrides=[f"specimen.width={width!r}", f"specimen.height={height!r}",
                                                       f"numerics.step_floor_quantile={quantile!r}"])
-    scene = build_scene(build_specimen(p, seed), p)
-    platens = Platens(scene)
-    scene.extras.append(platens)
-    platens.set_axial_velocity(1e-4 * platens.height / (steps * scene.O.dt))
+    scene = engine("yade").build_scene(build_specimen(p, seed), p)
+    platens = scene.attach_platens()
+    platens.set_axial_velocity(1e-4 * platens.height / (steps * scene.dt))
     scene.run(10)   # first steps: collider set-up
     start = time.process_time()
     scene.run(steps)
     cpu = time.process_time() - start
-    return {"dt_critical_s": scene.dt_critical, "dem_step_s": scene.O.dt, "steps_per_cpu_s": steps / cpu}
+    return {"dt_critical_s": scene.dt_critical, "dem_step_s": scene.dt, "steps_per_cpu_s": steps / cpu}
 
 
 def summary_markdown(rows) -> str:

@@ -122,3 +122,50 @@ def run_killed_and_resumed(tmp_path, monkeypatch, params, seed, stress, killed_w
                   run_values={"seed": seed})
     monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
     return whole, resume_creep(build_specimen(params, seed), params, stress, tmp_path / "cut")
+
+
+class HeldEvents:
+    """Creep events on a hand-made static network held at a platen stress (a test's helper: such a network is no
+    specimen, so the creep protocol cannot run it): the path to ``stress`` [Pa] (failing only by "no equilibrium
+    ahead"), then per event the law's interval to the next failure under frozen stresses (paper Eq. 7 for the
+    Hillig-Charles law, :func:`grainfrac_yade.law.creep_step`), its strengths written to the path, the cascade and
+    the regain of ``stress`` under ``rule``; what the static scene does under the creep protocol, without it.
+    After :meth:`run`: ``times``, ``strains`` (axial, after each event), ``events``, ``failed``, ``reason``,
+    ``state``."""
+
+    def __init__(self, eq, law, clock, stress, rule, path=None):
+        from grainfrac_yade.engines.static.cascade import Path
+        self.eq, self.law, self.clock, self.stress, self.rule = eq, law, clock, stress, rule
+        self.path = path or Path(eq)
+        self.times, self.strains, self.events, self.failed, self.reason, self.state = [], [], 0, False, "", None
+
+    def run(self, max_events=10**6):
+        from grainfrac_yade.engines.static.failure import FailureRule
+        from grainfrac_yade.law import Stresses, creep_step
+        net, path = self.eq.net, self.path
+        state, reason = path.hold(self.eq.initial(0.0), self.stress, FailureRule(0.0))
+        self.state = state
+        if reason:
+            self.failed, self.reason = True, "at load: " + reason
+            return self
+        bonds = self.law.initial_state(net.tensile_strength, net.cohesion, net.tan_friction)
+        while self.events < max_events:
+            intact = np.flatnonzero(~state.broken)
+            stresses = Stresses.of(intact, state.fn[intact] / net.area[intact],
+                                   np.abs(state.fs[intact]) / net.area[intact])
+            step = creep_step(self.law, self.clock, bonds, stresses)
+            if step.stalled or not len(step.failing):
+                self.reason = "nothing fails"
+                break
+            self.clock.advance(step.dt, step.failing)
+            bonds = step.state
+            jt, jc, _ = self.law.strengths(bonds)
+            path.jt, path.jc = np.asarray(jt, float).copy(), np.asarray(jc, float).copy()
+            state, reason = path.hold(path.cascade(state), self.stress, self.rule)
+            self.events, self.state = self.events + 1, state
+            self.times.append(self.clock.creep_time)
+            self.strains.append(state.closure / net.height)
+            if reason:
+                self.failed, self.reason = True, reason
+                break
+        return self

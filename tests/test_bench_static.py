@@ -1,5 +1,5 @@
 """``bench --static``: the quick static bench on tiny specimens writes every key, every ratio finite and positive; the
-size series alone without YADE; the timed hold is the core's hold; bad flags are one line.
+size series alone without YADE; the timed hold is the protocol's hold; bad flags are one line.
 
 No timing thresholds: the machine is shared, and the bench's ratios are only meaningful within a run.
 """
@@ -50,7 +50,7 @@ def _check_sizes(result, settings):
 
 
 def test_size_series_without_yade(tmp_path):
-    """The static core's holds on two tiny sizes: every key, per-event lists as long as the events, positive costs,
+    """The creep test on the static engine's plain path on two tiny sizes: every key, per-event lists as long as the events, positive costs,
     a finite exponent; the JSON is rewritten after each size and at the end holds what the function returns."""
     from grainfrac_yade.commands.bench import peak_rss_mb
     out = tmp_path / "static.json"
@@ -68,26 +68,18 @@ def test_size_series_without_yade(tmp_path):
     assert "| 3x6 | 286 |" in text and "CPU per event ~ dofs^b" in text
 
 
-def test_timed_hold_is_the_cores_hold():
+def test_timed_hold_is_the_protocols_hold():
     """Timing a hold changes nothing it computes: the same events at the same creep times and the same bonds as the
-    core's own creep_hold."""
-    from grainfrac_yade.clocks import EventClock
+    creep protocol's run stopped after as many events, untimed."""
+    from grainfrac_yade.commands.bench_static import SIZE_SERIES_OVERRIDES, size_params, static_hold
     from grainfrac_yade.geometry.specimen import build_specimen
-    from grainfrac_yade.law import build_law
-    from grainfrac_yade.params import load_parameters
-    from grainfrac_yade.engines.static.bench_timing import timed_creep_hold, timed_network
-    from grainfrac_yade.engines.static.creep import creep_hold
-    from grainfrac_yade.engines.static.failure import FailureRule
-    from grainfrac_yade.engines.static.solver import Equilibrium
-    p = load_parameters(extra_files=[FEM], overrides=["specimen.width=4e-3", "specimen.height=8e-3"])
-    net, _ = timed_network(build_specimen(p, 1), p)
-    timed = timed_creep_hold(net, p, 160e6, 4)
-    sc = p.stress_corrosion
-    plain = creep_hold(Equilibrium(net), build_law(sc), EventClock(sc.max_strength_loss_fraction, sc.creep_time_limit),
-                       160e6, FailureRule(p.creep.collapse_strain_increment), max_events=4)
-    assert timed["result"].times == plain.times and timed["events"] == plain.events == 4
-    assert np.array_equal(timed["result"].state.broken, plain.state.broken)
-    assert timed["ramp"]["broken"] + sum(timed["event_broken"]) == plain.broken
+    from grainfrac_yade.protocols.timed_creep import TimedCreepRun
+    p = size_params(FEM, [], 4e-3, 8e-3, SIZE_SERIES_OVERRIDES, "static")
+    timed = static_hold(p, 1, 160e6, 4)
+    plain = TimedCreepRun(build_specimen(p, 1), p, 160e6, max_events=4).run()
+    assert timed["events"] == len(timed["times"]) == 4 and timed["times"] == [r["creep_time_s"] for r in plain.rows[2:]]
+    assert timed["broken"] == int(plain.scene.broken.sum())
+    assert timed["ramp"]["broken"] + sum(timed["event_broken"]) == timed["broken"]
 
 
 @needs_yade

@@ -11,7 +11,6 @@ from grainfrac_yade.engines.static.cascade import Path
 from grainfrac_yade.engines.static.failure import FailureRule
 from grainfrac_yade.engines.static.network import build_static_network
 from grainfrac_yade.engines.static.solver import Equilibrium
-from grainfrac_yade.engines.static.ucs import ucs_path
 from static_tiny import KN, network
 
 #: Tiny specimens per grain model: fem 3 x 6 mm; rigid 4 x 8 mm (on 3 x 6 mm seed 1 a rigid cell's mechanism
@@ -74,14 +73,19 @@ def test_path_does_not_depend_on_solver_settings(model):
     assert np.allclose([r.stress_before for r in pa.records], [r.stress_before for r in pb.records], rtol=1e-7)
 
 
-def test_ucs_path_of_a_tiny_rigid_specimen_has_a_peak():
-    """Rigid cells, 4 x 8 mm: the stress rises, bonds break, the path passes a peak and ends post-peak (below
-    ucs.stop_stress_ratio of it).  (On 3 x 6 mm the path ends on a rigid cell's mechanism instead: reported.)"""
-    s, p, lay = _tiny("rigid")
-    r = ucs_path(Equilibrium(build_static_network(s, p, lay)), p.ucs.max_strain, p.ucs.stop_stress_ratio)
-    assert r.peak_stress > 0 and r.broken_at_peak > 0
-    assert r.end == "post-peak"
-    assert r.stress_after[-1] < p.ucs.stop_stress_ratio * r.peak_stress
+def test_ucs_of_a_tiny_rigid_specimen_on_the_plain_path_has_a_peak():
+    """Rigid cells, 4 x 8 mm, the UCS protocol on the static engine's plain path: the stress rises, bonds break, the
+    test passes a peak and ends post-peak (the last row below ucs.stop_stress_ratio of it).  (On 3 x 6 mm the path
+    ends on a rigid cell's mechanism instead: reported.)"""
+    from grainfrac_yade.protocols.ucs import run_ucs
+    s, p, _ = _tiny("rigid")
+    p = load_parameters(overrides=[*TINY["rigid"], "numerics.engine=static", "numerics.static_relaxation=none"])
+    cols, result, _, _ = run_ucs(s, p)
+    peak = max(cols["axial_stress_pa"])
+    assert peak > 0 and result["peak_reached"] and not result["numerical_failure"]
+    assert result["end_reason"].startswith("post-peak")
+    assert cols["broken_total"][cols["axial_stress_pa"].index(peak)] > 0
+    assert cols["axial_stress_pa"][-1] < p.ucs.stop_stress_ratio * peak
 
 
 def test_cell_cut_loose_is_held_and_reported():

@@ -1,21 +1,21 @@
-"""Static engine: creep holds with the law package and the event clock, and the failure rule (no YADE)."""
+"""Static engine: creep events with the law package and the event clock on hand-made networks and a tiny specimen's
+network, the failure rule, and the paper clock refused (no YADE)."""
 import math
 
 import numpy as np
 import pytest
 
-from grainfrac_yade.clocks import EventClock, PaperClock
-from grainfrac_yade.errors import GrainfracError
+from grainfrac_yade.clocks import EventClock
+from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.grains import layout_for
 from grainfrac_yade.law.hillig_charles import HilligCharles
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.engines.static.cascade import Path
-from grainfrac_yade.engines.static.creep import creep_hold
 from grainfrac_yade.engines.static.failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
 from grainfrac_yade.engines.static.network import build_static_network
 from grainfrac_yade.engines.static.solver import Equilibrium
-from static_tiny import JC, PHI, PHI_R, network, shear_pair
+from static_tiny import JC, PHI, PHI_R, HeldEvents, network, shear_pair
 
 #: Paper section 4.1: beta1 [Pa/s], beta2 [1/Pa].
 BETA1, BETA2 = 1e-3, 1e-7
@@ -30,17 +30,22 @@ def test_two_cell_creep_lifetime_is_eq7_integrated_by_hand():
     specimen fails (no equilibrium ahead)."""
     sigma, tau = 20e6, 35e6
     eq = Equilibrium(shear_pair(), confinement=sigma)
-    res = creep_hold(eq, HilligCharles(BETA1, BETA2), EventClock(), tau, FailureRule(1e-3))
+    res = HeldEvents(eq, HilligCharles(BETA1, BETA2), EventClock(), tau, FailureRule(1e-3)).run()
     expected = (JC + sigma * np.tan(PHI) - tau) / (BETA1 * math.exp(BETA2 * tau))
     assert res.failed and res.reason == NO_EQUILIBRIUM
     assert res.events == 1
-    assert res.lifetime == pytest.approx(expected, rel=EXACT)
+    assert res.times[-1] == pytest.approx(expected, rel=EXACT)
 
 
 def test_the_paper_clock_is_refused_in_one_line():
-    with pytest.raises(GrainfracError) as err:
-        creep_hold(Equilibrium(shear_pair()), HilligCharles(BETA1, BETA2), PaperClock(), 1e6, FailureRule(1e-3))
-    assert "Eq. 8" in str(err.value) and "\n" not in str(err.value)
+    """The creep protocol on the static engine with the paper clock (Eq. 8 needs an unbalanced force): one line
+    naming the key and the fix, before any creep."""
+    from grainfrac_yade.protocols.creep import run_creep
+    p = load_parameters(overrides=["numerics.engine=static", "stress_corrosion.clock=paper", "specimen.width=3e-3",
+                                   "specimen.height=6e-3"])
+    with pytest.raises(ParameterError) as err:
+        run_creep(build_specimen(p, 1), p, 100e6)
+    assert "Eq. 8" in str(err.value) and "fix:" in str(err.value) and "\n" not in str(err.value)
 
 
 def _soft_backed_pair(collapse):
@@ -48,8 +53,8 @@ def _soft_backed_pair(collapse):
     soft one must be sheared far to carry the held stress."""
     net = network([[0.0, 0.0], [1e-3, 0.0]], [[0, 1], [0, 1]], [[1.0, 0.0], [1.0, 0.0]], top=[1], bottom=[0],
                   left=[0], right=[1], ks=[2e9, 2e6], jc=[JC, 1e12], jt=[10e6, 1e12])
-    return creep_hold(Equilibrium(net, confinement=20e6), HilligCharles(BETA1, BETA2), EventClock(), 35e6,
-                      FailureRule(collapse))
+    return HeldEvents(Equilibrium(net, confinement=20e6), HilligCharles(BETA1, BETA2), EventClock(), 35e6,
+                      FailureRule(collapse)).run()
 
 
 def test_failure_rule_collapse_and_its_switch():
@@ -73,8 +78,8 @@ def _tiny_creep(**settings):
     net = build_static_network(s, p, layout_for(s, p))
     bracket = settings.pop("bracket_tol")
     eq = Equilibrium(net, **settings)
-    return creep_hold(eq, HilligCharles(BETA1, BETA2), EventClock(), 200e6, FailureRule(1e-3), max_events=8,
-                      path=Path(eq, bracket_tol=bracket))
+    return HeldEvents(eq, HilligCharles(BETA1, BETA2), EventClock(), 200e6, FailureRule(1e-3),
+                      path=Path(eq, bracket_tol=bracket)).run(max_events=8)
 
 
 def test_creep_does_not_depend_on_solver_settings():

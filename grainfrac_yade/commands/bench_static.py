@@ -10,13 +10,16 @@ Finite-element cells (``params/presets/fem.toml``), seed 1 (``--seed``), a creep
    relaxation, the static engine's solve back to the held stress).  The ratio YADE / static of the mean CPU per
    event is formed within the run; the steps per event are DEM steps (YADE) and equilibria solved (static).
 2. **Static CPU per event against specimen size** (10 x 20, 20 x 40 and the paper's 31.7 x 63.4 mm; 63.4 x 126.8
-   mm with ``--static-large``; ``--quick``: 3 x 6, 4 x 8 and 6 x 12 mm): the core's own creep hold
-   (:func:`grainfrac_yade.engines.static.bench_timing.timed_creep_hold`, reached through the engine registry, as the study
-   ``studies/static_engine_cost.py`` runs it), the same number of events from the start of each hold: dofs, the
-   network's build, the ramp (CPU, equilibria, bonds broken), events, CPU, equilibria and active-set iterations per
-   event, CPU per quiet event (one that breaks only what the creep law took to failure), the peak memory so far
-   (``ru_maxrss``: cumulative, the sizes run smallest first), and the exponent b of CPU per event ~ dofs^b fitted by
-   least squares in log-log over the sizes.
+   mm with ``--static-large``; ``--quick``: 3 x 6, 4 x 8 and 6 x 12 mm): the same creep test on the static engine's
+   plain path (``numerics.static_relaxation = "none"``, :data:`SIZE_SERIES_OVERRIDES`), timed as in part 1
+   (:func:`static_hold`), with the solver's counters read through the engine registry (the static engine's
+   ``solver_counters`` and ``path_summary``), the same number of events from the start of each hold: dofs, the
+   scene's build (layout, network, first equilibrium), the ramp (the protocol's strain-controlled ramp, the
+   servo's hold and the event loop's first relaxation: CPU, equilibria, bonds broken), events, CPU, equilibria and
+   active-set iterations per event, CPU per quiet event (one that breaks only what the creep law took to failure),
+   the peak memory so far (``ru_maxrss``: cumulative, the sizes run smallest first), and the exponent b of CPU per
+   event ~ dofs^b fitted by least squares in log-log over the sizes.  (Until this measured the protocol, it timed
+   the static core's own creep hold, a second driver since retired: docs/studies/static_bench.md says what moved.)
 
 3. **The collapse** on the comparison's specimen: the same creep hold to its end with the static engine and its
    inertial relaxation (``numerics.static_relaxation = "inertial"``: the core's own small-strain dynamics where the
@@ -40,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engines.registry import engine
+from ..engines.registry import engine_for
 from ..errors import GrainfracError
 from ..geometry.specimen import build_specimen
 from ..params import load_parameters, require_plane
@@ -58,6 +61,10 @@ STATIC_QUICK_OUT = Path("results/bench_static_quick.json")
 HOLD_STRESS_PA = 160e6
 #: The clock of every hold: the event clock (the static engine has no dynamics for the paper's clock, Eq. 8).
 CLOCK = "event"
+#: The size series' own settings: the plain static path (a status set that does not settle ends the hold as a
+#: numerical failure), the path whose cost per event the size series has measured since it timed the static core's
+#: own hold; the relaxations (``numerics.static_relaxation``) are the collapse's part.
+SIZE_SERIES_OVERRIDES = ("numerics.static_relaxation=none",)
 #: Events between two progress lines of a size's hold (event 0: the end of its ramp) [1].
 EVENT_LINES = 5
 #: The largest specimen (name, width [m], height [m]): ~142,500 dofs; its hold of 20 events did not finish in 36 CPU
@@ -103,13 +110,16 @@ def size_params(preset, user_files, width, height, user_overrides, engine_name):
 
 
 class EventCpuRun(TimedCreepRun):
-    """A timed creep run (:class:`TimedCreepRun`, stopped after ``max_events``) that also marks the process's CPU
-    time and the scene's step count at the end of every relaxation of the event clock's loop (module doc)."""
+    """A timed creep run (:class:`TimedCreepRun`, stopped after ``max_events``) that also marks, at the end of every
+    relaxation of the event clock's loop (module doc): the process's CPU time, the scene's step count, the bonds
+    broken, the clock's count of bonds the law took to failure, the axial strain and ``counters(scene)`` (the
+    engine's solver counters; None: none)."""
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args, counters=None, on_mark=None, **kwargs):
         super().__init__(*args, **kwargs)
         self.in_event_loop = False
-        self.marks = []   # (CPU s, scene steps) after each relaxation of the event loop; the first: before event 1
+        self.counters, self.on_mark = counters, on_mark
+        self.marks = []   # (CPU s, scene steps, broken, law's failures, strain, counters) after each relaxation
 
     def run_event_clock(self, resume=None):
         self.in_event_loop = True
@@ -118,7 +128,11 @@ class EventCpuRun(TimedCreepRun):
     def relax(self, creep_time, safe_point=None, resume=None):
         ok = super().relax(creep_time, safe_point, resume)
         if self.in_event_loop:
-            self.marks.append((time.process_time(), self.scene.steps))
+            self.marks.append((time.process_time(), self.scene.steps, int(self.scene.broken.sum()),
+                               self.clock.n_failures, self.platens.axial_strain(),
+                               self.counters(self.scene) if self.counters is not None else None))
+            if self.on_mark is not None:
+                self.on_mark(self)
         return ok
 
 
@@ -129,11 +143,8 @@ def engine_events(params, seed, stress, events) -> dict:
     specimen = build_specimen(params, seed)
     run = EventCpuRun(specimen, params, stress, max_events=events)
     run.run()
-    if len(run.marks) < 2:
-        raise GrainfracError(f"bench --static: the {params.numerics.engine} engine's hold at {stress / 1e6:g} MPa timed "
-                             f"no event ({run.failure_reason or 'it ended before the event clock'}); fix: a lower "
-                             "--creep-stress")
-    m = np.array(run.marks, float)
+    _require_events(run, params, stress)
+    m = np.array([mk[:2] for mk in run.marks], float)
     cpu, steps = np.diff(m[:, 0]), np.diff(m[:, 1])
     counts = run.scene.counts()
     return {"engine": params.numerics.engine, "n_bodies": counts["n_bodies"], "n_bonds": run.scene.n_bonds,
@@ -141,6 +152,74 @@ def engine_events(params, seed, stress, events) -> dict:
             "event_steps": steps.astype(int).tolist(), "cpu_per_event_s": float(cpu.mean()),
             "steps_per_event": float(steps.mean()), "failed": bool(run.failed),
             "numerical_failure": bool(run.numerical_failure), "end": run.failure_reason or "events asked"}
+
+
+def _require_events(run, params, stress):
+    if len(run.marks) < 2:
+        raise GrainfracError(f"bench --static: the {params.numerics.engine} engine's hold at {stress / 1e6:g} MPa timed "
+                             f"no event ({run.failure_reason or 'it ended before the event clock'}); fix: a lower "
+                             "--creep-stress")
+
+
+def static_hold(params, seed, stress, events, progress=None) -> dict:
+    """The creep test (:mod:`grainfrac_yade.protocols.creep`) of ``params`` on the static engine held at ``stress``
+    [Pa] for at most ``events`` events, timed per event (module doc, part 2); ``params`` must name the static engine
+    (or one that extends its scene).  Returns the scene's size and build CPU (layout, network, first equilibrium),
+    the ramp's cost (CPU from the built scene to the end of the event loop's first relaxation, equilibria, active-set
+    iterations, bonds broken, strain), the end, per-event lists (``event_cpu_s``, ``event_equilibria``,
+    ``event_iterations``, ``event_broken``), their means, the CPU per quiet event (one that breaks only the bonds the
+    law took to failure; None without one), the solver's counters, the path's break sequence hash, what the scene
+    adds to a run's summary (``engine_keys``: e.g. its relaxations) and the events' creep times (``times``).  ``progress``:
+    called with a dict after the ramp (event 0) and after each event."""
+    static = engine_for(params)
+    if not hasattr(static, "solver_counters"):
+        raise GrainfracError(f"a timed static hold: numerics.engine = {params.numerics.engine!r} has no static solver "
+                             "to count; fix: numerics.engine=static")
+    c0 = time.process_time()
+    specimen = build_specimen(params, seed)
+    t0 = time.process_time()
+
+    def mark(run):
+        if progress is not None:
+            cpu, _, broken, _, strain, c = run.marks[-1]
+            progress({"event": len(run.marks) - 1, "cpu_s": cpu - t_run, "creep_time_s": run.clock.creep_time,
+                      "broken": broken, "strain": strain, "equilibria": c["equilibria"]})
+    run = EventCpuRun(specimen, params, stress, max_events=events, counters=static.solver_counters, on_mark=mark)
+    t_run = time.process_time()
+    build = t_run - t0
+    run.run()
+    _require_events(run, params, stress)
+    cpu = time.process_time() - t_run
+    m = np.array([(c, b, f, s, k["equilibria"], k["iterations"]) for c, _, b, f, s, k in run.marks], float)
+    ramp = {"cpu_s": m[0, 0] - t_run, "equilibria": int(m[0, 4]), "iterations": int(m[0, 5]), "broken": int(m[0, 1]),
+            "strain": m[0, 3]}
+    d = np.diff(m, axis=0)
+    cpu_ev, broken, law_failed, eqs, its = d[:, 0], d[:, 1], d[:, 2], d[:, 4], d[:, 5]
+    quiet = broken <= law_failed
+    n = len(d)
+    path = static.path_summary(run.scene)
+    c = static.solver_counters(run.scene)
+    c.update(cpu_s=cpu, cpu_per_equilibrium_s=cpu / max(c["equilibria"], 1),
+             equilibria_per_break=c["equilibria"] / max(path["records"], 1),
+             cpu_per_break_s=cpu / max(path["records"], 1), cpu_per_bond_s=cpu / max(path["bonds"], 1),
+             iterations_per_equilibrium=c["iterations"] / max(c["equilibria"], 1))
+
+    def mean(x):
+        return float(x.mean()) if len(x) else None
+    return {
+        "dofs": path["dofs"], "bonds": run.scene.n_bonds, "specimen_cpu_s": t0 - c0, "build_cpu_s": build,
+        "stress_pa": stress, "ramp": ramp, "events": n, "events_asked": events, "failed": bool(run.failed),
+        "numerical_failure": bool(run.numerical_failure), "end": run.failure_reason or "events asked",
+        "broken": int(run.scene.broken.sum()), "creep_time_s": run.clock.creep_time, "cpu_s": cpu,
+        "events_cpu_s": float(cpu_ev.sum()), "cpu_per_event_s": mean(cpu_ev), "equilibria_per_event": mean(eqs),
+        "iterations_per_event": mean(its),
+        "iterations_per_equilibrium": float(its.sum() / eqs.sum()) if n and eqs.sum() else None,
+        "bonds_per_event": mean(broken), "quiet_events": int(quiet.sum()), "cpu_per_quiet_event_s": mean(cpu_ev[quiet]),
+        "event_cpu_s": cpu_ev.tolist(), "event_equilibria": eqs.astype(int).tolist(),
+        "event_iterations": its.astype(int).tolist(), "event_broken": broken.astype(int).tolist(),
+        "counters": c, "sequence_hash": path["sequence_hash"], "engine_keys": run.scene.summary_keys(),
+        "times": [float(r["creep_time_s"]) for r in run.rows[2:]],   # the events' (rows 0, 1: the ramp's end, the hold)
+    }
 
 
 def compare_engines(settings, preset, user_files, overrides, seed, stress, progress) -> dict:
@@ -190,27 +269,23 @@ def collapse_runs(settings, preset, user_files, overrides, seed, stress, progres
 
 
 def size_series(settings, preset, user_files, overrides, seed, stress, progress, peak_rss, save, rows) -> list:
-    """The core's creep hold on each specimen of ``settings.sizes`` (module doc, part 2), appended to ``rows`` (the
-    result's list, so that ``save()`` after each size writes it)."""
-    static = engine("static")
+    """The creep test on the static engine's plain path on each specimen of ``settings.sizes`` (module doc, part 2),
+    appended to ``rows`` (the result's list, so that ``save()`` after each size writes it)."""
     for name, width, height in settings.sizes:
-        params = size_params(preset, user_files, width, height, overrides, "static")
-        net, build_cpu = static.timed_network(build_specimen(params, seed), params)
-        progress(f"static core, {name} mm ({net.ndof} dofs): network built in {build_cpu:.2f} CPU s, ramp to "
-                 f"{stress / 1e6:g} MPa")
+        params = size_params(preset, user_files, width, height, [*overrides, *SIZE_SERIES_OVERRIDES], "static")
+        progress(f"static engine, {name} mm: ramp to {stress / 1e6:g} MPa")
 
         def event_line(e, name=name):   # where a long hold stands: its ramp, then every EVENT_LINES-th event
             if e["event"] % EVENT_LINES == 0:
                 progress(f"  {name} mm, event {e['event']}: {e['cpu_s']:.1f} CPU s, {e['equilibria']} equilibria, "
                          f"{e['broken']} bonds broken")
-        hold = static.timed_creep_hold(net, params, stress, settings.events, progress=event_line)
-        for key in ("path", "result", "times"):
-            hold.pop(key)
-        rows.append({"specimen": name, "width_m": width, "height_m": height, "dofs": net.ndof, "bonds": net.n_bonds,
-                     "build_cpu_s": build_cpu, **hold, "peak_rss_mb_after": peak_rss()})
+        hold = static_hold(params, seed, stress, settings.events, progress=event_line)
+        hold.pop("times")
+        rows.append({"specimen": name, "width_m": width, "height_m": height, **hold, "peak_rss_mb_after": peak_rss()})
         save()
-        progress(f"static core, {name} mm ({net.ndof} dofs): ramp {hold['ramp']['cpu_s']:.2f} CPU s, "
-                 f"{hold['events']} events, {_num(hold['cpu_per_event_s'], '.3g')} CPU s per event")
+        progress(f"static engine, {name} mm ({hold['dofs']} dofs): built in {hold['build_cpu_s']:.2f} CPU s, ramp "
+                 f"{hold['ramp']['cpu_s']:.2f} CPU s, {hold['events']} events, "
+                 f"{_num(hold['cpu_per_event_s'], '.3g')} CPU s per event")
     return rows
 
 
@@ -293,7 +368,8 @@ def static_tables(result: dict) -> str:
         ratio = k["hybrid_over_inertial_dynamic_cpu"]
         lines += ["", f"Hybrid / static + inertial, CPU of the run: x {k['hybrid_over_inertial_cpu']:.1f}"
                   + (f"; of the dynamics: x {ratio:.1f}." if ratio else "; the inertial run needed no dynamics.")]
-    lines += ["", f"Per creep event against size, the static core's hold ({b['settings']['events']} events asked each):", "",
+    lines += ["", f"Per creep event against size, the creep test on the static engine's plain path ({b['settings']['events']} "
+              "events asked each):", "",
               "| specimen [mm] | dofs | bonds | build [CPU s] | ramp: CPU [s], equilibria, bonds broken | events | "
               "CPU per event [s] | equilibria per event | iterations per event | iterations per equilibrium | "
               "quiet events | CPU per quiet event [s] | end | peak memory so far [MB] |", "|" + "---|" * 14]

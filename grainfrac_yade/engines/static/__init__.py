@@ -20,15 +20,13 @@ explicit dynamic relaxation (docs/engines.md).  One module per job:
   step);
 * :mod:`.inertial`: the inertial relaxation there (explicit small-strain dynamics of the same network under the
   creep protocol's servo and criteria; the default);
-* :mod:`.ucs`: the UCS (and confined) path without a loading rate and its stop rule;
-* :mod:`.creep`: the core's creep hold: :func:`~grainfrac_yade.law.creep_step` and the event clock fed by the
-  static stresses;
 * :mod:`.scene`: :class:`~.scene.StaticScene`, the engine's scene of :class:`grainfrac_yade.engines.Scene` (load
   increments, the held platen stress, save and restore with the kept factor, the state export);
 * :mod:`.platens`: the platens (displacement control of the closure), the held stress of a creep hold and the
   confinement that the protocols drive;
 * :mod:`.jaws`: the Brazilian disc's jaw cells as prescribed displacements, and the Brazilian levers;
 * :mod:`.settings`: the engine's name and the dynamic-only settings it does not read;
-* :mod:`.bench_timing`: the timings of ``bench --static`` (a network built, a creep hold timed per event);
+* :mod:`.bench_timing`: what ``bench --static`` and the study scripts read beside the protocols (the solver's
+  counters, the path's breaks, the path alone timed for a number of breaks);
 * :mod:`.engine`: what the engine registry returns for ``numerics.engine = "static"``.
 """

@@ -13,8 +13,9 @@ clock; the paper clock needs dynamics and is refused).  Every command runs on it
 command line refuses before a run folder is made) is empty; what it refuses within a command (the paper clock, a
 stiffness-changing law, rough platens, blocked rotation of fem cells) is refused in one line naming the fix.  The
 Brazilian test runs on the disc's jaws of :mod:`.jaws` (``attach_jaws``) with the levers of ``apply_levers``.
-The timings of ``bench --static`` (:mod:`.bench_timing`: a network built and a creep hold timed per event, in CPU
-time) are reached here, as YADE's are in its engine module.  VTK series are written as on any engine
+What ``bench --static`` and the static study scripts read of a scene beside the protocols (:mod:`.bench_timing`:
+the solver's counters, the path's breaks, the path alone timed for a number of breaks, in CPU time) is reached
+here, as YADE's timings are in its engine module.  VTK series are written as on any engine
 (:mod:`grainfrac_yade.protocols.snapshots` reads the scene's ``cell_motion`` and ``bond_shift``; :data:`VTK_REFUSED`
 is empty).
 
@@ -33,7 +34,7 @@ from ...errors import GrainfracError
 from ...law import MODE_CORRODED, Stresses, check_finite
 from ...protocols.corrosion import BondCorrosion
 from ...geometry.disc import DiscTessellation
-from .bench_timing import timed_creep_hold, timed_network  # noqa: F401
+from .bench_timing import path_summary, solver_counters, timed_path  # noqa: F401
 from .jaws import DiscScene
 from .jaws import apply_levers as _apply_levers
 from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state)  # noqa: F401
@@ -53,8 +54,7 @@ def version() -> str:
 
 class StaticCorrosion(BondCorrosion):
     """A degradation law's state on a static scene's bonds (:class:`BondCorrosion`): reads the solved bond forces,
-    writes the law's strengths into the path's (J^T, J^C per intact area, as the core's own creep hold does,
-    :mod:`.creep`) and hands the bonds at their failure point to the scene's next solve."""
+    writes the law's strengths into the path's (J^T, J^C per intact area) and hands the bonds at their failure point to the scene's next solve."""
 
     name = "StressCorrosion"
 
