@@ -1,8 +1,10 @@
 """The rows of the model convergence study as a CSV (docs/studies/model_convergence.md): one line per finished UCS
 run folder, the discretisation (bonds per face, radial rings, bonds, nodes), the strength, the moduli, the crack
-thresholds, the breaks, the cost (CPU, inertial relaxations) and why the run ended, units in the column names.
+thresholds, the breaks, the cost (CPU, inertial relaxations) and why the run ended, units in the column names;
+with ``--elastic``, one line per ``elastic --grains fem`` folder: the moduli and the contact stress tail.
 
     /usr/bin/python3 -m studies.model_convergence results/model_convergence/* --out docs/studies/model_convergence/ucs_runs.csv
+    /usr/bin/python3 -m studies.model_convergence --elastic results/model_convergence_elastic/* --out docs/studies/model_convergence/elastic_tails.csv
 
 A pure reader of run folders (summary.json, params.json; no YADE).
 """
@@ -23,6 +25,44 @@ COLUMNS = (("ucs_mpa", "ucs_pa", 1e-6), ("peak_axial_strain_percent", "peak_axia
            ("static_relaxation_cpu_s", "static_relaxation_cpu_s", 1.0))
 
 
+#: (column, key of an elastic model's summary, factor) of every elastic row.
+ELASTIC_COLUMNS = (("n_nodes_1", "n_nodes", 1), ("young_gpa", "young_pa", 1e-9), ("poisson_1", "poisson", 1.0),
+                   ("shear_ratio_p50_1", "shear_stress_ratio_p50", 1.0),
+                   ("shear_ratio_p99_1", "shear_stress_ratio_p99", 1.0),
+                   ("shear_ratio_max_1", "shear_stress_ratio_max", 1.0),
+                   ("tension_ratio_max_1", "tension_stress_ratio_max", 1.0))
+
+
+def _value(v, factor):
+    return None if v is None else (round(v * factor, 6) if isinstance(factor, float) else int(v))
+
+
+def _discretisation(res: dict) -> dict:
+    return {"bonds_per_face_1": res["nodes_per_face"],
+            "cell_rings_1": res.get("cell_rings", ADDED_KEYS["resolution.cell_rings"]),
+            "cell_ring_growth_1": res.get("cell_ring_growth", ADDED_KEYS["resolution.cell_ring_growth"])}
+
+
+def elastic_row(folder: Path) -> dict | None:
+    """The CSV row of one ``elastic --grains fem`` folder (None where it holds none): the fem cells' moduli and
+    contact shear tail (over the applied stress), and the mesh reference's beside them."""
+    try:
+        s = json.loads((folder / "summary.json").read_text())
+        res = json.loads((folder / "params.json").read_text())["resolution"]
+    except (OSError, ValueError, KeyError):
+        return None
+    models = s.get("models", {})
+    if "fem" not in models:
+        return None
+    out = {"run": folder.name, "seed": s["seed"], **_discretisation(res)}
+    for name, key, factor in ELASTIC_COLUMNS:
+        out[name] = _value(models["fem"].get(key), factor)
+    mesh = models.get("mesh", {})
+    out["mesh_reference_shear_ratio_p99_1"] = _value(mesh.get("shear_stress_ratio_p99"), 1.0)
+    out["mesh_reference_young_gpa"] = _value(mesh.get("young_pa"), 1e-9)
+    return out
+
+
 def row(folder: Path) -> dict | None:
     """The CSV row of one run folder (None where it holds no finished run)."""
     try:
@@ -31,11 +71,9 @@ def row(folder: Path) -> dict | None:
         return None
     res = s["params"]["resolution"]
     out = {"run": folder.name, "seed": s["seed"], "width_mm": 1e3 * s["params"]["specimen"]["width"],
-           "height_mm": 1e3 * s["params"]["specimen"]["height"], "bonds_per_face_1": res["nodes_per_face"],
-           "cell_rings_1": res.get("cell_rings", ADDED_KEYS["resolution.cell_rings"])}
+           "height_mm": 1e3 * s["params"]["specimen"]["height"], **_discretisation(res)}
     for name, key, factor in COLUMNS:
-        v = s.get(key)
-        out[name] = None if v is None else (round(v * factor, 6) if isinstance(factor, float) else int(v))
+        out[name] = _value(s.get(key), factor)
     out.update(end_reason=s.get("end_reason"), code_version=s.get("code_version"))
     return out
 
@@ -44,8 +82,10 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folders", nargs="+", type=Path)
     ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--elastic", action="store_true", help="the folders are elastic --grains fem runs")
     a = ap.parse_args(argv)
-    rows = sorted((r for r in map(row, a.folders) if r), key=lambda r: (r["cell_rings_1"], r["bonds_per_face_1"], r["run"]))
+    rows = sorted((r for r in map(elastic_row if a.elastic else row, a.folders) if r),
+                  key=lambda r: (r["cell_ring_growth_1"], r["cell_rings_1"], r["bonds_per_face_1"], r["run"]))
     if not rows:
         print("error: no finished run among the folders; fix: give run folders that hold a summary.json", file=sys.stderr)
         return 2
