@@ -179,7 +179,7 @@ class Scene(Protocol):
         """(largest resultant force on a body the platens do not drive [N], mean resultant force on those
         bodies / ``reference``, inf if ``reference`` <= 0): how far the scene is from equilibrium after the
         last step (0 for a static engine's solved state); ``reference`` is a mean bond force
-        (:func:`grainfrac_yade.protocols.loading.mean_bond_force`).  NumericalFailure if a force is not finite."""
+        (:func:`grainfrac_yade.kernel.equilibrium.mean_bond_force`).  NumericalFailure if a force is not finite."""
 
     def relaxation_damping(self, damping: float) -> None:
         """The numerical damping of relaxation from here on (YADE: Cundall's non-viscous damping coefficient);

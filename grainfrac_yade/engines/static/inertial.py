@@ -15,7 +15,7 @@ with the residual friction by the return mapping from the last step (:func:`.con
 
 The platens hold the target stress through the creep protocol's servo (closing speed (target - stress) x H /
 (E x ``creep.servo_response_steps`` x dt), within ``creep.servo_max_strain_rate`` x H), and the protocol's own
-criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_yade.protocols.loading.relaxed`):
+criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_yade.kernel.equilibrium.relaxed`):
 
 * **at rest**: mean resultant force on the nodes the platens do not drive over the mean intact bond force below
   ``creep.equilibrium_tolerance``, the held stress within ``creep.stress_tolerance``.  The static equilibrium is
