@@ -16,7 +16,7 @@ Engines that integrate motion in time (``DYNAMIC`` in the engine module) have an
 the platens (:meth:`PlatenDrive.hold_stress`).  Besides the scene, an engine module offers what the
 protocols call on it by name: ``build_scene``, ``scene_from_state``, ``consolidate`` (a confined test's
 isotropic stage), ``apply_levers`` (Brazilian levers) and ``stress_corrosion(scene, sc_params, saved=None)``,
-the bond writer of a creep test: a :class:`grainfrac_yade.protocols.corrosion.BondCorrosion` (the
+the bond writer of a creep test: a :class:`grainfrac_yade.kernel.corrosion.BondCorrosion` (the
 degradation law's state, engine-neutral) that also reads the bond stresses (``stresses``, ``intact``)
 and writes what the law says they carry (``write``, ``degrade``, ``hand_over_failures``), listed among
 the scene's engines (``saved``: its state from a checkpoint).

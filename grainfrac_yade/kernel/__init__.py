@@ -1,4 +1,5 @@
-"""The kernel that the tests' protocols and the engines both import (pure numpy; no engine, no test protocol).
+"""The kernel that the tests' protocols (:mod:`grainfrac_yade.protocols`) and the engines both import (pure numpy;
+it imports neither: no engine module imports a protocol).
 
 * :mod:`.held_relaxation`: the one held-load relaxation loop (DEM steps in chunks of ``creep.check_period`` until
   the load is held at equilibrium, the specimen collapses or the budget is spent), driven through
@@ -7,7 +8,10 @@
   (:class:`~.held_relaxation.CollapseWatch`);
 * :mod:`.servo`: the stress servo's law (closing speed from the stress error, clipped), behind the engines' servos;
 * :mod:`.equilibrium`: the equilibrium criterion of a held load (unbalanced force over the mean bond force, the held
-  stress within its tolerance) and the finite-value check of a measure.
-
-Nothing here imports :mod:`grainfrac_yade.protocols` or :mod:`grainfrac_yade.engines`.
+  stress within its tolerance) and the finite-value check of a measure;
+* :mod:`.corrosion`: a degradation law's state on the bonds (the pure half of stress corrosion; each engine's bond
+  writer is one);
+* :mod:`.cracks`: broken bonds by mode and kind, their face pieces for crack maps, the crack tables;
+* :mod:`.levers`: the Brazilian levers and which breaks they leave out of a test's counts;
+* :mod:`.confinement`: whether a specimen survived a confined test's isotropic stage.
 """

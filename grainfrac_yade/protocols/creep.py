@@ -2,7 +2,7 @@
 
 0. Confined tests (``confinement.stress`` sigma_3 > 0): side-wall forces, then the isotropic
    stage to sigma_1 = sigma_3 at equilibrium (the engine's ``consolidate``).  A specimen that breaks apart in
-   it (:func:`.confinement.broken_apart_reason`) ends the run there with ``failed_before_test`` set
+   it (:func:`grainfrac_yade.kernel.confinement.broken_apart_reason`) ends the run there with ``failed_before_test`` set
    and the reason in ``failure_reason``: no ramp, no creep, neither a lifetime nor a survival.
 1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
    stress reaches the target; bonds broken during the ramp are counted apart.
@@ -15,7 +15,7 @@
    ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is below
    the threshold, applied every ``engine_period`` DEM steps; a dynamic engine only,
    :func:`grainfrac_yade.engines.registry.require_dynamic`).  The engine's ``stress_corrosion`` hook
-   reads the bond forces and writes the strengths (the law's state: :class:`.corrosion.BondCorrosion`);
+   reads the bond forces and writes the strengths (the law's state: :class:`grainfrac_yade.kernel.corrosion.BondCorrosion`);
    the law is not here.
 
 Failure: the platens cannot hold the load.  Collapse
@@ -57,8 +57,8 @@ from ..vtkio import due_times, merged_frame_note
 from ..wave import hold_budget, scene_density
 from .checkpoints import Checkpointer, inexact_note, read
 from .creep_checkpoint import capture, restore
-from .confinement import broken_apart_reason
-from .cracks import bond_is_inter, broken_counts
+from ..kernel.confinement import broken_apart_reason
+from ..kernel.cracks import bond_is_inter, broken_counts
 from .creep_loops import event_clock_loop, paper_clock_loop
 from .snapshots import Series, write_creep_snapshot
 

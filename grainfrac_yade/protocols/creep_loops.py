@@ -6,8 +6,8 @@ A *holder* is the creep run the loops drive (:class:`grainfrac_yade.protocols.cr
 ``progress``, ``safe_point(phase, counters)`` (a checkpoint if one is due), ``platens``, ``servo``
 (None without a stress servo), ``failed``, ``failure_reason`` and ``last_relaxation_steps``.  The
 bonds are an engine's stress-corrosion bond writer (its ``stress_corrosion`` hook; YADE's
-:class:`grainfrac_yade.engines.yade.corrosion_engine.StressCorrosion`, a :class:`.corrosion.BondCorrosion`):
-its law, state, stresses and writes; its ``scene`` is an engine's :class:`grainfrac_yade.engines.Scene`
+:class:`grainfrac_yade.engines.yade.corrosion_engine.StressCorrosion`, a
+:class:`grainfrac_yade.kernel.corrosion.BondCorrosion`): its law, state, stresses and writes; its ``scene`` is an engine's :class:`grainfrac_yade.engines.Scene`
 (``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
 (event clock) and the law's ``degrade`` (paper clock, through the engine).  The paper clock's
 unbalanced force needs a dynamic engine (one with inertia).

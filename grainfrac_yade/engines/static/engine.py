@@ -31,7 +31,7 @@ import numpy as np
 
 from ...errors import GrainfracError
 from ...law import MODE_CORRODED, Stresses, check_finite
-from ...protocols.corrosion import BondCorrosion
+from ...kernel.corrosion import BondCorrosion
 from ...geometry.disc import DiscTessellation
 from .bench_timing import timed_creep_hold, timed_network  # noqa: F401
 from .jaws import DiscScene

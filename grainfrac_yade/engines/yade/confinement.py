@@ -16,7 +16,7 @@ import numpy as np
 
 from ...geometry.tessellation import SIDES
 from ...wave import hold_budget, scene_density
-from ...protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
+from ...kernel.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
 from ...kernel.equilibrium import held_at_equilibrium
 from ...kernel.held_relaxation import EQUILIBRIUM, HeldRelaxing, relax_held
 from .platens import StressServo
