@@ -15,13 +15,15 @@
    ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is below
    the threshold, applied every ``engine_period`` DEM steps; a dynamic engine only,
    :func:`grainfrac_yade.engines.registry.require_dynamic`).  The engine's ``stress_corrosion`` hook
-   reads the bond forces and writes the strengths (the law's state: :class:`grainfrac_yade.kernel.corrosion.BondCorrosion`);
-   the law is not here.
+   reads the bond forces and writes the strengths (the law's state:
+   :class:`grainfrac_yade.kernel.corrosion.BondCorrosion`); the law is not here.
 
-Failure: the platens cannot hold the load.  Collapse
-(:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`): the servo closes the platens at its speed limit on every DEM step while the axial strain
-grows by more than ``creep.collapse_strain_increment`` (the specimen carries less
-than the load however far it is squeezed; 0 = criterion off).  Backstop: no
+Failure: the platens cannot hold the load (the kernel's held-load loop,
+:func:`grainfrac_yade.kernel.held_relaxation.relax_held`).  Collapse
+(:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`): the servo closes the platens at its
+speed limit on every DEM step while the axial strain grows by more than
+``creep.collapse_strain_increment`` (the specimen carries less than the load however far it is
+squeezed; 0 = criterion off).  Backstop: no
 equilibrium at the held stress within ``creep.max_relaxation_steps`` DEM steps (the
 strain runs away).  Safety cap: the axial strain exceeds ``creep.failure_strain``.
 Lifetime is the creep time at failure.  Creep time is separate from DEM time.

@@ -15,8 +15,9 @@ first stint, :func:`grainfrac_yade.engines.dynamic.dynamic_engine`; through the 
 
 A **dynamic stint** then relaxes YADE's scene from that state under the control the protocol had set: the platens
 fixed where they are (a displacement-controlled test: UCS, the creep ramp) or YADE's stress servo at the held
-stress (a creep hold), with the creep protocol's own criteria: equilibrium (``creep.equilibrium_tolerance``, and the
-held stress within ``creep.stress_tolerance``), collapse (:class:`~grainfrac_yade.protocols.creep_loops.CollapseWatch`:
+stress (a creep hold), in the kernel's held-load loop (:func:`grainfrac_yade.kernel.held_relaxation.relax_held`, on
+:class:`Stint`) with the creep protocol's own criteria: equilibrium (``creep.equilibrium_tolerance``, and the held
+stress within ``creep.stress_tolerance``), collapse (:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`:
 the servo saturated while the axial strain grows by ``creep.collapse_strain_increment``), checked every
 ``creep.check_period`` DEM steps within the hold's relaxation budget (``creep.max_relaxation_steps`` /
 ``_crossings``).  Bonds the creep law had handed over and the cascade had not yet broken are broken in YADE first.

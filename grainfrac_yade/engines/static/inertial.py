@@ -25,7 +25,7 @@ criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_ya
   dynamics cost 0.3 ms per step);
 * **collapse**: the servo saturated closing while the axial strain grows by ``creep.collapse_strain_increment``
   with the stress below ``creep.collapse_stress_ratio`` x the target
-  (:class:`grainfrac_yade.protocols.creep_loops.CollapseWatch`);
+  (:class:`grainfrac_yade.kernel.held_relaxation.CollapseWatch`);
 * **no equilibrium within the budget** (``creep.max_relaxation_steps`` / ``_crossings``): the held load is lost,
   the creep protocol's rule for a platen that cannot hold it.
 
