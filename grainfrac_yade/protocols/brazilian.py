@@ -51,8 +51,8 @@ from ..kernel.levers import Levers, new_breaks
 from .loading import LoadingTest
 
 def crack_counts(scene) -> dict:
-    """Bonds broken during the test by mode and kind (:func:`grainfrac_yade.kernel.cracks.broken_counts` without the slits of
-    :mod:`grainfrac_yade.kernel.levers`, which are broken before loading)."""
+    """Bonds broken during the test by mode and kind (:func:`grainfrac_yade.kernel.cracks.broken_counts` without the
+    slits of :mod:`grainfrac_yade.kernel.levers`, which are broken before loading)."""
     return broken_counts(scene, new_breaks(scene))
 
 

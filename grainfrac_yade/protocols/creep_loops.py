@@ -7,8 +7,8 @@ A *holder* is the creep run the loops drive (:class:`grainfrac_yade.protocols.cr
 (None without a stress servo), ``failed``, ``failure_reason`` and ``last_relaxation_steps``.  The
 bonds are an engine's stress-corrosion bond writer (its ``stress_corrosion`` hook; YADE's
 :class:`grainfrac_yade.engines.yade.corrosion_engine.StressCorrosion`, a
-:class:`grainfrac_yade.kernel.corrosion.BondCorrosion`): its law, state, stresses and writes; its ``scene`` is an engine's :class:`grainfrac_yade.engines.Scene`
-(``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
+:class:`grainfrac_yade.kernel.corrosion.BondCorrosion`): its law, state, stresses and writes; its
+``scene`` is an engine's :class:`grainfrac_yade.engines.Scene` (``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
 (event clock) and the law's ``degrade`` (paper clock, through the engine).  The paper clock's
 unbalanced force needs a dynamic engine (one with inertia).
 """
@@ -110,7 +110,8 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     ``creep.max_relaxation_steps`` such steps in a row is the failure "no equilibrium".  Before
     that, collapse (:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`, checked every
     ``engine_period`` DEM steps) ends the run when ``creep.collapse_strain_increment`` > 0 and the holder
-    has a stress servo (``holder.servo`` not None).  ``sc``, ``cp``: the ``[stress_corrosion]`` and ``[creep]`` parameters.
+    has a stress servo (``holder.servo`` not None).  ``sc``, ``cp``: the ``[stress_corrosion]`` and
+    ``[creep]`` parameters.
 
     F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
     thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
