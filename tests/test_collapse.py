@@ -15,7 +15,7 @@ from conftest import needs_yade
 from grainfrac_yade.clocks import PaperClock
 from grainfrac_yade.errors import ParameterError
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.protocols.creep_loops import CollapseWatch, collapsing
+from grainfrac_yade.kernel.held_relaxation import CollapseWatch, collapsing
 from grainfrac_yade.engines.yade.platens import StressServo
 from test_reliability import JC, JT, StandInBonds, StandInHolder, loop_params
 

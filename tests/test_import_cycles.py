@@ -177,8 +177,9 @@ def _engine_of(short):
 
 def test_the_engines_stand_side_by_side():
     """The engines are one family: one sub-package each under ``engines/``, the registry naming a module of
-    each; an engine imports the pure core, the interface and the dynamic engines by name, never the registry,
-    the commands, the CLI or another engine (but the hybrid the static one); nothing outside ``engines/``
+    each; an engine imports the pure core (the kernel it shares with the tests' protocols among it), the interface
+    and the dynamic engines by name, never the registry, the tests' protocols, the commands, the CLI or another
+    engine (but the hybrid the static one); nothing outside ``engines/``
     imports an engine's sub-package but :data:`OUTSIDE_ENGINE_IMPORTS` (the commands go through the registry)."""
     from grainfrac_yade.engines.registry import ENGINE_MODULES
     assert {name: module.split(".")[2] for name, module in ENGINE_MODULES.items()} == {e: e for e in ENGINE_PACKAGES}
@@ -190,7 +191,7 @@ def test_the_engines_stand_side_by_side():
         for target in map(_short, targets):
             theirs = _engine_of(target)
             if mine:
-                core = not (target.startswith("engines") or target.startswith("commands") or target == "cli")
+                core = not (target.startswith(("engines", "commands", "protocols")) or target == "cli")
                 ok = core or target in ENGINE_SHARED or theirs in (mine,) + ENGINE_PACKAGES[mine]
             else:
                 ok = theirs is None or _short(module).startswith("engines.") or \

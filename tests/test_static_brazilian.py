@@ -13,7 +13,7 @@ from grainfrac_yade.engines.registry import engine_for
 from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.geometry.specimen import build_disc_specimen, build_specimen
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.protocols.levers import PRE_EXISTING, Levers
+from grainfrac_yade.kernel.levers import PRE_EXISTING, Levers
 
 #: A 4 mm disc of 0.5 mm grains (about 64 cells), rows every 2e-5 diametral strain: rigid cells split it in about
 #: 200 rows (0.3 CPU s, seed 1).

@@ -8,7 +8,7 @@ import pytest
 
 from grainfrac_yade.geometry.specimen import build_specimen
 from grainfrac_yade.params import load_parameters
-from grainfrac_yade.protocols.cracks import bond_segments
+from grainfrac_yade.kernel.cracks import bond_segments
 from grainfrac_yade.vtkio import BOND_STATE_NAMES, read_vtp
 
 pytest.importorskip("vtkmodules")

@@ -14,7 +14,7 @@ import sys
 
 from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
 from ..protocols.brazilian_output import require_disc_model, run_brazilian_to_folder
-from ..protocols.levers import Levers
+from ..kernel.levers import Levers
 from ._outcome import numerical_failure_line, steps_phrase
 
 
@@ -30,7 +30,7 @@ def register(sub, common):
                    help="multiply the tensile strength J^T of every contact row (Table 2) by F: the same as "
                         "--set contacts.<a>/<b>.tensile_strength=F x its value for each row (recorded so in "
                         "params.json)")
-    lv = p.add_argument_group("levers on the bonds and cells (grainfrac_yade.protocols.levers; recorded in "
+    lv = p.add_argument_group("levers on the bonds and cells (grainfrac_yade.kernel.levers; recorded in "
                               "summary.json under 'levers', not parameters: ucs and creep do not know them)")
     lv.add_argument("--slit-fraction", type=float, default=0.0, metavar="F",
                     help="share of faces unbonded before loading (slits: compression and friction, no tension)")

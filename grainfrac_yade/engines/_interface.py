@@ -16,7 +16,7 @@ Engines that integrate motion in time (``DYNAMIC`` in the engine module) have an
 the platens (:meth:`PlatenDrive.hold_stress`).  Besides the scene, an engine module offers what the
 protocols call on it by name: ``build_scene``, ``scene_from_state``, ``consolidate`` (a confined test's
 isotropic stage), ``apply_levers`` (Brazilian levers) and ``stress_corrosion(scene, sc_params, saved=None)``,
-the bond writer of a creep test: a :class:`grainfrac_yade.protocols.corrosion.BondCorrosion` (the
+the bond writer of a creep test: a :class:`grainfrac_yade.kernel.corrosion.BondCorrosion` (the
 degradation law's state, engine-neutral) that also reads the bond stresses (``stresses``, ``intact``)
 and writes what the law says they carry (``write``, ``degrade``, ``hand_over_failures``), listed among
 the scene's engines (``saved``: its state from a checkpoint).
@@ -179,7 +179,7 @@ class Scene(Protocol):
         """(largest resultant force on a body the platens do not drive [N], mean resultant force on those
         bodies / ``reference``, inf if ``reference`` <= 0): how far the scene is from equilibrium after the
         last step (0 for a static engine's solved state); ``reference`` is a mean bond force
-        (:func:`grainfrac_yade.protocols.loading.mean_bond_force`).  NumericalFailure if a force is not finite."""
+        (:func:`grainfrac_yade.kernel.equilibrium.mean_bond_force`).  NumericalFailure if a force is not finite."""
 
     def relaxation_damping(self, damping: float) -> None:
         """The numerical damping of relaxation from here on (YADE: Cundall's non-viscous damping coefficient);

@@ -46,13 +46,13 @@ from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoints import (LoadingCheckpoints, base_state, history_arrays, read, restore_scene, resume_record,
                           scene_arrays)
-from .cracks import broken_counts
-from .levers import Levers, new_breaks
+from ..kernel.cracks import broken_counts
+from ..kernel.levers import Levers, new_breaks
 from .loading import LoadingTest
 
 def crack_counts(scene) -> dict:
-    """Bonds broken during the test by mode and kind (:func:`.cracks.broken_counts` without the slits of
-    :mod:`.levers`, which are broken before loading)."""
+    """Bonds broken during the test by mode and kind (:func:`grainfrac_yade.kernel.cracks.broken_counts` without the
+    slits of :mod:`grainfrac_yade.kernel.levers`, which are broken before loading)."""
     return broken_counts(scene, new_breaks(scene))
 
 
@@ -170,7 +170,7 @@ def run_brazilian(specimen, params, progress=None, scene=None, levers=None, chec
 
     The snapshot (bonds broken, their modes) is taken at the failure load: the peak before the split
     (:func:`grainfrac_yade.analysis.brazilian_analysis.split_peak_index`, the same rows), else at the largest
-    load.  ``levers``: :class:`.levers.Levers` applied to the scene before loading (None: none).
+    load.  ``levers``: :class:`grainfrac_yade.kernel.levers.Levers` applied to the scene before loading (None: none).
     Broken counts and the snapshot leave out slits.  ``checkpoint_folder``: the run folder,
     checkpoints go to its ``checkpoint/`` (None: none); ``run_values``: stored with them (seed, levers).
     ``snapshot``: a :class:`.snapshots.StrainSeries` (VTK files, timestep the diametral strain; it only

@@ -14,8 +14,8 @@ from ..geometry.specimen import build_disc_specimen
 from ..params import require_plane
 from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
 from . import brazilian as brazilian_test
-from .cracks import bond_segments, crack_table
-from .levers import Levers, new_breaks
+from ..kernel.cracks import bond_segments, crack_table
+from ..kernel.levers import Levers, new_breaks
 from .snapshots import DIAMETRAL_STRAIN, StrainSeries
 
 
@@ -35,7 +35,7 @@ def run_brazilian_to_folder(params, seed, out, overwrite=False, progress=None, l
                             vtk_every=None) -> dict:
     """Run a Brazilian test into ``out``; summary.json is written last (it marks the run finished).
 
-    ``levers``: :class:`~grainfrac_yade.protocols.levers.Levers` (None: none).  Checkpoints go to
+    ``levers``: :class:`~grainfrac_yade.kernel.levers.Levers` (None: none).  Checkpoints go to
     ``out/checkpoint/`` every ``numerics.checkpoint_interval`` s of wall time and are removed once
     summary.json is written; ``resume``: go on from the checkpoint in ``out`` (its levers with it).
     ``vtk_every``: VTK series in ``out/vtk/`` at every k-th history row and the end (None: none; not

@@ -2,7 +2,7 @@
 
 0. Confined tests (``confinement.stress`` sigma_3 > 0): side-wall forces, then the isotropic
    stage to sigma_1 = sigma_3 at equilibrium (the engine's ``consolidate``).  A specimen that breaks apart in
-   it (:func:`.confinement.broken_apart_reason`) ends the run there with ``failed_before_test`` set
+   it (:func:`grainfrac_yade.kernel.confinement.broken_apart_reason`) ends the run there with ``failed_before_test`` set
    and the reason in ``failure_reason``: no ramp, no creep, neither a lifetime nor a survival.
 1. Ramp: strain-controlled platens (``creep.ramp_strain_rate``) until the axial
    stress reaches the target; bonds broken during the ramp are counted apart.
@@ -15,13 +15,15 @@
    ``paper`` clock (Eq. 8: creep step doubling while the unbalanced force is below
    the threshold, applied every ``engine_period`` DEM steps; a dynamic engine only,
    :func:`grainfrac_yade.engines.registry.require_dynamic`).  The engine's ``stress_corrosion`` hook
-   reads the bond forces and writes the strengths (the law's state: :class:`.corrosion.BondCorrosion`);
-   the law is not here.
+   reads the bond forces and writes the strengths (the law's state:
+   :class:`grainfrac_yade.kernel.corrosion.BondCorrosion`); the law is not here.
 
-Failure: the platens cannot hold the load.  Collapse (:class:`CollapseWatch`): the
-servo closes the platens at its speed limit on every DEM step while the axial strain
-grows by more than ``creep.collapse_strain_increment`` (the specimen carries less
-than the load however far it is squeezed; 0 = criterion off).  Backstop: no
+Failure: the platens cannot hold the load (the kernel's held-load loop,
+:func:`grainfrac_yade.kernel.held_relaxation.relax_held`).  Collapse
+(:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`): the servo closes the platens at its
+speed limit on every DEM step while the axial strain grows by more than
+``creep.collapse_strain_increment`` (the specimen carries less than the load however far it is
+squeezed; 0 = criterion off).  Backstop: no
 equilibrium at the held stress within ``creep.max_relaxation_steps`` DEM steps (the
 strain runs away).  Safety cap: the axial strain exceeds ``creep.failure_strain``.
 Lifetime is the creep time at failure.  Creep time is separate from DEM time.
@@ -34,8 +36,8 @@ break no bond, end the run with ``numerical_failure`` set and the reason in
 Checkpoints (given a run folder): every ``numerics.checkpoint_interval`` s of wall time
 in the ramp, always at its end, then every interval again at a safe point of the clock loops
 (:meth:`CreepRun.safe_point`); :func:`resume_creep` goes on from the last one and
-computes what the uninterrupted run would have (:mod:`.checkpoints`; :func:`capture` and :func:`restore`
-here: the run's own state beside the engine's scene).
+computes what the uninterrupted run would have (:mod:`.checkpoints`; :mod:`.creep_checkpoint`: the run's own
+state beside the engine's scene).
 
 Written against the scene interface (:class:`grainfrac_yade.engines.Scene`): any engine runs it.
 """
@@ -49,23 +51,21 @@ import numpy as np
 from ..clocks import EventClock, PaperClock
 from ..engines.registry import engine_for, require_dynamic
 from ..errors import NumericalFailure
+from ..kernel.equilibrium import check_value, held_at_equilibrium
+from ..kernel.held_relaxation import BUDGET, COLLAPSE, EQUILIBRIUM, HeldRelaxing, collapse_watch, relax_held
 from ..law import shear_strength
 from ..params import unbalanced_threshold
 from ..vtkio import due_times, merged_frame_note
-from ..wave import HoldBudget, hold_budget, scene_density
-from .checkpoints import Checkpointer, START_TABLE, base_state, inexact_note, platen_state, read, restore_platens, \
-    restore_scene, scene_arrays
-from ..runs.columns import history_as_today
-from .confinement import broken_apart_reason
-from .cracks import bond_is_inter, broken_counts
-from .creep_loops import CollapseWatch, collapsing, event_clock_loop, paper_clock_loop
-from .loading import check_value, held_at_equilibrium
+from ..wave import hold_budget, scene_density
+from .checkpoints import Checkpointer, inexact_note, read
+from .creep_checkpoint import capture, restore
+from ..kernel.confinement import broken_apart_reason
+from ..kernel.cracks import bond_is_inter, broken_counts
+from .creep_loops import event_clock_loop, paper_clock_loop
 from .snapshots import Series, write_creep_snapshot
 
 #: History rows between writes of the partial history (an interrupted run keeps what it measured).
 HISTORY_FLUSH_ROWS = 50
-
-
 
 #: The ramp fails on loading when the platen stress falls below RAMP_DROP_FRACTION of its peak, once
 #: that peak exceeds RAMP_DROP_MIN_PEAK of the target: at the start of the ramp the stress of a
@@ -87,6 +87,31 @@ SERVO_STRAIN_FLOOR = 1e-6
 #: target (secant 0) still gives the servo a finite gain; the gain only sets how fast the servo
 #: removes its error (``creep.servo_response_steps``), not where it holds.
 SERVO_MODULUS_FLOOR = 1e9
+
+
+class CreepHold(HeldRelaxing):
+    """A creep run's held load as the kernel's loop relaxes it (:class:`~grainfrac_yade.kernel.held_relaxation.
+    HeldRelaxing`): its scene's DEM steps; after each chunk the breaks marked at ``creep_time``, the strain cap
+    (:meth:`CreepRun.check_failure`), the servo's collapse and its equilibrium (:meth:`CreepRun.at_equilibrium`)."""
+
+    def __init__(self, run: "CreepRun", creep_time: float):
+        self.run, self.creep_time, self.servo = run, creep_time, run.servo
+
+    def advance(self, steps: int) -> None:
+        self.run.scene.run(steps)
+
+    def checked(self, done: int) -> None:
+        self.run.last_relaxation_steps = done
+        self.run.mark_breaks(self.creep_time)
+
+    def failure(self) -> str:
+        return self.run.failure_reason if self.run.check_failure() else ""
+
+    def axial_strain(self) -> float:
+        return self.run.platens.axial_strain()
+
+    def balanced(self) -> bool:
+        return self.run.at_equilibrium(self.servo)
 
 
 class CreepRun:
@@ -236,10 +261,11 @@ class CreepRun:
                                               cp.servo_max_strain_rate * self.platens.height)
 
     def relax(self, creep_time, safe_point=None, resume=None):
-        """Run DEM steps until equilibrium at the held load; False (and failed) at collapse
-        (:class:`CollapseWatch`, checked every ``creep.check_period`` steps) or if equilibrium does not
-        come within the hold's budget (``creep.max_relaxation_steps``, or ``creep.max_relaxation_crossings``
-        wave crossings where longer: :attr:`hold_budget`).
+        """Run DEM steps until equilibrium at the held load (the kernel's loop,
+        :func:`grainfrac_yade.kernel.held_relaxation.relax_held`, on :class:`CreepHold`); False (and failed) at
+        collapse (its ``CollapseWatch``, checked every ``creep.check_period`` steps), past the strain cap, or if
+        equilibrium does not come within the hold's budget (``creep.max_relaxation_steps``, or
+        ``creep.max_relaxation_crossings`` wave crossings where longer: :attr:`hold_budget`).
 
         ``safe_point(counters)``: called before each check's DEM steps but the first (the state is
         complete there; the caller checkpoints if one is due); ``resume``: such counters, to go on
@@ -247,27 +273,15 @@ class CreepRun:
         cp = self.params.creep
         done = 0 if resume is None else int(resume["done"])
         self.last_relaxation_steps = done
-        watch = None
-        if cp.collapse_strain_increment > 0:
-            saved = (resume or {}).get("collapse")
-            watch = (CollapseWatch.from_state(cp.collapse_strain_increment, saved) if saved
-                     else CollapseWatch(cp.collapse_strain_increment, self.platens.axial_strain()))
-        while done < self.hold_budget.max_relaxation_steps:
-            if safe_point is not None and done > 0:
-                safe_point({"done": done, "collapse": None if watch is None else watch.state_dict()})
-            self.scene.run(cp.check_period)
-            done += cp.check_period
-            self.last_relaxation_steps = done
-            self.mark_breaks(creep_time)
-            if self.check_failure():
-                return False
-            if watch is not None and watch.update(collapsing(self.servo, cp.check_period, cp.collapse_stress_ratio),
-                                                  self.platens.axial_strain()):
-                self.failed, self.failure_reason = True, watch.reason(cp.check_period)
-                return False
-            if self.at_equilibrium(self.servo):
-                return True
-        self.failed, self.failure_reason = True, "no equilibrium at the held load (strain runs away)"
+        watch = collapse_watch(cp, self.platens.axial_strain(), (resume or {}).get("collapse"))
+        end = relax_held(CreepHold(self, creep_time), self.hold_budget.max_relaxation_steps, cp.check_period,
+                         watch=watch, collapse_stress_ratio=cp.collapse_stress_ratio, done=done, safe_point=safe_point)
+        if end.outcome == EQUILIBRIUM:
+            return True
+        if end.outcome == COLLAPSE:
+            self.failed, self.failure_reason = True, end.reason
+        elif end.outcome == BUDGET:
+            self.failed, self.failure_reason = True, "no equilibrium at the held load (strain runs away)"
         return False
 
     def bond_stress_table(self) -> dict:
@@ -391,87 +405,6 @@ class CreepRun:
         if self.vtk_folder is not None:
             self.write_vtk(self.rows[-1]["creep_time_s"])
         return self
-
-
-# ------------------------------------------------------------------ checkpoints
-def capture(run, phase: str, loop: dict, run_values: dict, version: str = "") -> tuple:
-    """(state dict for state.json, arrays for arrays.npz) of creep run ``run`` at a safe point."""
-    sc, pl = run.scene, run.platens
-    state = {
-        **base_state("creep", run, phase, loop, run_values, version),
-        "creep_time_s": run.rows[-1]["creep_time_s"] if run.rows else 0.0,
-        "run": {"rows": run.rows, "ramp_broken": run.ramp_broken, "failed": run.failed,
-                "failure_reason": run.failure_reason, "failed_on_loading": run.failed_on_loading,
-                "n_events": run.n_events, "vtk_times": run.vtk_times, "vtk_written": run.vtk_written,
-                "vtk_merged": run.vtk_merged,
-                "vtk_rows": run._vtk_rows, "vtk": run.vtk_folder is not None, "vtk_every": run.vtk_every,
-                "last_relaxation_steps": run.last_relaxation_steps, "resumes": run.resumes,
-                "consolidation": run.consolidation},
-        "platens": platen_state(pl),
-        "servo": None, "clock": None, "corrosion": None, "start_table_columns": None,
-    }
-    arrays = {**scene_arrays(sc), "break_time": run.break_time, "macro_time": run.macro_time}
-    servo = run.servo
-    if servo is not None:
-        state["servo"] = {"target": servo.target, "gain": servo.gain, "max_speed": servo.max_speed,
-                          "stress": float(servo.stress), "hold_budget": run.hold_budget.as_dict(),
-                          "clipped": int(servo.clipped), "closing_clipped_steps": int(servo.closing_clipped_steps)}
-    if run.corr is not None:
-        corr = run.corr.state_dict()
-        state["corrosion"] = {"creep_time": corr["creep_time"], "law": corr["law"], "restored": corr["restored"]}
-        arrays.update(tensile_strength_pa=np.asarray(corr["tensile_strength_pa"]),
-                      cohesion_pa=np.asarray(corr["cohesion_pa"]), area_fraction=np.asarray(corr["area_fraction"]))
-    clock = run.clock
-    if clock is not None:
-        state["clock"] = clock.state_dict()
-    if run.initial_bond_stresses is not None:
-        state["start_table_columns"] = list(run.initial_bond_stresses)
-        arrays.update({START_TABLE + k: np.asarray(v) for k, v in run.initial_bond_stresses.items()})
-    return state, arrays
-
-
-def restore(run, where, state: dict, arrays: dict):
-    """Load the checkpoint ``where`` into creep run ``run``, freshly built from the same specimen and
-    parameters.
-
-    Returns (phase, loop counters) for the driver to go on from.
-    """
-    sc, pl = run.scene, run.platens
-    restore_scene(sc, where, state, arrays, run.confinement)
-    restore_platens(pl, state["platens"])
-    r = state["run"]
-    run.rows = [history_as_today(row) for row in r["rows"]]   # rows of older checkpoints: dem_steps
-    run.ramp_broken, run.failed, run.failure_reason = r["ramp_broken"], r["failed"], r["failure_reason"]
-    run.failed_on_loading, run.n_events = r["failed_on_loading"], r["n_events"]
-    run.vtk_times, run.vtk_written, run._vtk_rows = r["vtk_times"], r["vtk_written"], r["vtk_rows"]
-    run.vtk_every = int(r.get("vtk_every", 0))   # older checkpoints: times only
-    run.vtk_merged = r.get("vtk_merged", [])   # older checkpoints: none recorded
-    run.last_relaxation_steps = r["last_relaxation_steps"]
-    run.consolidation = r.get("consolidation", {})
-    run.resumes = r["resumes"] + [{"dem_steps": state["dem_steps"], "creep_time_s": state["creep_time_s"],
-                                   "phase": state["phase"], "checkpoint_written": state["written"]}]
-    run.break_time, run.macro_time = np.array(arrays["break_time"]), np.array(arrays["macro_time"])
-    run.t0 = time.time() - state["wall_s"]
-    run.c0 = time.process_time() - state.get("cpu_s", 0.0)
-    if state["servo"] is not None:
-        s = state["servo"]
-        # checkpoints written before the clip count was kept: counted from 0 again
-        servo = pl.resume_hold(s)
-        run.servo = servo
-        # checkpoints written before the hold budget had wave crossings held the fixed step counts
-        run.hold_budget = (HoldBudget.from_dict(s["hold_budget"]) if "hold_budget" in s
-                           else HoldBudget.fixed(run.params.creep))
-    if state["corrosion"] is not None:
-        run.corr = run.engine.stress_corrosion(
-            sc, run.params.stress_corrosion,
-            {"creep_time": state["corrosion"]["creep_time"], "restored": state["corrosion"].get("restored", []),
-             **{k: arrays[k] for k in ("tensile_strength_pa", "cohesion_pa", "area_fraction")}})
-    if state["clock"] is not None:
-        kind = state["clock"].get("kind")
-        run.clock = (EventClock if kind == EventClock.KIND else PaperClock).from_state(state["clock"])
-    columns = state["start_table_columns"]
-    run.initial_bond_stresses = None if columns is None else {k: arrays[START_TABLE + k] for k in columns}
-    return state["phase"], state["loop"]
 
 
 def run_creep(specimen, params, target_stress, progress=None, **outputs) -> CreepRun:

@@ -6,9 +6,9 @@ A *holder* is the creep run the loops drive (:class:`grainfrac_yade.protocols.cr
 ``progress``, ``safe_point(phase, counters)`` (a checkpoint if one is due), ``platens``, ``servo``
 (None without a stress servo), ``failed``, ``failure_reason`` and ``last_relaxation_steps``.  The
 bonds are an engine's stress-corrosion bond writer (its ``stress_corrosion`` hook; YADE's
-:class:`grainfrac_yade.engines.yade.corrosion_engine.StressCorrosion`, a :class:`.corrosion.BondCorrosion`):
-its law, state, stresses and writes; its ``scene`` is an engine's :class:`grainfrac_yade.engines.Scene`
-(``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
+:class:`grainfrac_yade.engines.yade.corrosion_engine.StressCorrosion`, a
+:class:`grainfrac_yade.kernel.corrosion.BondCorrosion`): its law, state, stresses and writes; its
+``scene`` is an engine's :class:`grainfrac_yade.engines.Scene` (``run``, ``broken``, ``specimen``).  The law is not here: :func:`grainfrac_yade.law.creep_step`
 (event clock) and the law's ``degrade`` (paper clock, through the engine).  The paper clock's
 unbalanced force needs a dynamic engine (one with inertia).
 """
@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import NumericalFailure
+from ..kernel.held_relaxation import collapse_watch, collapsing
 from ..law import creep_step
 
 #: Length of a UDEC 2D model's out-of-plane unit [m]: the paper's absolute F_u threshold (100 N)
@@ -27,68 +28,6 @@ PROGRESS_EVERY = 20
 #: Event clock: creep intervals of length 0 in a row that break no bond (a bond handed over at its
 #: failure point that the contact law does not break) before the run ends as a numerical failure.
 MAX_STALLED_INTERVALS = 10
-
-
-class CollapseWatch:
-    """Collapse of a specimen under the held load, recognised from the stress servo.
-
-    A servo saturated closing (its command clipped at +max speed) drives the platens together as
-    fast as it may because the specimen carries less than the target stress; when that lasts while
-    the axial strain grows by more than ``strain_increment``, the specimen is shortening without
-    regaining the load: it has collapsed.  A transient stress drop after a break that the specimen
-    recovers from ends the saturation before that, and any interruption starts the count again.
-
-    Fed once per check with ``saturated`` (the servo was clipped closing on every DEM step since the
-    previous check) and the axial strain at the check; :meth:`update` says whether collapse is
-    reached.  A saturated stretch is measured from the strain at the check before its first
-    saturated one (where the saturated DEM steps began).  ``strain_increment`` 0: criterion off.
-    """
-
-    def __init__(self, strain_increment: float, strain: float):
-        self.strain_increment = float(strain_increment)
-        #: axial strain at the previous check [1]
-        self.previous = float(strain)
-        #: axial strain where the current saturated stretch began [1]; None: not saturated
-        self.start = None
-        #: saturated checks in a row
-        self.checks = 0
-
-    @property
-    def growth(self) -> float:
-        """Axial strain gained in the current saturated stretch [1] (0 when not saturated)."""
-        return 0.0 if self.start is None else self.previous - self.start
-
-    def update(self, saturated: bool, strain: float) -> bool:
-        """One check; True when the saturated stretch has gained more than ``strain_increment``."""
-        if saturated:
-            if self.start is None:
-                self.start = self.previous
-            self.checks += 1
-        else:
-            self.start, self.checks = None, 0
-        self.previous = float(strain)
-        return self.strain_increment > 0 and self.start is not None and self.growth > self.strain_increment
-
-    def reason(self, steps_per_check: int) -> str:
-        """The failure reason once collapse is reached."""
-        return (f"collapse: servo at its closing speed limit for {self.checks * steps_per_check} DEM steps while "
-                f"the axial strain grew by {self.growth:.6g} > collapse_strain_increment {self.strain_increment:g}")
-
-    def state_dict(self) -> dict:
-        return {"previous": self.previous, "start": self.start, "checks": self.checks}
-
-    @classmethod
-    def from_state(cls, strain_increment: float, state: dict) -> "CollapseWatch":
-        watch = cls(strain_increment, state["previous"])
-        watch.start, watch.checks = state["start"], int(state["checks"])
-        return watch
-
-
-def collapsing(servo, steps: int, stress_ratio: float) -> bool:
-    """One check of :class:`CollapseWatch`: the servo closed the platens at its speed limit on each of the
-    last ``steps`` DEM steps and the held stress is below ``stress_ratio`` x its target (the specimen
-    carries a fraction of the load; a cascade it arrests keeps more)."""
-    return servo.closing_clipped_steps >= steps and servo.stress < stress_ratio * servo.target
 
 
 def event_clock_loop(holder, corr, clock, resume=None) -> int:
@@ -169,9 +108,10 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     One notion of balance: F_u below the clock's threshold (:meth:`PaperClock.balanced`) both
     doubles the step and resets the count of DEM steps without balance; more than
     ``creep.max_relaxation_steps`` such steps in a row is the failure "no equilibrium".  Before
-    that, collapse (:class:`CollapseWatch`, checked every ``engine_period`` DEM steps) ends the run
-    when ``creep.collapse_strain_increment`` > 0 and the holder has a stress servo (``holder.servo``
-    not None).  ``sc``, ``cp``: the ``[stress_corrosion]`` and ``[creep]`` parameters.
+    that, collapse (:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`, checked every
+    ``engine_period`` DEM steps) ends the run when ``creep.collapse_strain_increment`` > 0 and the holder
+    has a stress servo (``holder.servo`` not None).  ``sc``, ``cp``: the ``[stress_corrosion]`` and
+    ``[creep]`` parameters.
 
     F_u is the largest resultant force on a free cell; ``absolute`` compares it, per metre of
     thickness as in UDEC 2D, with the threshold (100 N); ``relative`` uses the mean resultant over
@@ -181,7 +121,6 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
     """
     scale = corr.scene.specimen.thickness / UDEC_UNIT_THICKNESS
     safe_point = holder.safe_point
-    increment = cp.collapse_strain_increment
     unbalanced_period = sc.unbalanced_engine_period
     servo = holder.servo
     if resume is None:
@@ -192,10 +131,8 @@ def paper_clock_loop(holder, corr, clock, sc, cp, resume=None):
         applications, not_balanced_steps = int(resume["applications"]), int(resume["not_balanced_steps"])
         period = int(resume.get("period", sc.engine_period))
     watch = None
-    if increment > 0 and servo is not None:
-        saved = (resume or {}).get("collapse")
-        watch = (CollapseWatch.from_state(increment, saved) if saved
-                 else CollapseWatch(increment, holder.platens.axial_strain()))
+    if servo is not None:
+        watch = collapse_watch(cp, holder.platens.axial_strain(), (resume or {}).get("collapse"))
     while True:
         counters = {"applications": applications, "not_balanced_steps": not_balanced_steps}
         if period != sc.engine_period:

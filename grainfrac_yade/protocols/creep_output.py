@@ -24,7 +24,7 @@ from ..runs.runio import (CHECKPOINT, SUMMARY, check_files, checkpoint_folder, c
                           write_json)
 from ..wave import budget_fields
 from . import creep as creep_test
-from .cracks import bond_segments, broken_counts, crack_table
+from ..kernel.cracks import bond_segments, broken_counts, crack_table
 from .snapshots import write_life_series
 
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..vtkio import (BOND_KIND_NAMES, BOND_STATE_NAMES, rigid_motion, series_file,
                      time_field, write_polygons, write_pvd, write_segments)
-from .cracks import bond_is_inter, bond_segments
+from ..kernel.cracks import bond_is_inter, bond_segments
 
 #: The time of each kind of run: (field-data name, unit) of the .pvd timestep.
 CREEP_TIME = ("creep_time", "s")

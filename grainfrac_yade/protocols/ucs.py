@@ -27,8 +27,8 @@ from ..errors import NumericalFailure
 from ..post_peak import softened_past_peak
 from .checkpoints import (LoadingCheckpoints, base_state, history_arrays, inexact_note, platen_state, read,
                           restore_platens, restore_scene, resume_record, scene_arrays)
-from .confinement import broken_apart_reason
-from .cracks import broken_counts
+from ..kernel.confinement import broken_apart_reason
+from ..kernel.cracks import broken_counts
 from .loading import LoadingTest
 
 #: Columns of a UCS history.

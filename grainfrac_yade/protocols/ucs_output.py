@@ -12,7 +12,7 @@ from ..geometry.specimen import build_specimen
 from ..params import require_plane
 from ..runs.runio import commit_run_dir, prepare_run_dir, remove_checkpoints, summary_header, write_csv, write_json
 from . import ucs as ucs_test
-from .cracks import bond_segments, crack_table
+from ..kernel.cracks import bond_segments, crack_table
 from .snapshots import AXIAL_STRAIN, StrainSeries
 
 

@@ -15,8 +15,9 @@ first stint, :func:`grainfrac_yade.engines.dynamic.dynamic_engine`; through the 
 
 A **dynamic stint** then relaxes YADE's scene from that state under the control the protocol had set: the platens
 fixed where they are (a displacement-controlled test: UCS, the creep ramp) or YADE's stress servo at the held
-stress (a creep hold), with the creep protocol's own criteria: equilibrium (``creep.equilibrium_tolerance``, and the
-held stress within ``creep.stress_tolerance``), collapse (:class:`~grainfrac_yade.protocols.creep_loops.CollapseWatch`:
+stress (a creep hold), in the kernel's held-load loop (:func:`grainfrac_yade.kernel.held_relaxation.relax_held`, on
+:class:`Stint`) with the creep protocol's own criteria: equilibrium (``creep.equilibrium_tolerance``, and the held
+stress within ``creep.stress_tolerance``), collapse (:class:`~grainfrac_yade.kernel.held_relaxation.CollapseWatch`:
 the servo saturated while the axial strain grows by ``creep.collapse_strain_increment``), checked every
 ``creep.check_period`` DEM steps within the hold's relaxation budget (``creep.max_relaxation_steps`` /
 ``_crossings``).  Bonds the creep law had handed over and the cascade had not yet broken are broken in YADE first.
@@ -51,8 +52,8 @@ import numpy as np
 
 from .._interface import SceneState
 from ...errors import NumericalFailure
-from ...protocols.creep_loops import CollapseWatch, collapsing
-from ...protocols.loading import held_at_equilibrium, relaxed
+from ...kernel.equilibrium import held_at_equilibrium, relaxed
+from ...kernel.held_relaxation import HeldRelaxing, collapse_watch, relax_held
 from ..static.cascade import LargeCascade
 from ..static.scene import StaticScene
 from .settings import not_used_settings
@@ -75,6 +76,41 @@ SERVO_STRAIN_FLOOR = 1e-6
 #: The engine of the dynamic stints (a name of :data:`grainfrac_yade.engines.dynamic.DYNAMIC_ENGINE_MODULES`),
 #: imported at the first stint.
 DYNAMIC_ENGINE = "yade"
+
+
+class Stint(HeldRelaxing):
+    """A dynamic stint as the kernel's held-load loop relaxes it (:class:`~grainfrac_yade.kernel.held_relaxation.
+    HeldRelaxing`): the dynamic scene ``dyn``'s DEM steps under YADE's servo (``servo``, a held stress) or its platens
+    fixed (``stop_below`` [Pa]: the stress below which the load is lost, the UCS test's post-peak rule); at rest by
+    the creep protocol's criterion over the intact bonds.  ``crossings`` receives the bonds broken in each elastic
+    wave crossing of ``crossing_steps`` DEM steps, read at the first check past its end."""
+
+    def __init__(self, dyn, platens, servo, creep_params, crossing_steps: float, stop_below, crossings: list):
+        self.dyn, self.platens, self.servo, self.creep_params = dyn, platens, servo, creep_params
+        self.crossing_steps, self.stop_below, self.crossings = crossing_steps, stop_below, crossings
+        #: bonds broken when the current crossing began
+        self.counted = int(dyn.broken.sum())
+
+    def advance(self, steps: int) -> None:
+        self.dyn.run(steps)
+
+    def checked(self, done: int) -> None:
+        if done >= (len(self.crossings) + 1) * self.crossing_steps:
+            now = int(self.dyn.broken.sum())
+            self.crossings.append(now - self.counted)
+            self.counted = now
+
+    def axial_strain(self) -> float:
+        return self.platens.axial_strain()
+
+    def lost(self) -> bool:
+        return self.stop_below is not None and self.platens.axial_stress() < self.stop_below
+
+    def balanced(self) -> bool:
+        intact = np.flatnonzero(~self.dyn.broken)
+        if self.servo is not None:
+            return held_at_equilibrium(self.dyn, self.servo, intact, self.creep_params)
+        return relaxed(self.dyn, intact, self.creep_params)
 
 
 class HybridScene(StaticScene):
@@ -213,40 +249,19 @@ class HybridScene(StaticScene):
         if held:
             servo = platens.hold_stress(self.hold_target, young, budget.servo_response_steps,
                                         cp.servo_max_strain_rate * self.net.height)
-            if cp.collapse_strain_increment > 0:
-                watch = CollapseWatch(cp.collapse_strain_increment, platens.axial_strain())
+            watch = collapse_watch(cp, platens.axial_strain())
         else:
             platens.set_axial_velocity(0.0)
         if cp.relaxation_damping > 0:
             dyn.relaxation_damping(cp.relaxation_damping)
-        done = 0
         min_steps = max(self.params.numerics.stint_min_crossings, retry * RETRY_CROSSINGS) * budget.crossing_steps
-        crossings = [] if crossings is None else crossings
-        counted = int(dyn.broken.sum())
-        while True:
-            if done >= budget.max_relaxation_steps:
-                outcome = "budget"
-                break
-            dyn.run(cp.check_period)
-            done += cp.check_period
-            if done >= (len(crossings) + 1) * budget.crossing_steps:
-                now = int(dyn.broken.sum())
-                crossings.append(now - counted)
-                counted = now
-            if watch is not None and watch.update(collapsing(servo, cp.check_period, cp.collapse_stress_ratio),
-                                                  platens.axial_strain()):
-                outcome = "collapse"
-                break
-            if not held and platens.axial_stress() < self.params.ucs.stop_stress_ratio * start.stress:
-                outcome = "lost load"     # the UCS test's post-peak rule: nothing to relax further
-                break
-            intact = np.flatnonzero(~dyn.broken)
-            balanced = held_at_equilibrium(dyn, servo, intact, cp) if held else relaxed(dyn, intact, cp)
-            if balanced and done >= min_steps:
-                outcome = "equilibrium"
-                break
-        crossings.append(int(dyn.broken.sum()) - counted)
-        return outcome, done, servo, min_steps, budget
+        stint = Stint(dyn, platens, servo, cp, budget.crossing_steps,
+                      None if held else self.params.ucs.stop_stress_ratio * start.stress,
+                      [] if crossings is None else crossings)
+        end = relax_held(stint, budget.max_relaxation_steps, cp.check_period, watch=watch,
+                         collapse_stress_ratio=cp.collapse_stress_ratio, min_steps=min_steps)
+        stint.crossings.append(int(dyn.broken.sum()) - stint.counted)
+        return end.outcome, end.steps, servo, min_steps, budget
 
     def _take_back(self, dyn, platens, dem_steps: int, log: dict) -> None:
         """What the stint reached, into the static scene: first YADE's relaxed state itself (:meth:`_take_state`);

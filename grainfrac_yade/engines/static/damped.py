@@ -24,7 +24,7 @@ after a step whose statuses settle the anchor is halved (the steps grow towards 
 after one whose statuses do not settle it is stiffened four-fold and the step taken again.  It ends
 
 * **at rest**: the creep protocol's measure of a relaxed held load (the YADE engine's too,
-  :func:`grainfrac_yade.protocols.loading.relaxed`): the mean unbalanced force on the free nodes over the mean
+  :func:`grainfrac_yade.kernel.equilibrium.relaxed`): the mean unbalanced force on the free nodes over the mean
   intact bond force, below :data:`REST_TOLERANCE` (1e-6; YADE's ``creep.equilibrium_tolerance`` of 1e-3 calls a
   sliding mechanism at rest).  The state is that anchored step's: its unbalanced force is what the measure read,
   its statuses consistent; the static path goes on from it;

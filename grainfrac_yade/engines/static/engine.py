@@ -32,7 +32,7 @@ import numpy as np
 
 from ...errors import GrainfracError
 from ...law import MODE_CORRODED, Stresses, check_finite
-from ...protocols.corrosion import BondCorrosion
+from ...kernel.corrosion import BondCorrosion
 from ...geometry.disc import DiscTessellation
 from .bench_timing import path_summary, solver_counters, timed_path  # noqa: F401
 from .jaws import DiscScene

@@ -15,7 +15,7 @@ with the residual friction by the return mapping from the last step (:func:`.con
 
 The platens hold the target stress through the creep protocol's servo (closing speed (target - stress) x H /
 (E x ``creep.servo_response_steps`` x dt), within ``creep.servo_max_strain_rate`` x H), and the protocol's own
-criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_yade.protocols.loading.relaxed`):
+criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_yade.kernel.equilibrium.relaxed`):
 
 * **at rest**: mean resultant force on the nodes the platens do not drive over the mean intact bond force below
   ``creep.equilibrium_tolerance``, the held stress within ``creep.stress_tolerance``.  The static equilibrium is
@@ -25,7 +25,7 @@ criteria decide, checked every ``creep.check_period`` steps (:func:`grainfrac_ya
   dynamics cost 0.3 ms per step);
 * **collapse**: the servo saturated closing while the axial strain grows by ``creep.collapse_strain_increment``
   with the stress below ``creep.collapse_stress_ratio`` x the target
-  (:class:`grainfrac_yade.protocols.creep_loops.CollapseWatch`);
+  (:class:`grainfrac_yade.kernel.held_relaxation.CollapseWatch`);
 * **no equilibrium within the budget** (``creep.max_relaxation_steps`` / ``_crossings``): the held load is lost,
   the creep protocol's rule for a platen that cannot hold it.
 
@@ -42,7 +42,9 @@ import numpy as np
 from ...errors import NumericalFailure
 from ...grains import model_of
 from ...layout import bond_properties
-from ...protocols.creep_loops import CollapseWatch, collapsing
+from ...kernel import held_relaxation as held
+from ...kernel.held_relaxation import HeldRelaxing, collapse_watch, relax_held
+from ...kernel.servo import ServoLaw
 from ...wave import hold_budget, scene_density
 from . import contacts as cl
 from .cascade import Path, Record
@@ -94,26 +96,20 @@ def damped_step(u: np.ndarray, v: np.ndarray, f: np.ndarray, inv_m: np.ndarray, 
     u += dt * v
 
 
-class HeldServo:
-    """The creep protocol's stress servo on the static network's platen closure (module doc): the attributes
-    :func:`grainfrac_yade.protocols.creep_loops.collapsing` reads (``stress``, ``target``,
-    ``closing_clipped_steps``); its :attr:`watch` the collapse criterion."""
+class HeldServo(ServoLaw):
+    """The creep protocol's stress servo on the static network's platen closure (module doc): the kernel's servo
+    law (:class:`grainfrac_yade.kernel.servo.ServoLaw`) at the dynamics' step; its :attr:`watch` the collapse
+    criterion."""
 
     def __init__(self, target: float, gain: float, max_speed: float, creep, strain: float):
-        self.target, self.gain, self.max_speed = float(target), float(gain), float(max_speed)
-        self.stress, self.clipped, self.closing_clipped_steps = 0.0, 0, 0
+        super().__init__(float(target), float(gain), float(max_speed))
         self.stress_tolerance = creep.stress_tolerance
         #: the creep protocol's collapse criterion from the strain ``strain`` on (None where it is off)
-        self.watch = CollapseWatch(creep.collapse_strain_increment, strain) if creep.collapse_strain_increment > 0 \
-            else None
+        self.watch = collapse_watch(creep, strain)
 
     def speed(self, stress: float, dt: float) -> float:
         """The closing speed [m/s] for the measured ``stress`` [Pa] (and the clip bookkeeping)."""
-        self.stress = stress
-        v = (self.target - stress) * self.gain / dt
-        self.clipped = 1 if v > self.max_speed else (-1 if v < -self.max_speed else 0)
-        self.closing_clipped_steps = self.closing_clipped_steps + 1 if self.clipped == 1 else 0
-        return min(max(v, -self.max_speed), self.max_speed)
+        return self.command(stress, dt)
 
     def held(self, stress: float) -> bool:
         """The held stress within ``creep.stress_tolerance`` of the target (the rest criterion's second half)."""
@@ -176,76 +172,33 @@ class InertialRelaxation:
 
     def relax(self, state: State, control, jt: np.ndarray, jc: np.ndarray, take_back=None):
         """Relax ``state`` (a converged static state) under ``control`` (:class:`HeldServo` or
-        :class:`FixedPlatens`) with the current strengths ``jt``, ``jc`` [Pa].  ``take_back(state) -> (state,
-        failure reason or None) | None``: the static equilibrium from a relaxed dynamic state (None where it gives
-        out: the dynamics go on).  Returns (state, failure reason or None, steps, take-backs that gave out, bonds
-        broken); with fixed platens the reason is :data:`LOST_LOAD` once the stress fell below the control's
-        limit, and at the end of the budget the relaxed state is taken back if it can be (as a YADE stint's)."""
-        net, eq, cp = self.net, self.eq, self.params.creep
+        :class:`FixedPlatens`) with the current strengths ``jt``, ``jc`` [Pa], by the kernel's held-load loop
+        (:func:`grainfrac_yade.kernel.held_relaxation.relax_held`, on :class:`InertialMotion`; the last chunk ends at
+        the budget).  ``take_back(state) -> (state, failure reason or None) | None``: the static equilibrium from a
+        relaxed dynamic state (None where it gives out: the dynamics go on, the next take-back 2, 4, 8, ... checks
+        later).  Returns (state, failure reason or None, steps, take-backs that gave out, bonds broken); with fixed
+        platens the reason is :data:`LOST_LOAD` once the stress fell below the control's limit, and at the end of
+        the budget the relaxed state is taken back if it can be (as a YADE stint's)."""
+        cp = self.params.creep
         budget = self.budget(state)
-        u, v = state.u.copy(), np.zeros(net.ndof)
-        closure = state.closure
-        broken, status, sign, s_p = state.broken.copy(), state.status.copy(), state.sign.copy(), state.s_p.copy()
-        mode = state.break_mode.copy()
-        broken0 = int(broken.sum())
-        e = eq.e
-        plat = eq.platen_fixed
-        inv_m = np.where(plat, 0.0, 1.0 / self.masses)
-        rows = self._rows(broken)
-        gave_out = 0
-        steps = 0
-        next_take_back = 0      # after a take-back that gave out, the next waits 2, 4, 8, ... checks
-        dt, damping = self.dt, self.damping
+        motion = InertialMotion(self, state, control, jt, jc, take_back)
+        end = relax_held(motion, budget.max_relaxation_steps, cp.check_period, watch=control.watch,
+                         collapse_stress_ratio=cp.collapse_stress_ratio, clip_to_budget=True)
+        steps, gave_out = end.steps, end.gave_out
 
-        def now():
-            return self._state(closure, u, broken, status, sign, s_p, fn, fs, stress, mode)
+        def ended(state_, reason):
+            return state_, reason, steps, gave_out, int(state_.broken.sum()) - motion.broken0
 
-        def end(state_, reason):
-            return state_, reason, steps, gave_out, int(state_.broken.sum()) - broken0
-
-        while steps < budget.max_relaxation_steps:
-            u[plat] = closure * e[plat]
-            dn, ds = net.cn @ u, net.ct @ u
-            status, sign = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual, status, sign)[:2]
-            fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)
-            hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
-            if hit.any():
-                idx = np.flatnonzero(hit)
-                _, md = cl.overstress(fn[idx], fs[idx], net.area[idx], jt[idx], jc[idx], net.tan_friction[idx])
-                st, sg, sp = cl.break_state(dn[idx], ds[idx], fs[idx], net.kn[idx], net.ks[idx],
-                                            net.tan_residual[idx])
-                broken[idx], status[idx], sign[idx], s_p[idx], mode[idx] = True, st, sg, sp, md
-                fn[idx], fs[idx] = cl.forces(dn[idx], ds[idx], st, sg, sp, net.kn[idx], net.ks[idx],
-                                             net.tan_residual[idx])
-                rows = self._rows(broken)
-            s_p = np.where(broken, cl.converged_slip(ds, status, fs, net.ks), s_p)
-            r = net.k_grain @ u + rows[0] @ fn + rows[1] @ fs
-            stress = eq.reaction_stress(r - eq.f_ext)
-            f = eq.f_ext - r
-            damped_step(u, v, f, inv_m, dt, damping)
-            closure += dt * control.speed(stress, dt)
-            steps += 1
-            if steps % cp.check_period:
-                continue
-            if control.watch is not None and control.watch.update(
-                    collapsing(control, cp.check_period, cp.collapse_stress_ratio), closure / net.height):
-                return end(now(), COLLAPSE)
-            if control.lost(stress):
-                return end(now(), LOST_LOAD)
-            if steps < next_take_back:
-                continue
-            if relative_force(net, f, fn, fs, broken) < cp.equilibrium_tolerance and control.held(stress):
-                back = take_back(now()) if take_back is not None else (now(), None)
-                if back is not None:
-                    return end(*back)
-                gave_out += 1
-                next_take_back = steps + cp.check_period * 2 ** gave_out
-        last = now()
-        if isinstance(control, FixedPlatens) and take_back is not None:
+        if end.outcome == held.EQUILIBRIUM:
+            return ended(*motion.back)
+        if end.outcome == held.COLLAPSE:
+            return ended(motion.now(), COLLAPSE)
+        last = motion.now()
+        if end.outcome == held.BUDGET and isinstance(control, FixedPlatens) and take_back is not None:
             back = take_back(last)
             if back is not None:
-                return end(*back)
-        return end(last, LOST_LOAD)
+                return ended(*back)
+        return ended(last, LOST_LOAD)
 
     def intact_modulus(self) -> float:
         """The intact specimen's axial modulus dS/d(strain) [Pa] (the servo's gain and the wave-crossing budget where
@@ -266,6 +219,76 @@ class InertialRelaxation:
                                    "critical one?)")
         return State(float(closure), u.copy(), broken.copy(), status.copy(), sign.copy(), s_p.copy(), fn.copy(),
                      fs.copy(), float(stress), mode.copy())
+
+
+class InertialMotion(HeldRelaxing):
+    """The explicit dynamics of one relaxation (:meth:`InertialRelaxation.relax`) as the kernel's held-load loop
+    drives them (:class:`~grainfrac_yade.kernel.held_relaxation.HeldRelaxing`): central-difference steps of the
+    static network from ``state`` at rest under ``control`` with strengths ``jt``, ``jc`` [Pa]; at rest by the
+    relative unbalanced force on the free dofs and the held stress; taken back by ``take_back`` (module doc)."""
+
+    def __init__(self, dynamics: "InertialRelaxation", state: State, control, jt, jc, take_back):
+        self.dyn, self.net, self.eq = dynamics, dynamics.net, dynamics.eq
+        self.control, self.servo, self.jt, self.jc, self.take_back = control, control, jt, jc, take_back
+        self.u, self.v = state.u.copy(), np.zeros(self.net.ndof)
+        self.closure = state.closure
+        self.broken, self.status, self.sign = state.broken.copy(), state.status.copy(), state.sign.copy()
+        self.s_p, self.mode = state.s_p.copy(), state.break_mode.copy()
+        #: bonds broken when the relaxation began
+        self.broken0 = int(self.broken.sum())
+        self.inv_m = np.where(self.eq.platen_fixed, 0.0, 1.0 / dynamics.masses)
+        self.rows = dynamics._rows(self.broken)
+        #: the take-back of the rested state (:meth:`settle`)
+        self.back = None
+
+    def advance(self, steps: int) -> None:
+        net, eq, control = self.net, self.eq, self.control
+        jt, jc, e, plat, inv_m = self.jt, self.jc, eq.e, eq.platen_fixed, self.inv_m
+        dt, damping = self.dyn.dt, self.dyn.damping
+        u, v, broken, s_p, mode = self.u, self.v, self.broken, self.s_p, self.mode
+        status, sign, rows, closure = self.status, self.sign, self.rows, self.closure
+        for _ in range(steps):
+            u[plat] = closure * e[plat]
+            dn, ds = net.cn @ u, net.ct @ u
+            status, sign = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual, status, sign)[:2]
+            fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)
+            hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
+            if hit.any():
+                idx = np.flatnonzero(hit)
+                _, md = cl.overstress(fn[idx], fs[idx], net.area[idx], jt[idx], jc[idx], net.tan_friction[idx])
+                st, sg, sp = cl.break_state(dn[idx], ds[idx], fs[idx], net.kn[idx], net.ks[idx],
+                                            net.tan_residual[idx])
+                broken[idx], status[idx], sign[idx], s_p[idx], mode[idx] = True, st, sg, sp, md
+                fn[idx], fs[idx] = cl.forces(dn[idx], ds[idx], st, sg, sp, net.kn[idx], net.ks[idx],
+                                             net.tan_residual[idx])
+                rows = self.dyn._rows(broken)
+            s_p = np.where(broken, cl.converged_slip(ds, status, fs, net.ks), s_p)
+            r = net.k_grain @ u + rows[0] @ fn + rows[1] @ fs
+            stress = eq.reaction_stress(r - eq.f_ext)
+            f = eq.f_ext - r
+            damped_step(u, v, f, inv_m, dt, damping)
+            closure += dt * control.speed(stress, dt)
+        self.status, self.sign, self.rows, self.closure, self.s_p = status, sign, rows, closure, s_p
+        self.fn, self.fs, self.stress, self.f = fn, fs, stress, f
+
+    def axial_strain(self) -> float:
+        return self.closure / self.net.height
+
+    def lost(self) -> bool:
+        return self.control.lost(self.stress)
+
+    def balanced(self) -> bool:
+        return (relative_force(self.net, self.f, self.fn, self.fs, self.broken) < self.dyn.params.creep.
+                equilibrium_tolerance and self.control.held(self.stress))
+
+    def settle(self) -> bool:
+        self.back = self.take_back(self.now()) if self.take_back is not None else (self.now(), None)
+        return self.back is not None
+
+    def now(self) -> State:
+        """The relaxation's state after the last step (NumericalFailure where the motion is not finite)."""
+        return self.dyn._state(self.closure, self.u, self.broken, self.status, self.sign, self.s_p, self.fn, self.fs,
+                               self.stress, self.mode)
 
 
 class InertialPath(RelaxingPath):

@@ -18,7 +18,7 @@ Measures, as YADE's jaws read them: the load P = the mean of the two jaws' react
 / D, the horizontal strain = -(change of the mean x of the nodes of the cells at the right end of the horizontal
 diameter minus that of the left end) / D (every node of those cells, as YADE averages their bodies).
 
-**Levers** (:func:`apply_levers`, :class:`grainfrac_yade.protocols.levers.Levers`), the YADE adapter's draws
+**Levers** (:func:`apply_levers`, :class:`grainfrac_yade.kernel.levers.Levers`), the YADE adapter's draws
 from the same random stream in the same order:
 
 * ``strength_cv``: each bond's J^T and J^C x one lognormal factor of mean 1 (YADE: FnMax and FsMax, the same
@@ -39,7 +39,7 @@ import numpy as np
 
 from ...errors import GrainfracError
 from ...geometry.disc import DiscTessellation
-from ...protocols.levers import PRE_EXISTING, Levers, lever_draws
+from ...kernel.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
 from .platens import StaticPlatens

@@ -16,8 +16,9 @@ import numpy as np
 
 from ...geometry.tessellation import SIDES
 from ...wave import hold_budget, scene_density
-from ...protocols.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
-from ...protocols.loading import held_at_equilibrium
+from ...kernel.confinement import BROKEN_APART_FRACTION, broken_apart_reason  # noqa: F401
+from ...kernel.equilibrium import held_at_equilibrium
+from ...kernel.held_relaxation import EQUILIBRIUM, HeldRelaxing, relax_held
 from .platens import StressServo
 
 
@@ -62,6 +63,20 @@ class Confinement:
         return float(sum(abs(f) for f in self.body_force.values()))
 
 
+class IsotropicStage(HeldRelaxing):
+    """The isotropic stage as the kernel's loop relaxes it: YADE's DEM steps, at rest where the servo holds its
+    target at equilibrium over the intact bonds (:func:`grainfrac_yade.kernel.equilibrium.held_at_equilibrium`)."""
+
+    def __init__(self, scene, servo, creep_params):
+        self.scene, self.servo, self.creep_params = scene, servo, creep_params
+
+    def advance(self, steps: int) -> None:
+        self.scene.run(steps)
+
+    def balanced(self) -> bool:
+        return held_at_equilibrium(self.scene, self.servo, np.flatnonzero(~self.scene.broken), self.creep_params)
+
+
 def young_estimate(params) -> float:
     """Area-weighted Young's modulus of the minerals (paper Table 1) [Pa]: the servo's gain estimate
     of the specimen's modulus (70 GPa for Table 1; measured specimens: 50.5 GPa raw, 69-72 GPa
@@ -72,9 +87,10 @@ def young_estimate(params) -> float:
 def consolidate(scene, platens, stress: float, params) -> dict:
     """Isotropic stage: with the confining forces on, a servo brings the axial stress to ``stress``
     [Pa] and holds it until equilibrium (mean resultant on free bodies / mean bond force below
-    ``creep.equilibrium_tolerance`` and the axial stress within ``creep.stress_tolerance``), at most
-    ``creep.max_relaxation_steps`` DEM steps (:func:`grainfrac_yade.protocols.loading.held_at_equilibrium`, as a creep run's
-    hold).  The servo's gain uses :func:`young_estimate` of ``params``; with it and the scene's density
+    ``creep.equilibrium_tolerance`` and the axial stress within ``creep.stress_tolerance``,
+    :func:`grainfrac_yade.kernel.equilibrium.held_at_equilibrium`), at most ``creep.max_relaxation_steps`` DEM
+    steps: the kernel's held-load loop (:func:`grainfrac_yade.kernel.held_relaxation.relax_held`), as a creep
+    run's hold.  The servo's gain uses :func:`young_estimate` of ``params``; with it and the scene's density
     (:func:`~grainfrac_yade.wave.scene_density`) the servo's response and the stage's step budget follow the
     creep hold's (:func:`~grainfrac_yade.wave.hold_budget`).
     The platens are left at rest.  Returns the stage's DEM steps, whether it
@@ -84,15 +100,10 @@ def consolidate(scene, platens, stress: float, params) -> dict:
     budget = hold_budget(cp, platens.height, young, scene_density(params), scene.O.dt)
     servo = StressServo(platens, stress, young, budget.servo_response_steps, cp.servo_max_strain_rate * platens.height)
     scene.drivers.append(servo)
-    done, balanced = 0, False
     try:
-        while done < budget.max_relaxation_steps:
-            scene.run(cp.check_period)
-            done += cp.check_period
-            if held_at_equilibrium(scene, servo, np.flatnonzero(~scene.broken), cp):
-                balanced = True
-                break
+        end = relax_held(IsotropicStage(scene, servo, cp), budget.max_relaxation_steps, cp.check_period)
     finally:
         scene.drivers.remove(servo)
         platens.set_axial_velocity(0.0)
-    return {"consolidation_steps": done, "consolidated": balanced, "consolidation_axial_stress_pa": servo.stress}
+    return {"consolidation_steps": end.steps, "consolidated": end.outcome == EQUILIBRIUM,
+            "consolidation_axial_stress_pa": servo.stress}

@@ -1,6 +1,6 @@
 """Stress corrosion of the scene's cohesive bonds: the YADE side of a degradation law.
 
-The law and its per-bond state are pure numpy (:class:`grainfrac_yade.protocols.corrosion.BondCorrosion`,
+The law and its per-bond state are pure numpy (:class:`grainfrac_yade.kernel.corrosion.BondCorrosion`,
 which :class:`StressCorrosion` extends).  This adapter only reads bond forces
 (:meth:`StressCorrosion.stresses`) and writes what the law says a bond can carry: ``FnMax`` and
 ``FsMax``, and ``kn``/``ks`` for a law that changes stiffness (the area law).
@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...law import MODE_CORRODED, MODE_TENSION, Stresses, check_finite
-from ...protocols.corrosion import STATE_KEYS, BondCorrosion  # noqa: F401
+from ...kernel.corrosion import STATE_KEYS, BondCorrosion  # noqa: F401
 from .scene import SHEAR
 
 #: Relative margin below the current load given to a bond that has reached its strength,

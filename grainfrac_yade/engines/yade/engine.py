@@ -8,7 +8,7 @@ module does not import YADE: :func:`.load_yade` does, when the first scene is bu
 The isotropic stage of a confined test (``consolidate``: a stress servo and dynamic relaxation), the
 Brazilian levers applied to a scene (``apply_levers``), the stress-corrosion bond writer of a creep test
 (``stress_corrosion(scene, sc_params, saved=None)``: reads the bond forces, writes what the degradation law
-says they can carry; the law's state is :class:`grainfrac_yade.protocols.corrosion.BondCorrosion`), yade-batch rows and the timings of ``bench`` are this engine's, listed here so that the test
+says they can carry; the law's state is :class:`grainfrac_yade.kernel.corrosion.BondCorrosion`), yade-batch rows and the timings of ``bench`` are this engine's, listed here so that the test
 protocols (:mod:`grainfrac_yade.protocols`) and the commands reach them through the engine registry and
 never import this package.
 """

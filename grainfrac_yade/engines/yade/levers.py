@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import GrainfracError
-from ...protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers, lever_draws, new_breaks  # noqa: F401
+from ...kernel.levers import LEVER_STREAM, PRE_EXISTING, Levers, lever_draws, new_breaks  # noqa: F401
 
 def apply_levers(scene, levers: Levers, seed: int) -> dict:
     """Apply ``levers`` to ``scene`` (before its first step); return what was done (counts)."""

@@ -1,12 +1,12 @@
 """Measures of a YADE scene that its drivers share: finite values, resultant forces on bodies (the mean
 bond force that unbalanced forces are measured against is engine-neutral:
-:func:`grainfrac_yade.protocols.loading.mean_bond_force`)."""
+:func:`grainfrac_yade.kernel.equilibrium.mean_bond_force`)."""
 from __future__ import annotations
 
 import numpy as np
 
 from ...law import check_finite
-from ...protocols.loading import BOND_FORCE_SAMPLE, check_value, mean_bond_force  # noqa: F401
+from ...kernel.equilibrium import BOND_FORCE_SAMPLE, check_value, mean_bond_force  # noqa: F401
 
 
 def resultant_forces(scene, body_ids) -> tuple:

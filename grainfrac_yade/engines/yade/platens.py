@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...kernel.servo import ServoLaw
+
 
 #: DOFs blocked on platen cells: y prescribed, z and all rotations blocked (pseudo-2D, flat platen).
 PLATEN_BLOCKED = {"free": "yzXYZ", "fixed": "xyzXYZ"}
@@ -149,33 +151,17 @@ def free_bodies(scene, platens) -> list:
     return [int(b) for b in scene.bodies_of(free)]
 
 
-class StressServo:
-    """Holds the axial stress at a target by moving the platens (a driver, called before each step).
-
-    The platen closing speed is set from the stress error so that the error
-    would be removed in ``response_steps`` DEM steps on a specimen of axial
-    stiffness ``young`` x cross-section / height:
-
-        v = (target - stress) * height / (young * response_steps * dt)
-
-    clipped to +-``max_speed``.
-
-    Saturation: a command clipped at +``max_speed``: the specimen carries so much less than the
-    target that the servo closes the platens as fast as it may.
-    ``clipped`` is the sign of the clip of the last command (+1 closing at the limit, -1 opening at
-    the limit, 0 within the limits); ``closing_clipped_steps`` counts the DEM steps in a row, up to
-    and including the last one, whose command was clipped closing (0 after any other command).
-    """
+class StressServo(ServoLaw):
+    """Holds the axial stress at a target by moving the platens (a driver, called before each step): the servo law
+    of :mod:`grainfrac_yade.kernel.servo` (its gain from the specimen's axial stiffness ``young`` x cross-section /
+    height and ``response_steps``, its speed within +-``max_speed``; its saturation and clip counts) on YADE's
+    platens, at YADE's DEM step."""
 
     name = "StressServo"
 
     def __init__(self, platens: Platens, target: float, young: float, response_steps: int, max_speed: float):
-        self.platens, self.target = platens, target
-        self.gain = platens.height / (young * response_steps)
-        self.max_speed = max_speed
-        self.stress = 0.0
-        self.clipped = 0
-        self.closing_clipped_steps = 0
+        super().__init__(target, platens.height / (young * response_steps), max_speed)
+        self.platens = platens
 
     @classmethod
     def restored(cls, platens: Platens, target: float, gain: float, max_speed: float, stress: float,
@@ -183,14 +169,10 @@ class StressServo:
         """A servo as a checkpoint saved it: its own ``gain`` [m/Pa], last measured ``stress`` [Pa] and
         clip state (``clipped``, ``closing_clipped_steps``)."""
         servo = cls.__new__(cls)
-        servo.platens, servo.target, servo.gain, servo.max_speed = platens, target, gain, max_speed
+        ServoLaw.__init__(servo, target, gain, max_speed)
+        servo.platens = platens
         servo.stress, servo.clipped, servo.closing_clipped_steps = stress, int(clipped), int(closing_clipped_steps)
         return servo
 
     def before_step(self, scene):
-        self.stress = self.platens.axial_stress()
-        speed = (self.target - self.stress) * self.gain / scene.O.dt
-        self.clipped = 1 if speed > self.max_speed else (-1 if speed < -self.max_speed else 0)
-        self.closing_clipped_steps = self.closing_clipped_steps + 1 if self.clipped == 1 else 0
-        # min/max, not np.clip: the same double, without numpy's per-call overhead (3 % of a creep run's time)
-        self.platens.set_axial_velocity(float(min(max(speed, -self.max_speed), self.max_speed)))
+        self.platens.set_axial_velocity(float(self.command(self.platens.axial_stress(), scene.O.dt)))

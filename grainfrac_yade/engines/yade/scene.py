@@ -34,7 +34,7 @@ from ...grains import GrainModel, layout_for, model_of
 from ...law import MODE_NEVER, MODE_SHEAR, MODE_TENSION
 from ...layout import BondProperties, ClumpLayout, bond_properties
 from ...params import Parameters
-from ...protocols.cracks import bond_is_inter
+from ...kernel.cracks import bond_is_inter
 from ...geometry.specimen import Specimen
 from . import fem_cells, load_yade, rigid_cells
 from .confinement import Confinement
