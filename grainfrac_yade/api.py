@@ -40,7 +40,7 @@ EXPORTS = {
     "CreepRun": "grainfrac_yade.protocols.creep", "TimedCreepRun": "grainfrac_yade.protocols.timed_creep",
     "run_ucs_to_folder": "grainfrac_yade.protocols.ucs_output",
     "run_brazilian_to_folder": "grainfrac_yade.protocols.brazilian_output",
-    "Levers": "grainfrac_yade.protocols.levers", "mean_bond_force": "grainfrac_yade.protocols.loading",
+    "Levers": "grainfrac_yade.kernel.levers", "mean_bond_force": "grainfrac_yade.kernel.equilibrium",
     "scene_density": "grainfrac_yade.wave",
     "engine": "grainfrac_yade.engines.registry", "engine_for": "grainfrac_yade.engines.registry",
     "elastic_summary": "grainfrac_yade.elastic",
