@@ -47,7 +47,7 @@ def test_without_a_stint_the_hybrid_path_is_the_static_one():
             stress.append(pl.axial_stress())
         paths[name] = (np.array(stress), scene.broken.copy(), scene.state.u.copy())
         if name == "hybrid":
-            assert scene.stints == [] and scene.summary_keys()["dynamic_stints"] == 0
+            assert scene.strategy.stints == [] and scene.summary_keys()["dynamic_stints"] == 0
     (sa, ba, ua), (sb, bb, ub) = paths["static"], paths["hybrid"]
     assert np.array_equal(sa, sb) and np.array_equal(ba, bb) and np.array_equal(ua, ub)
 
@@ -177,11 +177,11 @@ def test_a_hybrid_creep_killed_after_a_stint_resumes_to_the_uninterrupted_run(tm
     p = load_parameters(overrides=["specimen.width=4e-3", "specimen.height=8e-3", "numerics.engine=hybrid",
                                    "numerics.handover_cascade_bonds=2", "numerics.checkpoint_interval=1e-9"])
     whole, resumed = run_killed_and_resumed(tmp_path, monkeypatch, p, 3, 160e6,
-                                            lambda run, written: bool(run.scene.stints))
-    assert len(whole.scene.stints) >= 1
+                                            lambda run, written: bool(run.scene.strategy.stints))
+    assert len(whole.scene.strategy.stints) >= 1
     assert_resumed_as_whole(resumed, whole)
-    strip = [{k: v for k, v in s.items() if k != "cpu_s"} for s in whole.scene.stints]
-    assert [{k: v for k, v in s.items() if k != "cpu_s"} for s in resumed.scene.stints] == strip
+    strip = [{k: v for k, v in s.items() if k != "cpu_s"} for s in whole.scene.strategy.stints]
+    assert [{k: v for k, v in s.items() if k != "cpu_s"} for s in resumed.scene.strategy.stints] == strip
 
 
 def test_the_hybrid_relaxes_by_its_stints_not_by_the_static_relaxation():

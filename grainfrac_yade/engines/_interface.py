@@ -185,6 +185,12 @@ class Scene(Protocol):
         """The numerical damping of relaxation from here on (YADE: Cundall's non-viscous damping coefficient);
         an engine that solves for equilibrium ignores it."""
 
+    def lose_load_below(self, ratio: float | None) -> None:
+        """The test's post-peak rule under displacement control, given by the protocol: a relaxation the engine runs
+        with the platens held (a static engine's where its static path gives out) ends as the specimen's failure
+        once the platen stress falls below ``ratio`` x the stress it started from (None: never).  An engine whose
+        loading is itself dynamic ignores it (the protocol reads the drop off its rows)."""
+
     # ------------------------------------------------------------------ bonds
     def bond_forces(self, indices=None) -> tuple:
         """(normal force, tension positive; shear force magnitude) [N] of bonds ``indices`` (all: None)."""

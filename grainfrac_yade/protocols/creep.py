@@ -137,6 +137,8 @@ class CreepRun:
         self.engine = engine_for(params)
         self.scene = self.engine.build_scene(specimen, params)
         self.platens = self.scene.attach_platens(params.ucs.platen_lateral)
+        # the ramp loads as the UCS test does (its platens, its post-peak rule for a relaxation with them held)
+        self.scene.lose_load_below(params.ucs.stop_stress_ratio)
         #: side-wall forces of a confined test (``confinement.stress`` > 0), else None
         self.confinement = None
         #: the isotropic stage of a confined test (the engine's ``consolidate``): steps, equilibrium

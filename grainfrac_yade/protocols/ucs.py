@@ -51,6 +51,8 @@ class UcsRun(LoadingCheckpoints, LoadingTest):
         self.scene = scene = scene or self.engine.build_scene(specimen, params)
         ucs = params.ucs
         self.platens = platens = scene.attach_platens(ucs.platen_lateral)
+        # the post-peak rule is the test's: a relaxation with the platens held loses the load below it
+        scene.lose_load_below(ucs.stop_stress_ratio)
         self.closing_speed = ucs.strain_rate * platens.height
         platens.set_axial_velocity(self.closing_speed)
         self.steps_per_row = max(1, int(round(ucs.record_strain_increment / (ucs.strain_rate * scene.dt))))

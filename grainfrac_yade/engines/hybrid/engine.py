@@ -1,7 +1,10 @@
 """The hybrid engine: what :func:`grainfrac_yade.engines.registry.engine` returns for ``numerics.engine = "hybrid"``.
 
-The static engine's scene, tests and bond writer (:mod:`grainfrac_yade.engines.static.engine`), with dynamic stints on
-YADE where statics give out (:class:`.scene.HybridScene`).  Between stints nothing moves in time: the paper clock
+The static engine's scene, tests and bond writer (:mod:`grainfrac_yade.engines.static.engine`), the scene with the
+relaxation strategy of dynamic stints on YADE where statics give out (:class:`.stints.DynamicStints`): the static
+engine with that strategy.  This module composes the two engines: the stints get YADE's engine module by name
+from the registry's dynamic engines (:func:`grainfrac_yade.engines.dynamic.dynamic_engine`, at the first stint),
+never by importing ``engines/yade/``.  Between stints nothing moves in time: the paper clock
 (Eq. 8 measures an unbalanced force at every creep step) is refused as on the static engine.  The dynamic settings
 (damping, mass scaling, the servo and the relaxation budgets) are used by the stints, so none is reported unused;
 the static engine's relaxation settings are not (:mod:`.settings`).
@@ -13,11 +16,16 @@ from ..static.engine import (VTK_REFUSED,  # noqa: F401
                              apply_levers, consolidate, stress_corrosion)
 from ..static.engine import UNSUPPORTED as STATIC_UNSUPPORTED
 from ..static.engine import version as static_version
-from .scene import HybridScene, build_scene, scene_from_state  # noqa: F401
+from ..static.scene import StaticScene
+from ..dynamic import dynamic_engine
+from .stints import DynamicStints
 from .settings import warn_not_used
 
 #: The value of ``numerics.engine`` that selects this engine.
 NAME = "hybrid"
+#: The engine of the dynamic stints (a name of :data:`grainfrac_yade.engines.dynamic.DYNAMIC_ENGINE_MODULES`),
+#: imported at the first stint.
+DYNAMIC_ENGINE = "yade"
 #: No time integration between stints: no unbalanced force for the paper clock.
 DYNAMIC = False
 #: Commands the hybrid engine cannot run -> the one line that says so and the fix: the static engine's, and the
@@ -36,3 +44,17 @@ def warn_dynamic_only(overrides, params) -> list:
     """The dynamic stints read every dynamic setting; the static relaxation's settings are not read
     (:mod:`.settings`)."""
     return warn_not_used(overrides)
+
+
+def build_scene(specimen, params, layout=None) -> StaticScene:
+    """The hybrid scene of ``specimen`` (rigid or fem cells): a static scene with the strategy of dynamic stints on
+    :data:`DYNAMIC_ENGINE`."""
+    return StaticScene(specimen, params, layout, DynamicStints(lambda: dynamic_engine(DYNAMIC_ENGINE)))
+
+
+def scene_from_state(specimen, params, state, layout=None) -> StaticScene:
+    """A hybrid scene of ``specimen`` in ``state`` (a :class:`grainfrac_yade.engines.SceneState` of any engine), the
+    static equilibrium solved there."""
+    scene = build_scene(specimen, params, layout)
+    scene.apply_state(state)
+    return scene

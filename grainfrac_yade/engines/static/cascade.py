@@ -77,6 +77,10 @@ class Path:
         self.last_converged = None
         #: bonds one cascade may break before :class:`LargeCascade` is raised; None: no limit (the static engine)
         self.max_cascade = None
+        #: the test's post-peak rule under displacement control, as the scene was given it
+        #: (:meth:`.strategy.RelaxationHooks.lose_load_below`): a relaxation with the platens held loses the load
+        #: below this ratio of the stress it started from; None: never (a path that does not relax ignores it)
+        self.load_loss_ratio = None
 
     # ------------------------------------------------------------------ ratios and the tie rule
     def ratios(self, state: State):

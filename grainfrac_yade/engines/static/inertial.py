@@ -122,12 +122,13 @@ class HeldServo(ServoLaw):
 
 class FixedPlatens:
     """The platens held where they are (displacement control: the UCS path, a ramp): no servo; the load is lost
-    once the platen stress falls below ``stop_below`` [Pa] (the UCS test's post-peak rule)."""
+    once the platen stress falls below ``stop_below`` [Pa] (the test's post-peak rule, as the protocol gave it to
+    the scene; None: never)."""
 
     watch = None
 
-    def __init__(self, stop_below: float):
-        self.stop_below, self.stress = float(stop_below), 0.0
+    def __init__(self, stop_below):
+        self.stop_below, self.stress = (None if stop_below is None else float(stop_below)), 0.0
 
     def speed(self, stress: float, dt: float) -> float:
         self.stress = stress
@@ -137,7 +138,7 @@ class FixedPlatens:
         return True
 
     def lost(self, stress: float) -> bool:
-        return stress < self.stop_below
+        return self.stop_below is not None and stress < self.stop_below
 
 
 class InertialRelaxation:
@@ -296,7 +297,8 @@ class InertialPath(RelaxingPath):
     (``numerics.static_relaxation = "inertial"``): under a held load (a creep hold's regain) with the creep
     protocol's servo, and under displacement control (the UCS path, a ramp) with the platens held where the path
     stood, as a YADE stint of the hybrid engine would (the specimen failing there once the stress falls below
-    ``ucs.stop_stress_ratio`` of the stint's start).  A relaxed state goes back to the static path by the static
+    :attr:`load_loss_ratio` of the relaxation's start: the test's post-peak rule, which the protocol gives the scene,
+    :meth:`.strategy.RelaxationHooks.lose_load_below`).  A relaxed state goes back to the static path by the static
     equilibrium at its closure (and, under a held load, the plain regain: :meth:`take_back`).  Relaxations are
     tallied as the overdamped ones (their steps are DEM steps; "unsettled": take-backs that gave out)."""
 
@@ -359,7 +361,7 @@ class InertialPath(RelaxingPath):
         finally:
             self._in_move = False
         dyn, c0 = self.dynamics, time.process_time()
-        stop = dyn.params.ucs.stop_stress_ratio * start.stress
+        stop = None if self.load_loss_ratio is None else self.load_loss_ratio * start.stress
         state, reason, steps, gave_out, broken = dyn.relax(
             start, FixedPlatens(stop), self.jt, self.jc, lambda s: self.take_back(s, None, FailureRule(0.0),
                                                                                   start.closure))

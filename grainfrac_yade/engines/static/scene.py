@@ -58,6 +58,7 @@ from .network import build_static_network
 from .scene_state import SceneStateExchange
 from .settings import summary_keys
 from .solver import Equilibrium, State
+from .strategy import RelaxationHooks, SceneRelaxation
 
 #: Fields of the core's converged state that a save keeps (arrays over bonds in canonical order, or scalars).
 STATE_FIELDS = ("closure", "u", "broken", "status", "sign", "s_p", "fn", "fs", "stress", "break_mode", "held",
@@ -92,16 +93,15 @@ STIFFNESS_LAW_REFUSED = ("static engine: the creep hold follows laws that lower 
 VTK_REFUSED = ""
 
 
-class StaticScene(SceneStateExchange):
-    """A specimen's static scene (module doc); bond arrays of the interface in the layout's order."""
+class StaticScene(SceneStateExchange, RelaxationHooks):
+    """A specimen's static scene (module doc); bond arrays of the interface in the layout's order.  ``strategy``:
+    what it does where the plain static solve gives out (:class:`.strategy.SceneRelaxation`; default the plain one,
+    the path relaxing by ``numerics.static_relaxation``)."""
 
-    #: The engine a checkpoint of this scene names (a checkpoint is resumed by the engine that wrote it).
-    engine_name = "static"
-    #: The static path's relaxation (:data:`.paths.PATHS`); None: ``numerics.static_relaxation``.
-    relaxation = None
-
-    def __init__(self, specimen, params, layout=None):
+    def __init__(self, specimen, params, layout=None, strategy: SceneRelaxation | None = None):
         self.specimen, self.params = specimen, params
+        #: the scene's relaxation strategy (:mod:`.strategy`)
+        self.strategy = strategy or SceneRelaxation()
         self.layout = layout or layout_for(specimen, params)
         self.net = build_static_network(specimen, params, self.layout)
         m = self.net.n_bonds
@@ -110,7 +110,7 @@ class StaticScene(SceneStateExchange):
         self.canon[self.net.order] = np.arange(m)
         self.confinement_stress = 0.0
         self.eq = Equilibrium(self.net)
-        self.path = path_for(self.eq, params, 0.0, self.masses, self.relaxation)
+        self.path = path_for(self.eq, params, 0.0, self.masses, self.strategy.path_relaxation)
         self.drivers = []
         self._dt = load_increment(params)
         self._time = 0.0
@@ -128,6 +128,13 @@ class StaticScene(SceneStateExchange):
         #: canonical bonds the creep law took to their failure point, broken at the next solve if the cascade did not
         self.hold_pending = np.zeros(0, np.int64)
         self.hold_rule = FailureRule(params.creep.collapse_strain_increment)
+        self.strategy.attach(self)
+
+    @property
+    def engine_name(self) -> str:
+        """The engine a checkpoint of this scene names (a checkpoint is resumed by the engine that wrote it): its
+        strategy's."""
+        return self.strategy.engine_name
 
     # ------------------------------------------------------------------ counters
     @property
@@ -166,7 +173,11 @@ class StaticScene(SceneStateExchange):
 
     def move_to(self, closure: float) -> None:
         """Follow the path to ``closure`` [m] (breaks at their crossings, cascades); the bookkeeping synced.  A
-        closure behind the current one (opening platens) is solved directly, with the cascade there."""
+        closure behind the current one (opening platens) is solved directly, with the cascade there.  Through the
+        strategy (:meth:`.strategy.SceneRelaxation.move`)."""
+        self.strategy.move(self, lambda: self._follow(closure))
+
+    def _follow(self, closure: float) -> None:
         if closure >= self.state.closure:
             state = self.path.run_closure(self.state, closure)
         else:
@@ -196,17 +207,21 @@ class StaticScene(SceneStateExchange):
         """Under the held stress: the cascade of what is at its strength at the reached closure (the bonds handed
         over by the creep law among it), then the path back to the held stress (:meth:`.cascade.Path.hold`, with the
         failure rule of :mod:`.failure`); a stress above it (the ramp's overshoot) unloaded to it first.  Once the
-        rule says the load cannot be regained, nothing moves any more (module doc)."""
+        rule says the load cannot be regained, nothing moves any more (module doc).  Through the strategy
+        (:meth:`.strategy.SceneRelaxation.hold`); the creep law's hand-overs are kept until a regain succeeds."""
+        self.strategy.hold(self, lambda: self._regain(n_steps))
+
+    def _regain(self, n_steps: int) -> None:
         servo = next((d for d in self.drivers if isinstance(d, StaticServo)), None)
         if not self.hold_failure:
             state = self.path.cascade(self.state)
             for c in self.hold_pending:
                 if not state.broken[c]:
                     state = self.path.cascade(state, first=int(c))
-            self.hold_pending = np.zeros(0, np.int64)
             state = self._unload(state, self.hold_target)
             state, reason = self.path.hold(state, self.hold_target, self.hold_rule)
             self._take(state)
+            self.hold_pending = np.zeros(0, np.int64)
             self.hold_failure = reason or ""
         if servo is not None:
             servo.count(n_steps)
@@ -360,7 +375,8 @@ class StaticScene(SceneStateExchange):
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
-        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.relaxation)
+        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.strategy.path_relaxation)
+        self.path.load_loss_ratio = self.load_loss_ratio
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)
         self.state = self.eq.solve(self.state.closure, self.state)
@@ -373,6 +389,7 @@ class StaticScene(SceneStateExchange):
         for d in self.drivers:
             if hasattr(d, "summary_keys"):
                 keys.update(d.summary_keys())
+        keys.update(self.strategy.summary_keys(self))
         return keys
 
     def engine_names(self) -> list:
@@ -393,6 +410,7 @@ class StaticScene(SceneStateExchange):
                    hold_target=np.float64(math.nan if self.hold_target is None else self.hold_target),
                    hold_failure=np.str_(self.hold_failure), hold_pending=self.hold_pending)
         out.update(self.path.saved_arrays())
+        out.update(self.strategy.saved_arrays())
         return out
 
     def save(self, path) -> None:
@@ -429,6 +447,7 @@ class StaticScene(SceneStateExchange):
         self.hold_target = None if math.isnan(target) else target
         self.hold_failure = str(a["hold_failure"]) if "hold_failure" in a else ""
         self.hold_pending = a["hold_pending"].astype(np.int64) if "hold_pending" in a else np.zeros(0, np.int64)
+        self.strategy.restore_arrays(a)
 
     def checkpoint_state(self) -> dict:
         return {"n_bodies": int(len(self.net.node_pos)), "n_bonds": self.n_bonds, "engine": self.engine_name}

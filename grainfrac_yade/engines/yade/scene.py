@@ -340,6 +340,9 @@ class GrainScene:
         """Cundall's non-viscous damping of the integrator from here on (``NewtonIntegrator.damping``)."""
         self.newton.damping = damping
 
+    def lose_load_below(self, ratio) -> None:
+        """Ignored: YADE's loading is dynamic throughout, and the protocol reads a post-peak drop off its rows."""
+
     def confine(self, stress: float) -> Confinement:
         """Confining stress sigma_3 [Pa] on the side walls (:class:`.confinement.Confinement`: permanent forces)."""
         confinement = Confinement(self, stress)

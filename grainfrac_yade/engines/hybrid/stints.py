@@ -1,10 +1,12 @@
-"""The hybrid engine's scene: the static scene, with YADE's dynamic relaxation where statics give out.
+"""The hybrid engine's relaxation strategy of the static scene: YADE's dynamic relaxation where statics give out.
 
-:class:`HybridScene` is a :class:`grainfrac_yade.engines.static.scene.StaticScene` (the protocols drive it the same way:
-displacement control along the sequentially linear path, the held platen stress of a creep hold) that hands its
-state to the dynamic engine (YADE's engine module, :mod:`grainfrac_yade.engines.yade.engine`, looked up by name at the
-first stint, :func:`grainfrac_yade.engines.dynamic.dynamic_engine`; through the engine-neutral
-:class:`grainfrac_yade.engines.SceneState`) at two points:
+:class:`DynamicStints` is a relaxation strategy of :class:`grainfrac_yade.engines.static.scene.StaticScene`
+(:class:`grainfrac_yade.engines.static.strategy.SceneRelaxation`: the protocols drive the scene as a static one,
+displacement control along the sequentially linear path, the held platen stress of a creep hold).  Where the plain
+static solve gives out it hands the scene's state to a dynamic engine (YADE's, given by the hybrid engine module
+that composes the two, :mod:`.engine`; through the engine-neutral :class:`grainfrac_yade.engines.SceneState`) and
+puts the outcome back through the scene's public hooks (:class:`grainfrac_yade.engines.static.strategy.
+RelaxationHooks`).  It hands over at two points:
 
 * **the static equilibrium gives out**: no set of frictional contact statuses settles (the core's
   :class:`~grainfrac_yade.errors.NumericalFailure`; frictional equilibria with non-associated slip need not be
@@ -25,40 +27,38 @@ the servo saturated while the axial strain grows by ``creep.collapse_strain_incr
 At equilibrium (or, with the platens fixed, at the end of the budget) what the stint reached comes back: YADE's
 relaxed state itself (nodes, broken set, each broken contact's shear reference from YADE's shear force), the static
 equilibrium solved there; where that does not settle, the bonds YADE broke, in its order, each broken alone in the
-static state the stint started from (:meth:`HybridScene._take_back`); then the static cascade, and a held stress is
+static state the stint started from (:meth:`DynamicStints._take_back`); then the static cascade, and a held stress is
 regained along the static path.  A stint after such unsettled hand-backs runs :data:`RETRY_CROSSINGS` wave crossings
-more per one in a row.  Under a held
-stress a collapse (or no equilibrium within the budget) ends the hold as the static failure rule does
-(:attr:`hold_failure`), with the broken set YADE reached.  With the platens fixed, a stint whose stress falls
-below ``ucs.stop_stress_ratio`` x the stress it started from (the UCS test's own post-peak rule) is the specimen
-failing: its state (stress, broken set) is the scene's last, and the static path does not go on
-(:attr:`dynamic_end`).  Inertia is thus simulated only where the static path cannot go on.
+more per one in a row.  Under a held stress a collapse (or no equilibrium within the budget) ends the hold as the
+static failure rule does (the scene's ``hold_failure``), with the broken set YADE reached.  With the platens fixed,
+a stint whose stress falls below the test's post-peak ratio x the stress it started from (the ratio the protocol
+gave the scene, its ``load_loss_ratio``: the UCS test's ``ucs.stop_stress_ratio``) is the specimen failing: its
+state (stress, broken set) is the scene's last, and the static path does not go on (:attr:`DynamicStints.
+dynamic_end`).  Inertia is thus simulated only where the static path cannot go on.
 
 Not bit-reproducible between processes once a stint ran (YADE sums fem node forces in an order keyed by memory
 address, docs/studies/paper_fem.md); a run without stints is the static engine's, bit for bit.  Every stint is
-logged (:attr:`stints`) and summarised in summary.json (:meth:`summary_keys`); its log names the budget it ran
-under in YADE's DEM steps (one wave crossing, the servo's response, the relaxation budget): the summary's
-``wave_crossing_steps``, ``servo_response_steps_used`` and ``max_relaxation_steps_used`` are the creep protocol's,
-counted in the static scene's load increments, not YADE's.
+logged (:attr:`DynamicStints.stints`) and summarised in summary.json (:meth:`DynamicStints.summary_keys`); its log
+names the budget it ran under in YADE's DEM steps (one wave crossing, the servo's response, the relaxation budget):
+the summary's ``wave_crossing_steps``, ``servo_response_steps_used`` and ``max_relaxation_steps_used`` are the creep
+protocol's, counted in the static scene's load increments, not YADE's.  This module imports no engine but the
+static one's strategy interface.
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import time
 
 import numpy as np
 
-from .._interface import SceneState
 from ...errors import NumericalFailure
 from ...kernel.equilibrium import held_at_equilibrium, relaxed
 from ...kernel.held_relaxation import HeldRelaxing, collapse_watch, relax_held
 from ..static.cascade import LargeCascade
-from ..static.scene import StaticScene
+from ..static.strategy import SceneRelaxation
 from .settings import not_used_settings
 from ...wave import hold_budget, scene_density
-from ..dynamic import dynamic_engine
 
 #: Dynamic stints one static solve may call before the run ends as a numerical failure [1]: each stint leaves a
 #: new broken set; where statics give out again at once, three stints in a row say that the hand-back does not
@@ -72,10 +72,6 @@ RETRY_CROSSINGS = 1.0
 #: Smallest axial strain taken for the secant modulus that sets the servo's gain and the wave-crossing budget [1]
 #: (the creep protocol's floor, so that a hand-over at zero strain still has a finite modulus).
 SERVO_STRAIN_FLOOR = 1e-6
-
-#: The engine of the dynamic stints (a name of :data:`grainfrac_yade.engines.dynamic.DYNAMIC_ENGINE_MODULES`),
-#: imported at the first stint.
-DYNAMIC_ENGINE = "yade"
 
 
 class Stint(HeldRelaxing):
@@ -113,64 +109,69 @@ class Stint(HeldRelaxing):
         return relaxed(self.dyn, intact, self.creep_params)
 
 
-class HybridScene(StaticScene):
-    """A static scene whose solves hand over to YADE's dynamics where statics give out (module doc)."""
+class DynamicStints(SceneRelaxation):
+    """The hybrid engine's relaxation strategy of a static scene (:class:`grainfrac_yade.engines.static.strategy.
+    SceneRelaxation`; module doc): where its plain static solve gives out, a dynamic stint on the engine that
+    ``dynamic_engine()`` returns (YADE's engine module, looked up at the first stint), its outcome put back through
+    the scene's hooks (:class:`grainfrac_yade.engines.static.strategy.RelaxationHooks`)."""
 
     engine_name = "hybrid"
     #: Where statics give out, the plain static path gives out and YADE's dynamic stint relaxes instead
     #: (``numerics.static_relaxation`` is not read).
-    relaxation = "none"
+    path_relaxation = "none"
 
-    def __init__(self, specimen, params, layout=None):
-        super().__init__(specimen, params, layout)
-        self.path.max_cascade = params.numerics.handover_cascade_bonds or None
+    def __init__(self, dynamic_engine):
+        #: () -> the dynamic engine module of the stints (called at each stint)
+        self.dynamic_engine = dynamic_engine
         #: one dict per dynamic stint: why, where, outcome, DEM steps, bonds broken in it, CPU [s]
         self.stints: list[dict] = []
         #: why the specimen failed in a stint with the platens fixed ("" while it has not): its stress fell below
-        #: ``ucs.stop_stress_ratio`` x the stress the stint started from (the UCS test's own post-peak rule)
+        #: the test's post-peak ratio x the stress the stint started from (the scene's ``load_loss_ratio``)
         self.dynamic_end = ""
         #: stints in a row whose state the static path could not go on from (each next stint runs longer)
         self.unsettled_hand_backs = 0
 
+    def attach(self, scene) -> None:
+        """A cascade above ``numerics.handover_cascade_bonds`` bonds gives out to a stint (0: never)."""
+        scene.limit_cascade(scene.params.numerics.handover_cascade_bonds or None)
+
     # ------------------------------------------------------------------ the two solves that may hand over
-    def move_to(self, closure: float) -> None:
+    def move(self, scene, solve) -> None:
         if self.dynamic_end:
             raise NumericalFailure(f"hybrid: the static path cannot go on from a specimen that failed in a dynamic "
                                    f"stint ({self.dynamic_end})")
         for _ in range(MAX_STINTS_PER_SOLVE + 1):
             try:
-                super().move_to(closure)
+                solve()
                 self.unsettled_hand_backs = 0
                 return
             except (NumericalFailure, LargeCascade) as exc:
-                self._attempt(exc, held=False)
+                self._attempt(scene, exc, held=False)
                 if self.dynamic_end:
                     return
         raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static path "
-                               f"a state it can go on from (closure {self.state.closure:.6g} m)")
+                               f"a state it can go on from (closure {scene.state.closure:.6g} m)")
 
-    def hold(self, n_steps: int = 1) -> None:
+    def hold(self, scene, solve) -> None:
         for _ in range(MAX_STINTS_PER_SOLVE + 1):
-            pending = self.hold_pending.copy()
             try:
-                super().hold(n_steps)
+                solve()
                 self.unsettled_hand_backs = 0
                 return
             except (NumericalFailure, LargeCascade) as exc:
-                self.hold_pending = pending
-                self._attempt(exc, held=True)
-                if self.hold_failure:
-                    super().hold(n_steps)     # a lost load: nothing solved, the servo counts its saturated steps
+                self._attempt(scene, exc, held=True)
+                if scene.hold_failure:
+                    solve()     # a lost load: nothing solved, the servo counts its saturated steps
                     return
         raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static hold "
-                               f"a state it can go on from (stress {self.state.stress:.6g} Pa)")
+                               f"a state it can go on from (stress {scene.state.stress:.6g} Pa)")
 
-    def _attempt(self, exc, held: bool) -> None:
+    def _attempt(self, scene, exc, held: bool) -> None:
         """A stint from where ``exc`` left the static path; its take-back may itself meet a status set that does not
         settle: the bonds taken back so far stay broken, and the caller's next solve goes on from there."""
         before = len(self.stints)
         try:
-            self._stint(exc, held, self.unsettled_hand_backs)
+            self._stint(scene, exc, held, self.unsettled_hand_backs)
         except (NumericalFailure, LargeCascade):
             if len(self.stints) == before:    # no stint ran: nothing to start it from
                 raise
@@ -180,30 +181,31 @@ class HybridScene(StaticScene):
         self.unsettled_hand_backs = 0
 
     # ------------------------------------------------------------------ the dynamic stint
-    def _stint(self, exc, held: bool, retry: int = 0) -> None:
+    def _stint(self, scene, exc, held: bool, retry: int = 0) -> None:
         """Relax YADE's scene from the state where statics gave out (module doc); the static scene takes the
         outcome back.  NumericalFailure if there is no converged state to start from (a NaN, not a status cycle)."""
-        start = exc.state if isinstance(exc, LargeCascade) else self.path.last_converged
+        start = exc.state if isinstance(exc, LargeCascade) else scene.last_converged()
         if start is None or not (math.isfinite(start.stress) and np.all(np.isfinite(start.fn))):
             raise exc
         c0 = time.process_time()
-        self._take(start)
-        pending = np.setdiff1d(self.net.order[self.hold_pending], np.flatnonzero(self.broken)) if held else \
-            np.zeros(0, np.int64)
-        self.hold_pending = np.zeros(0, np.int64)
-        platens = self._platens()
+        scene.adopt(start)
+        pending = scene.take_hand_overs()
+        if not held:
+            pending = np.zeros(0, np.int64)
+        platens = scene.attached_platens()
         log = {"reason": str(exc).split(";")[0][:200], "held": held, "closure_m": float(start.closure),
-               "stress_pa": float(start.stress), "broken_before": int(self.broken.sum()) + len(pending)}
-        dyn = dynamic_engine(DYNAMIC_ENGINE).scene_from_state(self.specimen, self.params,
-                                                              self.export_state(platens), self.layout)
+               "stress_pa": float(start.stress), "broken_before": int(scene.broken.sum()) + len(pending)}
+        dyn = self.dynamic_engine().scene_from_state(scene.specimen, scene.params, scene.export_state(platens),
+                                                     scene.layout)
         ypl = dyn.attach_platens("free")
         if len(pending):
-            _, mode = self.path.ratios(start)
-            modes = mode[self.canon[pending]]
+            modes = scene.failure_modes(start, pending)
             for m in np.unique(modes):
                 dyn.break_bonds(pending[modes == m], int(m))
         crossings = []
-        outcome, steps, servo, min_steps, budget = self._relax(dyn, ypl, start, held, retry, crossings)
+        stop_ratio = None if held else scene.load_loss_ratio
+        outcome, steps, servo, min_steps, budget = self._relax(scene, dyn, ypl, start, held, stop_ratio, retry,
+                                                               crossings)
         log.update(outcome=outcome, dem_steps=int(steps), min_dem_steps=int(math.ceil(min_steps)),
                    wave_crossing_steps=float(budget.crossing_steps),
                    servo_response_steps=int(budget.servo_response_steps) if held else None,
@@ -213,139 +215,85 @@ class HybridScene(StaticScene):
                    stress_after_pa=float(servo.stress if servo is not None else ypl.axial_stress()))
         log["cpu_s"] = time.process_time() - c0
         self.stints.append(log)
-        dropped = not held and log["stress_after_pa"] < self.params.ucs.stop_stress_ratio * log["stress_pa"]
+        dropped = stop_ratio is not None and log["stress_after_pa"] < stop_ratio * log["stress_pa"]
         if outcome == "equilibrium" and not dropped or (outcome == "budget" and not held and not dropped):
-            self._take_back(dyn, ypl, steps, log)
+            self._take_back(scene, dyn, ypl, steps, log)
             log["cpu_s"] = time.process_time() - c0
             return
         if held:
-            self.hold_failure = (f"dynamic stint: {outcome}: YADE from the static state could not hold "
-                                 f"{self.hold_target:.6g} Pa ({log['reason']})")
+            scene.fail_hold(f"dynamic stint: {outcome}: YADE from the static state could not hold "
+                            f"{scene.hold_target:.6g} Pa ({log['reason']})")
         else:
             self.dynamic_end = (f"dynamic stint: with the platens fixed the stress fell from {log['stress_pa']:.6g} to "
                                 f"{log['stress_after_pa']:.6g} Pa ({log['reason']})")
-        new = dyn.broken & ~self.broken
-        self.broken[new], self.break_mode[new] = True, dyn.break_mode[new]
-        self.break_step[new] = self.steps
         # the platens as the stint left them: the run's last row shows the load the specimen kept
-        closure = self.state.closure + (ypl.axial_strain() * self.net.height)
-        self.state = dataclasses.replace(self.state, closure=closure, stress=log["stress_after_pa"])
-        self._steps_offset += int(steps)
+        scene.take_lost_load(dyn.broken, dyn.break_mode, ypl.axial_strain() * scene.height, log["stress_after_pa"],
+                             steps)
 
-    def _relax(self, dyn, platens, start, held: bool, retry: int = 0, crossings=None):
+    def _relax(self, scene, dyn, platens, start, held: bool, stop_ratio, retry: int = 0, crossings=None):
         """YADE's relaxation under the protocol's control, with the creep protocol's criteria: (outcome, DEM steps,
         servo or None, the DEM steps before the equilibrium check may end it: ``numerics.stint_min_crossings`` wave
         crossings, or :data:`RETRY_CROSSINGS` per ``retry`` where more, and the stint's
-        :class:`~grainfrac_yade.wave.HoldBudget` in YADE's DEM steps); outcome "equilibrium", "collapse" (a held load), "lost load" (fixed platens: the stress below
-        ``ucs.stop_stress_ratio`` x the stint's start, the UCS test's post-peak rule) or "budget" (none of these
-        within the relaxation budget).  ``crossings`` (a list) receives the bonds YADE broke in each elastic wave
-        crossing of the stint, read at the first check past each crossing's end (the last entry: the part-crossing
-        the stint ended in)."""
-        cp = self.params.creep
-        strain = max(start.closure / self.net.height, SERVO_STRAIN_FLOOR)
+        :class:`~grainfrac_yade.wave.HoldBudget` in YADE's DEM steps); outcome "equilibrium", "collapse" (a held
+        load), "lost load" (fixed platens: the stress below ``stop_ratio`` x the stint's start, the test's post-peak
+        rule; None: never) or "budget" (none of these within the relaxation budget).  ``crossings`` (a list)
+        receives the bonds YADE broke in each elastic wave crossing of the stint, read at the first check past each
+        crossing's end (the last entry: the part-crossing the stint ended in)."""
+        params = scene.params
+        cp, height = params.creep, scene.height
+        strain = max(start.closure / height, SERVO_STRAIN_FLOOR)
         young = max(start.stress, 0.0) / strain
-        budget = hold_budget(cp, self.net.height, young, scene_density(self.params), dyn.dt)
+        budget = hold_budget(cp, height, young, scene_density(params), dyn.dt)
         servo = watch = None
         if held:
-            servo = platens.hold_stress(self.hold_target, young, budget.servo_response_steps,
-                                        cp.servo_max_strain_rate * self.net.height)
+            servo = platens.hold_stress(scene.hold_target, young, budget.servo_response_steps,
+                                        cp.servo_max_strain_rate * height)
             watch = collapse_watch(cp, platens.axial_strain())
         else:
             platens.set_axial_velocity(0.0)
         if cp.relaxation_damping > 0:
             dyn.relaxation_damping(cp.relaxation_damping)
-        min_steps = max(self.params.numerics.stint_min_crossings, retry * RETRY_CROSSINGS) * budget.crossing_steps
+        min_steps = max(params.numerics.stint_min_crossings, retry * RETRY_CROSSINGS) * budget.crossing_steps
         stint = Stint(dyn, platens, servo, cp, budget.crossing_steps,
-                      None if held else self.params.ucs.stop_stress_ratio * start.stress,
+                      None if stop_ratio is None else stop_ratio * start.stress,
                       [] if crossings is None else crossings)
         end = relax_held(stint, budget.max_relaxation_steps, cp.check_period, watch=watch,
                          collapse_stress_ratio=cp.collapse_stress_ratio, min_steps=min_steps)
         stint.crossings.append(int(dyn.broken.sum()) - stint.counted)
         return end.outcome, end.steps, servo, min_steps, budget
 
-    def _take_back(self, dyn, platens, dem_steps: int, log: dict) -> None:
-        """What the stint reached, into the static scene: first YADE's relaxed state itself (:meth:`_take_state`);
-        where the static equilibrium does not settle from it, the bonds YADE broke, into the static state the stint
-        started from (:meth:`_take_breaks`).  ``log["taken_back"]`` names the way that worked.  The counters go on
-        (steps: equilibria and the stint's DEM steps; time: the load parameter, DEM time not added)."""
-        self._steps_offset += int(dem_steps)
-        saved = (self.state, self.path.jt.copy(), self.path.jc.copy(), self.broken.copy(), self.break_mode.copy(),
-                 self.break_step.copy(), self._steps_offset)
+    def _take_back(self, scene, dyn, platens, dem_steps: int, log: dict) -> None:
+        """What the stint reached, into the static scene: first YADE's relaxed state itself
+        (:meth:`~grainfrac_yade.engines.static.strategy.RelaxationHooks.take_relaxed_state`); where the static
+        equilibrium does not settle from it, the bonds YADE broke, into the static state the stint started from
+        (:meth:`~grainfrac_yade.engines.static.strategy.RelaxationHooks.take_breaks`).  ``log["taken_back"]`` names
+        the way that worked.  The counters go on (steps: equilibria and the stint's DEM steps; time: the load
+        parameter, DEM time not added)."""
+        scene.add_steps(dem_steps)
         try:
-            self._take_state(dyn.export_state(platens))
+            scene.take_relaxed_state(dyn.export_state(platens))
             log["taken_back"] = "state"
             return
         except (NumericalFailure, LargeCascade):
-            (self.state, self.path.jt, self.path.jc, self.broken, self.break_mode, self.break_step,
-             self._steps_offset) = saved
-        self._take_breaks(dyn)
+            pass
+        scene.take_breaks(dyn.broken, dyn.break_step, dyn.break_mode)
         log["taken_back"] = "breaks"
 
-    def _take_state(self, state: SceneState) -> None:
-        """YADE's relaxed ``state``: nodes, broken set and strengths as YADE left them, each broken contact's shear
-        reference from YADE's shear force (s_p = du_s - F_s / k_s along the static tangent,
-        :mod:`grainfrac_yade.engines.static.contacts`), the static equilibrium solved there and its cascade.  With fem cells
-        a relaxed YADE state is a static equilibrium of the same model (the hand-over check: 2e-10), so the solve
-        starts settled; NumericalFailure where it does not settle (LargeCascade where its cascade grows)."""
-        net = self.net
-        _, tangent = self._bond_frame()
-        fs = (np.asarray(state.bond_shear_force) * tangent).sum(1)[net.order]
-        ds = net.ct @ self.displacements(state)
-        broken = np.asarray(state.bond_broken, bool)[net.order]
-        slip = np.empty(self.n_bonds)
-        slip[net.order] = np.where(broken, ds - fs / net.ks, 0.0)
-        back = dataclasses.replace(state, bond_slip=slip, steps=self.steps, time=self._time, platens=None)
-        self.apply_state(back)
-        self._take(self.path.cascade(self.state))
-
-    def _take_breaks(self, dyn) -> None:
-        """The bonds YADE broke, in the order it broke them (ties: canonical order), into the static state the stint
-        started from, each broken alone and the static equilibrium restored at the same closure
-        (:meth:`.cascade.Path.break_bond`), then the static cascade: the static model keeps its own state and contact
-        statuses, the stint decides which bonds break."""
-        new = np.flatnonzero(dyn.broken & ~self.broken)
-        order = np.lexsort((self.canon[new], dyn.break_step[new]))
-        state = self.state
-        try:
-            for k in new[order]:
-                state = self.path.break_bond(state, int(self.canon[k]), int(dyn.break_mode[k]))
-            state = self.path.cascade(state)
-        finally:
-            self._take(state)
-
     # ------------------------------------------------------------------ records
-    def summary_keys(self) -> dict:
+    def summary_keys(self, scene) -> dict:
         """The engine's name, no unused settings (the stints use the dynamic ones), and the stints' totals and log."""
-        keys = super().summary_keys()
-        keys.update({"engine": self.engine_name, "settings_not_used": not_used_settings(self.params),
-                     "dynamic_stints": len(self.stints),
-                     "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
-                     "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
-                     "dynamic_stint_log": list(self.stints),
-                     "engine_failure_reason": self.hold_failure or self.dynamic_end})
-        return keys
+        return {"engine": self.engine_name, "settings_not_used": not_used_settings(scene.params),
+                "dynamic_stints": len(self.stints),
+                "dynamic_stint_dem_steps": int(sum(s["dem_steps"] for s in self.stints)),
+                "dynamic_stint_cpu_s": float(sum(s["cpu_s"] for s in self.stints)),
+                "dynamic_stint_log": list(self.stints),
+                "engine_failure_reason": scene.hold_failure or self.dynamic_end}
 
-    def _arrays(self) -> dict:
-        out = super()._arrays()
-        out["hybrid_stints"] = np.str_(json.dumps(self.stints))
-        out["hybrid_dynamic_end"] = np.str_(self.dynamic_end)
-        return out
+    def saved_arrays(self) -> dict:
+        return {"hybrid_stints": np.str_(json.dumps(self.stints)), "hybrid_dynamic_end": np.str_(self.dynamic_end)}
 
-    def restore(self, path) -> None:
-        super().restore(path)
-        with np.load(path) as data:
-            self.stints = json.loads(str(data["hybrid_stints"])) if "hybrid_stints" in data.files else []
-            self.dynamic_end = str(data["hybrid_dynamic_end"]) if "hybrid_dynamic_end" in data.files else ""
+    def restore_arrays(self, arrays: dict) -> None:
+        self.stints = json.loads(str(arrays["hybrid_stints"])) if "hybrid_stints" in arrays else []
+        self.dynamic_end = str(arrays["hybrid_dynamic_end"]) if "hybrid_dynamic_end" in arrays else ""
 
-
-def build_scene(specimen, params, layout=None) -> HybridScene:
-    """The hybrid scene of ``specimen`` (rigid or fem cells)."""
-    return HybridScene(specimen, params, layout)
-
-
-def scene_from_state(specimen, params, state: SceneState, layout=None) -> HybridScene:
-    """A hybrid scene of ``specimen`` in ``state`` (of any engine), the static equilibrium solved there."""
-    scene = HybridScene(specimen, params, layout)
-    scene.apply_state(state)
-    return scene
 
