@@ -7,8 +7,8 @@ Three engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep
 * ``"static"``: static equilibrium between bond failures, bonds broken one at a time, relaxing where no static
   equilibrium settles (:mod:`grainfrac_yade.engines.static.engine`, pure numpy and scipy; UCS, confined, Brazilian and
   creep tests);
-* ``"hybrid"``: the static engine with YADE's dynamic stints where the statics give out
-  (:mod:`grainfrac_yade.engines.hybrid.engine`; UCS, confined and creep tests).
+* ``"hybrid"``: the static engine with the relaxation strategy of YADE's dynamic stints where the statics give
+  out (:mod:`grainfrac_yade.engines.hybrid.engine`; UCS, confined and creep tests).
 
 Every engine module offers ``NAME``, ``build_scene(specimen, params, layout=None)`` and
 ``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements
@@ -19,8 +19,8 @@ parameters; a command never imports an engine's package itself.  Adding an engin
 implementing the interface, its name in :data:`.registry.ENGINE_MODULES` and among the choices of
 ``numerics.engine`` (docs/maintainers.md).  Each engine is a sub-package beside the interface and the registry
 (``yade/``, ``static/``, ``hybrid/``) and imports only the pure core and ``_interface`` (the hybrid also the
-static engine, whose scene it extends, and YADE's by name through :mod:`.dynamic`, the registry's dynamic
-engines).  This ``__init__`` imports no engine (the registry does, by name), so that an engine may import the
+static engine, whose scene it runs with its own relaxation strategy through the scene's public hooks, and, in its
+``engine.py`` alone, YADE's by name through :mod:`.dynamic`, the registry's dynamic engines).  This ``__init__`` imports no engine (the registry does, by name), so that an engine may import the
 interface.
 """
 from __future__ import annotations

@@ -19,7 +19,7 @@ The checks run in that order at the end of every chunk of ``creep.check_period``
 :class:`HeldRelaxing` (the steps and what it measures): the creep hold and the isotropic stage on YADE's scene
 (:mod:`grainfrac_yade.protocols.creep`, :mod:`grainfrac_yade.engines.yade.confinement`), the static engine's
 inertial dynamics (:mod:`grainfrac_yade.engines.static.inertial`) and the hybrid engine's dynamic stints
-(:mod:`grainfrac_yade.engines.hybrid.scene`).  What an outcome means (a failed creep run, a stint's take-back, a
+(:mod:`grainfrac_yade.engines.hybrid.stints`).  What an outcome means (a failed creep run, a stint's take-back, a
 relaxed static state) is the caller's.
 """
 from __future__ import annotations

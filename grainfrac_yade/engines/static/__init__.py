@@ -16,6 +16,8 @@ explicit dynamic relaxation (docs/engines.md).  One module per job:
   platen closure and the return to a held load;
 * :mod:`.failure`: the physical failure rule under a held load (no equilibrium ahead, or too much strain to regain);
 * :mod:`.paths`: the registry that turns ``numerics.static_relaxation`` into the scene's path;
+* :mod:`.strategy`: the scene's relaxation strategy (what it does where the plain solve gives out: the plain one
+  here, the hybrid engine's dynamic stints) and the public hooks a strategy uses;
 * :mod:`.damped`: the overdamped relaxation where no status set settles (backward Euler, an anchor halved step by
   step);
 * :mod:`.inertial`: the inertial relaxation there (explicit small-strain dynamics of the same network under the
