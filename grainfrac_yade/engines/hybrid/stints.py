@@ -140,31 +140,33 @@ class DynamicStints(SceneRelaxation):
         if self.dynamic_end:
             raise NumericalFailure(f"hybrid: the static path cannot go on from a specimen that failed in a dynamic "
                                    f"stint ({self.dynamic_end})")
-        for _ in range(MAX_STINTS_PER_SOLVE + 1):
-            try:
-                solve()
-                self.unsettled_hand_backs = 0
-                return
-            except (NumericalFailure, LargeCascade) as exc:
-                self._attempt(scene, exc, held=False)
-                if self.dynamic_end:
-                    return
-        raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static path "
-                               f"a state it can go on from (closure {scene.state.closure:.6g} m)")
+        if not self._retried(scene, solve, held=False):
+            raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static "
+                                   f"path a state it can go on from (closure {scene.state.closure:.6g} m)")
 
     def hold(self, scene, solve) -> None:
+        if not self._retried(scene, solve, held=True):
+            raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static "
+                                   f"hold a state it can go on from (stress {scene.state.stress:.6g} Pa)")
+
+    def _retried(self, scene, solve, held: bool) -> bool:
+        """``solve()``, with a stint (:meth:`_attempt`) each time it gives out, at most :data:`MAX_STINTS_PER_SOLVE`
+        stints: True once a solve went through or a stint ended the test (a held load lost: the solve once more,
+        nothing solved, the servo counting its saturated steps; the platens fixed: :attr:`dynamic_end`); False
+        where the statics gave out after the last stint."""
         for _ in range(MAX_STINTS_PER_SOLVE + 1):
             try:
                 solve()
                 self.unsettled_hand_backs = 0
-                return
+                return True
             except (NumericalFailure, LargeCascade) as exc:
-                self._attempt(scene, exc, held=True)
-                if scene.hold_failure:
-                    solve()     # a lost load: nothing solved, the servo counts its saturated steps
-                    return
-        raise NumericalFailure(f"hybrid: {MAX_STINTS_PER_SOLVE} dynamic stints in a row did not give the static hold "
-                               f"a state it can go on from (stress {scene.state.stress:.6g} Pa)")
+                self._attempt(scene, exc, held=held)
+                if held and scene.hold_failure:
+                    solve()
+                    return True
+                if not held and self.dynamic_end:
+                    return True
+        return False
 
     def _attempt(self, scene, exc, held: bool) -> None:
         """A stint from where ``exc`` left the static path; its take-back may itself meet a status set that does not
