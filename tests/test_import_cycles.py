@@ -27,7 +27,7 @@ ALLOWED = {
              "read once by OpenBLAS and the OpenMP runtime) before anything loads it",
              ("cli", "commands._args")),
     **_group("guarded by ImportError: a cluster's batch code may predate checkpoints",
-             ("runs.slurm", "runs.runio")),
+             ("runs.slurm_states", "runs.runio")),
     **_group("cli.py sets the one-thread default of YADE's OpenMP runtime (engines.yade.use_default_threads) "
              "before anything loads it", ("cli", "engines.yade")),
     **_group(_RESTRUCTURED,
