@@ -195,7 +195,7 @@ def size_series(settings, preset, user_files, overrides, seed, stress, progress,
     static = engine("static")
     for name, width, height in settings.sizes:
         params = size_params(preset, user_files, width, height, overrides, "static")
-        net, build_cpu = static.timed_network(build_specimen(params, seed), params)
+        net, build_cpu = static.timings.timed_network(build_specimen(params, seed), params)
         progress(f"static core, {name} mm ({net.ndof} dofs): network built in {build_cpu:.2f} CPU s, ramp to "
                  f"{stress / 1e6:g} MPa")
 
@@ -203,7 +203,7 @@ def size_series(settings, preset, user_files, overrides, seed, stress, progress,
             if e["event"] % EVENT_LINES == 0:
                 progress(f"  {name} mm, event {e['event']}: {e['cpu_s']:.1f} CPU s, {e['equilibria']} equilibria, "
                          f"{e['broken']} bonds broken")
-        hold = static.timed_creep_hold(net, params, stress, settings.events, progress=event_line)
+        hold = static.timings.timed_creep_hold(net, params, stress, settings.events, progress=event_line)
         for key in ("path", "result", "times"):
             hold.pop(key)
         rows.append({"specimen": name, "width_m": width, "height_m": height, "dofs": net.ndof, "bonds": net.n_bonds,

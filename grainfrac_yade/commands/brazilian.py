@@ -128,8 +128,9 @@ def check_tensile_scale(base, scaled, factor: float):
 def run_brazilian_in_yade(rows):
     """Entry of ``yade_scripts/brazilian.py``: parameters from the batch row (or defaults); a finished row
     is skipped or stops as a UCS row does, an unfinished one with a checkpoint of this row (no levers)
-    goes on from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
-    ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.engines.yade.batch`)."""
+    goes on from it.  ``rows``: the engine's reader of the batch table
+    (its ``batch_rows``: ``read_table``, ``row_errors``, ``row_plan``, ``run_folder_name``;
+    :mod:`grainfrac_yade.engines.yade.batch`)."""
     from ..params import load_parameters
     from ..runs.runio import read_checkpoint_state
     read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name

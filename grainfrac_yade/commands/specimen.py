@@ -59,8 +59,8 @@ def run_specimen(params, seed: int, out, draw_bonds: bool = False, overwrite: bo
 
 def run_specimen_in_yade(rows):
     """Entry of ``yade_scripts/specimen.py``: parameters from the batch table; counts read from the scene
-    its engine builds.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
-    ``run_folder_name``)."""
+    its engine builds.  ``rows``: the engine's reader of the batch table
+    (its ``batch_rows``: ``read_table``, ``row_errors``, ``run_folder_name``)."""
     from ..params import load_parameters
     read_table, row_errors, run_folder_name = rows.read_table, rows.row_errors, rows.run_folder_name
     with row_errors():

@@ -70,8 +70,9 @@ def _fmt(value, unit=1e6, digits=1) -> str:
 def run_ucs_in_yade(rows):
     """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults); a finished row
     is skipped or stops as a creep row does, an unfinished one with a checkpoint of this row goes on
-    from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
-    ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.engines.yade.batch`)."""
+    from it.  ``rows``: the engine's reader of the batch table
+    (its ``batch_rows``: ``read_table``, ``row_errors``, ``row_plan``, ``run_folder_name``;
+    :mod:`grainfrac_yade.engines.yade.batch`)."""
     from ..params import load_parameters, require_plane
     read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name
     with row_errors():

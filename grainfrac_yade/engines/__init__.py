@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from importlib import import_module
 
-__all__ = ["PlatenDrive", "Scene", "SceneState"]
+__all__ = ["EngineModule", "PlatenDrive", "Scene", "SceneState"]
 
 
 def __getattr__(name):

@@ -49,8 +49,8 @@ from .measures import BOND_FORCE_SAMPLE, check_value, mean_bond_force, resultant
 INTACT, TENSION, SHEAR = MODE_NEVER, MODE_TENSION, MODE_SHEAR
 #: Material type shared by all cells: JCFpm bonds only form between equal types.
 COHESIVE_TYPE = 1
-#: The YADE side of each grain model, by ``ClumpLayout.model`` (the same names as :mod:`grainfrac_yade.grains`).
-YADE_CELLS = {"rigid": rigid_cells, "fem": fem_cells}
+#: The YADE side of each grain model, by the name of the model it builds (its ``MODEL``, :mod:`grainfrac_yade.grains`).
+YADE_CELLS = {cells.MODEL.name: cells for cells in (rigid_cells, fem_cells)}
 @dataclass
 class GrainScene(GrainSceneState):
     """A built YADE scene plus the numpy bookkeeping of its bonds.
@@ -233,7 +233,7 @@ class GrainScene(GrainSceneState):
     def sliding_erasures(self) -> int:
         """Bonds erased by their sliding path so far (:mod:`.joints`): those synced as breaks, and the
         intact ones without cohesion that no strength break has synced yet; 0 without smooth joints."""
-        if not self.cells.BONDS_ON_FACES:
+        if not self.model.bonds_on_faces:
             return 0
         pending = sum(1 for k in np.flatnonzero(~self.broken) if not self.interactions[k].phys.isCohesive)
         return self.erased_by_sliding + pending
@@ -287,7 +287,7 @@ class GrainScene(GrainSceneState):
         fn = np.empty(len(idx))
         fs = np.empty(len(idx))
         inter = self.interactions
-        on_face = self.cells.BONDS_ON_FACES
+        on_face = self.model.bonds_on_faces
         for n, k in enumerate(idx):
             i = inter[k]
             phys = i.phys
@@ -300,7 +300,7 @@ class GrainScene(GrainSceneState):
         along the line of centres (penetration below its initial value), or across the face for bonds
         on their face's plane (YADE's smooth joint: |(x_b - x_a) . n| above its initial value)."""
         inter = self.interactions
-        if not self.cells.BONDS_ON_FACES:
+        if not self.model.bonds_on_faces:
             return np.array([inter[k].geom.penetrationDepth - inter[k].phys.initD < 0 for k in indices], dtype=bool)
         bodies = self.O.bodies
         out = []
@@ -402,7 +402,7 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
             young=g.young, poisson=g.poisson, density=g.density, type=COHESIVE_TYPE,
             frictionAngle=c.friction_angle, residualFrictionAngle=c.residual_friction_angle,
             tensileStrength=1.0, cohesion=1.0)))
-    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True, smoothJoint=cells.BONDS_ON_FACES)
+    law = w.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM(neverErase=True, smoothJoint=model.bonds_on_faces)
     geometry = w.Ig2_Sphere_Sphere_ScGeom()
     cells.configure_geometry(geometry)
     newton = w.NewtonIntegrator(damping=params.numerics.damping, gravity=(0, 0, 0))
@@ -444,6 +444,6 @@ def build_scene(specimen: Specimen, params: Parameters, layout: ClumpLayout | No
                        dt_critical=dt_crit)
     scene.node_origin = scene.node_positions()
     scene.node_orientation0 = [O.bodies[int(b)].state.ori for b in scene.node_bodies()]
-    if cells.BONDS_ON_FACES and params.numerics.keep_intact_joints:
+    if model.bonds_on_faces and params.numerics.keep_intact_joints:
         scene.drivers.append(IntactJointGuard(scene))
     return scene

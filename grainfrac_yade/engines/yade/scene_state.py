@@ -119,7 +119,7 @@ class GrainSceneState:
             bond_normal_force=-normal, bond_shear_force=-shear,
             bond_reference_gap=np.array([ph.initD for ph in phys]),
             bond_slip=np.array([ph.jointCumulativeSliding for ph in phys]),
-            bond_plane_normal=(np.array([tuple(ph.jointNormal) for ph in phys]).reshape(-1, 3) if self.cells.BONDS_ON_FACES
+            bond_plane_normal=(np.array([tuple(ph.jointNormal) for ph in phys]).reshape(-1, 3) if self.model.bonds_on_faces
                                else np.zeros((len(phys), 3))),
             platens=None if platens is None else platens.state_dict())
 
@@ -159,7 +159,7 @@ class GrainSceneState:
             ph.shearForce = Vector3(*(-state.bond_shear_force[k]))
             ph.initD = float(state.bond_reference_gap[k])
             ph.jointCumulativeSliding = float(state.bond_slip[k])
-            if self.cells.BONDS_ON_FACES:   # YADE's smooth joint: its normal as the bond's first step aligned it
+            if self.model.bonds_on_faces:   # YADE's smooth joint: its normal as the bond's first step aligned it
                 ph.jointNormal = Vector3(*state.bond_plane_normal[k])
             if state.bond_broken[k]:
                 ph.isCohesive, ph.isBroken = False, True
