@@ -11,6 +11,7 @@ from ..errors import GrainfracError
 from ..params import FlagOverride, check_conflicting_overrides, load_parameters, override_origin
 from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
+from ._loads import positive_int
 
 
 def seed_type(text: str, example: str = "1") -> int:
@@ -86,3 +87,10 @@ def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
         raise GrainfracError(module.vtk_refused)
     for line in module.warn_dynamic_only([o for o in overrides if override_origin(o) == "--set"], params):
         print(line, file=sys.stderr)
+
+
+def add_vtk_every_option(parser, strain: str):
+    """``--vtk-every K``: VTK series of a strain-controlled test, timestep the ``strain`` strain."""
+    parser.add_argument("--vtk-every", type=positive_int, default=None, metavar="K",
+                        help=f"write VTK files of cells and bonds at every K-th history row and at the end into "
+                             f"DIR/vtk/ (cells.pvd, bonds.pvd: time series whose timestep is the {strain} strain)")

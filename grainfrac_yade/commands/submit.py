@@ -24,7 +24,7 @@ from ..runs.slurm import (SubmitOptions, cell_value, frozen_table_text, log_path
                           read_json_file, record_path, render_sbatch, slurm_dir, study_dir_of, table_digest,
                           write_record, write_text_atomically)
 from ..runs.slurm_states import study_states
-from .creep import CREEP_ROW_COLUMNS
+from ._loads import CREEP_ROW_COLUMNS
 
 #: Scripts by the table columns that make a row a creep row.
 CREEP_COLUMNS = ("ratio", "stress")

@@ -7,16 +7,10 @@ import numpy as np
 
 from ..protocols.ucs_output import run_ucs_to_folder
 from ..errors import EXIT_NUMERICAL_FAILURE
-from ._loads import add_confinement_option, check_stress_range, confinement_override, positive_int
+from ._loads import add_confinement_option, check_stress_range, confinement_override
 from ._outcome import numerical_failure_line, steps_phrase
-from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
-
-
-def add_vtk_every_option(parser, strain: str):
-    """``--vtk-every K``: VTK series of a strain-controlled test, timestep the ``strain`` strain."""
-    parser.add_argument("--vtk-every", type=positive_int, default=None, metavar="K",
-                        help=f"write VTK files of cells and bonds at every K-th history row and at the end into "
-                             f"DIR/vtk/ (cells.pvd, bonds.pvd: time series whose timestep is the {strain} strain)")
+from ._args import add_vtk_every_option
+from ._resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
 def register(sub, common):
