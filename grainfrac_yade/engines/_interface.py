@@ -31,7 +31,7 @@ positive for the normal force; strengths per intact bond area ``layout.bond_area
 modes the codes of :mod:`grainfrac_yade.law` (``MODE_TENSION``, ``MODE_SHEAR``).
 
 :class:`SceneState` is the state that one engine exports (:meth:`Scene.export_state`) and another
-builds its scene from (the engine module's ``scene_from_state``), so that a run can change engine
+builds its scene from (its :class:`EngineModule`'s ``scene_from_state``), so that a run can change engine
 mid-way, e.g. a quasi-static engine handing a collapse to a dynamic one and taking the result back.
 """
 from __future__ import annotations
