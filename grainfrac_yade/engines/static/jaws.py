@@ -39,7 +39,7 @@ import numpy as np
 
 from ...errors import GrainfracError
 from ...geometry.disc import DiscTessellation
-from ...grains import GRAIN_MODEL_NAMES, grain_model
+from ...grains import rotating_grain_models
 from ...protocols.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
@@ -53,7 +53,7 @@ LATERALS = ("fixed", "free")
 #: bodies rotate named as the fix).
 BLOCK_ROTATION_REFUSED = ("static engine: --block-rotation blocks the rotation of cells whose bodies rotate; this grain "
                           "model's nodes have no rotation dof; fix: leave it out, or resolution.grain_model = one of "
-                          f"{[name for name in GRAIN_MODEL_NAMES if grain_model(name).rotating]}")
+                          f"{rotating_grain_models()}")
 
 
 def jaw_cells(tessellation, loading_arc: float) -> tuple:

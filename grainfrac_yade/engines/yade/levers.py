@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import GrainfracError
-from ...grains import GRAIN_MODEL_NAMES, grain_model
+from ...grains import rotating_grain_models
 from ...protocols.levers import LEVER_STREAM, PRE_EXISTING, Levers, lever_draws, new_breaks  # noqa: F401
 
 def apply_levers(scene, levers: Levers, seed: int) -> dict:
@@ -39,7 +39,7 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
     if scene.O.iter != 0:
         raise GrainfracError("levers: the scene has already run; fix: apply levers right after build_scene")
     if not scene.model.rotating:   # the levers act on each cell's one body, which rotates
-        rotating = [name for name in GRAIN_MODEL_NAMES if grain_model(name).rotating]
+        rotating = rotating_grain_models()
         raise GrainfracError(f"levers: built for cells that are one rotating body each (grain models {rotating}), "
                              f"not {scene.model.name!r} cells; fix: use resolution.grain_model = \"{rotating[0]}\"")
     factor, slits = lever_draws(levers, seed, scene.n_bonds)
