@@ -334,6 +334,10 @@ def run_digest(params, run_values: dict) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:8]
 
 
+#: The fix a damaged checkpoint's one line names.
+RESTART_FIX = "fix: start the run again with the same command (run.json) and --overwrite"
+
+
 def scene_file_of(state: dict, where) -> str:
     """The name of the file that holds the scene of the checkpoint ``where`` whose state.json is ``state``: the one
     it names (:data:`SCENE_FILE_KEY`), else :data:`LEGACY_SCENE_FILE`; GrainfracError (one line) if what it names
@@ -341,7 +345,7 @@ def scene_file_of(state: dict, where) -> str:
     name = state.get(SCENE_FILE_KEY, LEGACY_SCENE_FILE)
     if not isinstance(name, str) or not name or Path(name).name != name or name in (".", ".."):
         raise GrainfracError(f"{where}: the checkpoint's state file names no scene file ({SCENE_FILE_KEY} "
-                             f"{name!r}); fix: start the run again with the same command (run.json) and --overwrite")
+                             f"{name!r}); {RESTART_FIX}")
     return name
 
 
@@ -352,7 +356,7 @@ def check_files(where) -> None:
     before YADE is loaded and before anything is written.  Reads every file once (the scene's gzip stream to its
     end: about a second per 100 MB)."""
     where = Path(where)
-    fix = "fix: start the run again with the same command (run.json) and --overwrite"
+    fix = RESTART_FIX
     try:
         state = json.loads((where / CHECKPOINT_STATE).read_text())
         if not isinstance(state, dict):
