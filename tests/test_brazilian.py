@@ -292,6 +292,21 @@ def test_params_json_written_before_the_brazilian_section_still_loads(tmp_path):
         load_run_parameters(tmp_path)
 
 
+def test_yade_levers_refuse_a_grain_model_whose_bodies_do_not_rotate():
+    """YADE's levers act on each cell's one rotating body: a grain model that declares its bodies do not rotate
+    (``rotating``; fem cells) is refused in one line naming a model that does, as the grain models say, not by name."""
+    from types import SimpleNamespace
+    from grainfrac_yade.engines.yade.levers import Levers, apply_levers
+    from grainfrac_yade.grains import grain_model, rotating_grain_models
+    assert rotating_grain_models() == ["rigid"]
+    scene = SimpleNamespace(O=SimpleNamespace(iter=0), model=grain_model("fem"), n_bonds=4)
+    with pytest.raises(GrainfracError) as err:
+        apply_levers(scene, Levers(strength_cv=0.2), 1)
+    assert "\n" not in str(err.value) and "'fem' cells" in str(err.value)
+    assert 'fix: use resolution.grain_model = "rigid"' in str(err.value)
+    assert apply_levers(scene, Levers(), 1) == {"levers": Levers().to_dict()}   # no lever: nothing to refuse
+
+
 @needs_yade
 @pytest.mark.yade
 def test_levers_off_change_nothing_and_slits_are_not_cracks():

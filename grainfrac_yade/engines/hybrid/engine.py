@@ -9,11 +9,9 @@ Importing this module does not import YADE: the first stint does.
 """
 from __future__ import annotations
 
-from ..static.engine import (VTK_REFUSED,  # noqa: F401
-                             apply_levers, consolidate, stress_corrosion)
-from ..static.engine import UNSUPPORTED as STATIC_UNSUPPORTED
-from ..static.engine import version as static_version
-from .scene import HybridScene, build_scene, scene_from_state  # noqa: F401
+from .._interface import EngineModule
+from ..static.engine import ENGINE as STATIC
+from .scene import build_scene, scene_from_state
 from .settings import warn_not_used
 
 #: The value of ``numerics.engine`` that selects this engine.
@@ -22,17 +20,25 @@ NAME = "hybrid"
 DYNAMIC = False
 #: Commands the hybrid engine cannot run -> the one line that says so and the fix: the static engine's, and the
 #: Brazilian test (its stints would need YADE's jaws handed the static state).
-UNSUPPORTED = {**STATIC_UNSUPPORTED,
+UNSUPPORTED = {**STATIC.unsupported,
                "brazilian": ("the hybrid engine has no Brazilian test (its dynamic stints would need YADE's jaws); fix: "
                              "--engine yade or --engine static")}
 
 
 def version() -> str:
     """The static engine's libraries (the stints' YADE version is recorded with the stints' engine)."""
-    return static_version()
+    return STATIC.version()
 
 
 def warn_dynamic_only(overrides, params) -> list:
     """The dynamic stints read every dynamic setting; the static relaxation's settings are not read
     (:mod:`.settings`)."""
     return warn_not_used(overrides)
+
+
+#: What the registry returns for ``numerics.engine = "hybrid"``: the static engine's tests, bond writer and
+#: checkpoint scene file (a static scene's npz, stints and all) with this engine's scene.
+ENGINE = EngineModule(name=NAME, dynamic=DYNAMIC, scene_file=STATIC.scene_file, version=version,
+                      build_scene=build_scene, scene_from_state=scene_from_state, consolidate=STATIC.consolidate,
+                      apply_levers=STATIC.apply_levers, stress_corrosion=STATIC.stress_corrosion,
+                      unsupported=UNSUPPORTED, vtk_refused=STATIC.vtk_refused, warn_dynamic_only=warn_dynamic_only)
