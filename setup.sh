@@ -6,7 +6,7 @@
 # own single-node cluster from a generated slurm.conf (nothing is configured here).
 # python3-vtk9: VTK's XML writer and reader for the ParaView series (vtk/*.vtp, *.pvd); python3-pil
 # (Pillow) and ffmpeg: the GIF and MP4 of `animate`. python3-pytest-xdist: the test command runs the suite on every core
-# (`-n auto`, one test file per worker).
+# (`-n logical`, one test file per worker).
 set -euo pipefail
 PACKAGES="yade python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest python3-pytest-xdist git slurm-wlm munge python3-vtk9 python3-pil ffmpeg"
 missing=""
