@@ -99,6 +99,9 @@ def _creep_cli(capsys, out, *extra):
     return rc
 
 
+@pytest.mark.slow   # the same run with and without checkpoints: test_creep_with_checkpoints_is_the_creep_without[rigid]
+#                     (bit for bit); the command line's static creep with a checkpoint against the uninterrupted one
+#                     (summary keys, cracks.csv byte for byte): test_static_engine.py's creep resumed through the command line
 def test_creep_command_with_a_tiny_checkpoint_interval_gives_the_same_files(capsys, tmp_path):
     """Through the command line: a checkpoint at every safe point against the default interval (none in a run this
     short but the ramp's): summary.json (the code, the machine's times and the checkpoint record aside) and
