@@ -37,7 +37,7 @@ def main(argv=None):
     settings = {"reuse_factor": False} if a.direct else {}
     if a.max_low_rank is not None and not a.direct:
         settings["max_low_rank_contacts"] = a.max_low_rank
-    timed = engine("static").timed_path(build_specimen(p, a.seed), p, a.breaks, a.max_strain, settings)
+    timed = engine("static").timings.timed_path(build_specimen(p, a.seed), p, a.breaks, a.max_strain, settings)
     sequence = timed.pop("sequence", [])
     out = {"seed": a.seed, "width": a.width, "height": a.height, "direct": a.direct, **timed}
     times = []

@@ -55,7 +55,7 @@ def ucs_probe(p, seed) -> dict:
     cols, result, scene, _ = run_ucs(specimen, p)
     cpu = time.process_time() - t0
     static = engine(p.numerics.engine)
-    c, path = static.solver_counters(scene), static.path_summary(scene)
+    c, path = static.timings.solver_counters(scene), static.timings.path_summary(scene)
     strain, stress = np.asarray(cols["axial_strain"]), np.asarray(cols["axial_stress_pa"])
     k = int(np.argmax(stress)) if len(stress) else 0
     breaks = max(path["records"], 1)

@@ -101,10 +101,11 @@ def assert_resumed_as_whole(resumed, whole):
     assert np.array_equal(resumed.break_time, whole.break_time, equal_nan=True)
 
 
-def run_killed_and_resumed(tmp_path, monkeypatch, params, seed, stress, killed_when):
+def run_killed_and_resumed(tmp_path, monkeypatch, params, seed, stress, killed_when, before_resume=None):
     """The creep run of ``params`` (``seed``, held ``stress`` [Pa]) uninterrupted, and the same run killed (a
     KeyboardInterrupt) at the first checkpoint after which ``killed_when(run, checkpoints written)`` holds, then
-    resumed from it: (whole, resumed) (helper of the kill-and-resume tests of the static and hybrid engines)."""
+    resumed from it: (whole, resumed) (helper of the kill-and-resume tests of the static and hybrid engines).
+    ``before_resume(run folder)``: called on the killed run's folder before the resume."""
     import grainfrac_yade.protocols.checkpoints as checkpoints
     from grainfrac_yade.protocols.creep import resume_creep, run_creep
     whole = run_creep(build_specimen(params, seed), params, stress, checkpoint_folder=tmp_path / "whole",
@@ -121,6 +122,8 @@ def run_killed_and_resumed(tmp_path, monkeypatch, params, seed, stress, killed_w
         run_creep(build_specimen(params, seed), params, stress, checkpoint_folder=tmp_path / "cut",
                   run_values={"seed": seed})
     monkeypatch.setattr(checkpoints.Checkpointer, "write", write)
+    if before_resume is not None:
+        before_resume(tmp_path / "cut")
     return whole, resume_creep(build_specimen(params, seed), params, stress, tmp_path / "cut")
 
 

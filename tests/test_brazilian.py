@@ -199,9 +199,31 @@ def test_crack_location_counts():
 
 
 # ----------------------------------------------------------------------------- YADE
+def _tiny_disc(seed) -> dict:
+    """A Brazilian test of the 8 mm disc with the shipped parameters: its history and result, tensile strength,
+    crack locations at the end and at the peak, and YADE's engines (read before another scene replaces them)."""
+    from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary
+    from grainfrac_yade.protocols.brazilian import run_brazilian
+    p = load_parameters(overrides=TINY)
+    sp = build_disc_specimen(p, seed)
+    hist, result, scene, (broken_peak, _) = run_brazilian(sp, p)
+    centre = sp.tessellation.centre
+    return {"hist": hist, "result": result,
+            "strength": brazilian_summary(hist, 8e-3, sp.thickness)["tensile_strength_pa"],
+            "end": crack_location(scene.layout.bond_point, scene.broken, scene.break_step, centre, 8e-3),
+            "peak": crack_location(scene.layout.bond_point, broken_peak, scene.break_step, centre, 8e-3),
+            "engines": scene.engine_names()}
+
+
+@pytest.fixture(scope="module")
+def tiny_disc_seed1():
+    """The 8 mm disc, seed 1, once for the tests that read its plain run (central crack, tensile scale, levers)."""
+    return _tiny_disc(1)
+
+
 @needs_yade
 @pytest.mark.yade
-def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack():
+def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack(tiny_disc_seed1):
     """8 mm disc (64 cells, 1 mm grains), shipped parameters, seeds 1-3: a finite positive strength, the peak
     passed, and a central crack: most broken bonds in the middle third (|x - x_c| <= D/6, 0.42 of the area),
     at the peak and at the end of the test.
@@ -210,26 +232,19 @@ def test_tiny_brazilian_gives_a_finite_strength_and_a_central_crack():
     peak 0.87 / 0.96 / 0.88.  Eight grains across is near the smallest disc that splits cleanly: seed 4
     ends at 0.44 (0.73 at the peak) after post-peak cracking, and a 6 mm disc (36 cells) ends at 0.46-0.60.
     """
-    from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary
-    from grainfrac_yade.protocols.brazilian import run_brazilian
-    p = load_parameters(overrides=TINY)
     for seed in (1, 2, 3):
-        sp = build_disc_specimen(p, seed)
-        hist, result, scene, (broken_peak, _) = run_brazilian(sp, p)
-        s = brazilian_summary(hist, 8e-3, sp.thickness)
+        disc = tiny_disc_seed1 if seed == 1 else _tiny_disc(seed)
+        result, end, peak = disc["result"], disc["end"], disc["peak"]
         assert result["peak_reached"] and not result["numerical_failure"]
-        assert math.isfinite(s["tensile_strength_pa"]) and s["tensile_strength_pa"] > 0
-        centre = sp.tessellation.centre
-        end = crack_location(scene.layout.bond_point, scene.broken, scene.break_step, centre, 8e-3)
-        peak = crack_location(scene.layout.bond_point, broken_peak, scene.break_step, centre, 8e-3)
+        assert math.isfinite(disc["strength"]) and disc["strength"] > 0
         assert end["central_band_fraction"] > 0.5 and peak["central_band_fraction"] > 0.5, (seed, end, peak)
-        assert scene.engine_names() == ["ForceResetter", "InsertionSortCollider", "InteractionLoop",
-                                        "NewtonIntegrator", "DiscJaws"]
+        assert disc["engines"] == ["ForceResetter", "InsertionSortCollider", "InteractionLoop",
+                                   "NewtonIntegrator", "DiscJaws"]
 
 
 @needs_yade
 @pytest.mark.yade
-def test_tensile_scale_lowers_the_strength():
+def test_tensile_scale_lowers_the_strength(tiny_disc_seed1):
     """J^T x 0.5 on every contact row, cohesion unchanged: a lower Brazilian strength (8 mm disc, seed 1;
     measured 37.7 -> 31.0 MPa, -18 %: the split's zigzag faces fail in shear as well as in tension)."""
     from grainfrac_yade.analysis.brazilian_analysis import brazilian_summary
@@ -239,11 +254,9 @@ def test_tensile_scale_lowers_the_strength():
     half = load_parameters(overrides=TINY + tensile_scale_overrides(base, 0.5))
     check_tensile_scale(base, half, 0.5)
     assert all(half.contacts[k].cohesion == c.cohesion for k, c in base.contacts.items())
-    out = []
-    for p in (base, half):
-        sp = build_disc_specimen(p, 1)
-        out.append(brazilian_summary(run_brazilian(sp, p)[0], 8e-3, sp.thickness)["tensile_strength_pa"])
-    assert out[1] < 0.9 * out[0]
+    sp = build_disc_specimen(half, 1)
+    halved = brazilian_summary(run_brazilian(sp, half)[0], 8e-3, sp.thickness)["tensile_strength_pa"]
+    assert halved < 0.9 * tiny_disc_seed1["strength"]
 
 
 @needs_yade
@@ -292,9 +305,24 @@ def test_params_json_written_before_the_brazilian_section_still_loads(tmp_path):
         load_run_parameters(tmp_path)
 
 
+def test_yade_levers_refuse_a_grain_model_whose_bodies_do_not_rotate():
+    """YADE's levers act on each cell's one rotating body: a grain model that declares its bodies do not rotate
+    (``rotating``; fem cells) is refused in one line naming a model that does, as the grain models say, not by name."""
+    from types import SimpleNamespace
+    from grainfrac_yade.engines.yade.levers import Levers, apply_levers
+    from grainfrac_yade.grains import grain_model, rotating_grain_models
+    assert rotating_grain_models() == ["rigid"]
+    scene = SimpleNamespace(O=SimpleNamespace(iter=0), model=grain_model("fem"), n_bonds=4)
+    with pytest.raises(GrainfracError) as err:
+        apply_levers(scene, Levers(strength_cv=0.2), 1)
+    assert "\n" not in str(err.value) and "'fem' cells" in str(err.value)
+    assert 'fix: use resolution.grain_model = "rigid"' in str(err.value)
+    assert apply_levers(scene, Levers(), 1) == {"levers": Levers().to_dict()}   # no lever: nothing to refuse
+
+
 @needs_yade
 @pytest.mark.yade
-def test_levers_off_change_nothing_and_slits_are_not_cracks():
+def test_levers_off_change_nothing_and_slits_are_not_cracks(tiny_disc_seed1):
     """Levers() leaves a run bit-identical; slits start broken (mode PRE_EXISTING), are left out of the crack
     counts, and lower the strength; blocked rotation blocks every cell's Z rotation (8 mm disc, seed 1)."""
     from grainfrac_yade.protocols.brazilian import run_brazilian
@@ -302,7 +330,7 @@ def test_levers_off_change_nothing_and_slits_are_not_cracks():
     from grainfrac_yade.engines.yade.scene import build_scene
     p = load_parameters(overrides=TINY)
     sp = build_disc_specimen(p, 1)
-    plain, r_plain, _, _ = run_brazilian(sp, p)
+    plain = tiny_disc_seed1["hist"]
     off, r_off, _, _ = run_brazilian(sp, p, levers=Levers())
     assert plain == off and r_off["levers"] == Levers().to_dict()
     slit, r_slit, scene, (at_peak, _) = run_brazilian(sp, p, levers=Levers(slit_fraction=0.3))

@@ -32,6 +32,12 @@ def _creep(ratio, ucs, extra=()):
     return run_creep(build_specimen(p, 1), p, ratio * ucs)
 
 
+@pytest.fixture(scope="module")
+def creep_at_08(small_ucs):
+    """The small specimen's creep run at 0.8 of its UCS, once for the tests that read it (load ordering, beta1)."""
+    return _creep(0.8, small_ucs)
+
+
 def test_without_stress_corrosion_a_load_below_ucs_is_held(small_ucs):
     run = _creep(0.85, small_ucs, ["stress_corrosion.enabled=false"])
     assert not run.failed, run.failure_reason
@@ -39,8 +45,8 @@ def test_without_stress_corrosion_a_load_below_ucs_is_held(small_ucs):
     assert run.servo.stress == pytest.approx(0.85 * small_ucs, rel=0.01)
 
 
-def test_higher_load_fails_sooner(small_ucs):
-    low, high = _creep(0.8, small_ucs), _creep(0.9, small_ucs)
+def test_higher_load_fails_sooner(small_ucs, creep_at_08):
+    low, high = creep_at_08, _creep(0.9, small_ucs)
     assert low.failed and high.failed
     t_low, t_high = low.rows[-1]["creep_time_s"], high.rows[-1]["creep_time_s"]
     assert 0 < t_high < t_low
@@ -79,11 +85,11 @@ def test_load_above_ucs_is_one_clear_line(tmp_path):
     assert "above the UCS" in res.stderr and "fix:" in res.stderr
 
 
-def test_event_clock_lifetime_scales_exactly_with_beta1(small_ucs):
+def test_event_clock_lifetime_scales_exactly_with_beta1(small_ucs, creep_at_08):
     """Strength mode, event clock: Eq. 7 makes every time to failure proportional to 1/beta1 while
     the sequence of failures is unchanged, so beta1 x 10 must give lifetime / 10 and the same cracks
     (this is what makes a single calibration factor on beta1 meaningful)."""
-    base = _creep(0.8, small_ucs)
+    base = creep_at_08
     p = load_parameters()
     fast = _creep(0.8, small_ucs, [("stress_corrosion.beta1", 10 * p.stress_corrosion.beta1)])
     assert base.failed and fast.failed

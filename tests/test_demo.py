@@ -1,4 +1,5 @@
-"""The main job end to end on a tiny specimen: UCS, creep through yade-batch, analysis report."""
+"""The main job end to end on a tiny specimen (3 x 6 mm, the smallest the other YADE tests run; the physics at larger
+sizes is tested in tests/test_ucs.py and tests/test_creep.py): UCS, creep through yade-batch, analysis report."""
 import json
 import subprocess
 import sys
@@ -12,7 +13,7 @@ pytestmark = [needs_yade, pytest.mark.yade]
 
 def test_demo_runs_a_small_study_and_ends_with_the_report(tmp_path):
     out = tmp_path / "demo"
-    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "demo", "--width", "6e-3", "--height", "12e-3",
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", "demo", "--width", "3e-3", "--height", "6e-3",
                           "--ratios", "0.75,0.85", "--seeds", "1", "--jobs", "2", "--out", str(out)],
                          capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 0, res.stderr[-2000:]

@@ -111,6 +111,6 @@ def test_readme_is_short():
 
 def test_readme_keeps_the_ci_test_command():
     """.ci/run calls the README's test command verbatim."""
-    command = 'bash setup.sh && /usr/bin/python3 -m pytest -q -m "not slow"'
+    command = 'bash setup.sh && /usr/bin/python3 -m pytest -q -m "not slow" -n logical --dist loadfile'
     assert command in (ROOT / "README.md").read_text()
     assert command in (ROOT / ".ci" / "run").read_text()

@@ -33,7 +33,7 @@ def test_misspelt_engine_is_one_line():
 def test_engine_module_loads_without_yade():
     """The registry's module is found without building a scene (YADE is imported only then)."""
     e = engine_for(load_parameters())
-    assert e.NAME == "yade" and callable(e.build_scene) and callable(e.scene_from_state)
+    assert e.name == "yade" and callable(e.build_scene) and callable(e.scene_from_state)
 
 
 def test_the_dynamic_engines_are_the_registry_s_dynamic_ones():
@@ -42,7 +42,7 @@ def test_the_dynamic_engines_are_the_registry_s_dynamic_ones():
     from grainfrac_yade.engines.dynamic import DYNAMIC_ENGINE_MODULES, dynamic_engine
     from grainfrac_yade.engines.registry import ENGINE_MODULES
     assert DYNAMIC_ENGINE_MODULES.items() <= ENGINE_MODULES.items()
-    assert {n for n in ENGINE_NAMES if getattr(engine(n), "DYNAMIC", False)} == set(DYNAMIC_ENGINE_MODULES)
+    assert {n for n in ENGINE_NAMES if engine(n).dynamic} == set(DYNAMIC_ENGINE_MODULES)
     assert dynamic_engine("yade") is engine("yade")
     with pytest.raises(ParameterError) as err:
         dynamic_engine("static")
@@ -130,8 +130,9 @@ def test_the_paper_clock_needs_a_dynamic_engine(monkeypatch, tmp_path):
     from grainfrac_yade.protocols.creep_output import run_creep_to_folder
     from grainfrac_yade.engines import registry
     import dataclasses
-    assert registry.require_dynamic(load_parameters(), "the paper clock").NAME == "yade"
-    monkeypatch.setitem(sys.modules, "static_stand_in", SimpleNamespace(NAME="static", DYNAMIC=False))
+    assert registry.require_dynamic(load_parameters(), "the paper clock").name == "yade"
+    stand_in = dataclasses.replace(registry.engine("yade"), name="static", dynamic=False)
+    monkeypatch.setitem(sys.modules, "static_stand_in", SimpleNamespace(ENGINE=stand_in))
     monkeypatch.setitem(registry.ENGINE_MODULES, "static", "static_stand_in")
     p = load_parameters(overrides=["stress_corrosion.clock=paper"])
     p = dataclasses.replace(p, numerics=dataclasses.replace(p.numerics, engine="static"))
@@ -139,3 +140,26 @@ def test_the_paper_clock_needs_a_dynamic_engine(monkeypatch, tmp_path):
         run_creep_to_folder(p, 1, tmp_path / "run", 200e6, 0.7, 285e6)
     assert "numerics.engine" in str(err.value) and "paper clock" in str(err.value) and "\n" not in str(err.value)
     assert not (tmp_path / "run").exists()
+
+
+def test_every_engine_declares_a_typed_engine_module(monkeypatch):
+    """Each registered engine's module declares an EngineModule under its own name, with the hooks the protocols
+    call and one checkpoint scene file per scene format (YADE's gzip'd archive; the static and hybrid scenes'
+    npz); a module without one is refused by name."""
+    import sys
+    from types import SimpleNamespace
+    from grainfrac_yade.engines import EngineModule
+    from grainfrac_yade.engines import registry
+    for name in ENGINE_NAMES:
+        e = engine(name)
+        assert isinstance(e, EngineModule) and e.name == name
+        assert all(callable(getattr(e, hook)) for hook in ("build_scene", "scene_from_state", "consolidate",
+                                                           "apply_levers", "stress_corrosion", "version"))
+        assert e.scene_file and "/" not in e.scene_file
+    assert {n: engine(n).scene_file for n in ENGINE_NAMES} == {"yade": "scene.yade.gz", "static": "scene.npz",
+                                                                "hybrid": "scene.npz"}
+    assert engine("yade").refusal("creep") == "" and engine("hybrid").refusal("brazilian").startswith("the hybrid")
+    monkeypatch.setitem(sys.modules, "engine_without_declaration", SimpleNamespace(build_scene=None))
+    monkeypatch.setitem(registry.ENGINE_MODULES, "bare", "engine_without_declaration")
+    with pytest.raises(TypeError, match="engine_without_declaration.ENGINE is NoneType, not an EngineModule"):
+        engine("bare")

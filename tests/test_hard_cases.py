@@ -397,6 +397,8 @@ def assert_same_runs(a, b):
         pd.testing.assert_frame_equal(ta, tb, check_exact=True)
 
 
+@pytest.mark.slow   # a creep command in its own process repeating an in-process run of 4 x 8 mm bit for bit (events,
+#                     lifetime, history, cracks): tests/test_resume.py's kill inside a relaxation, resumed
 @needs_yade
 @pytest.mark.yade
 def test_g_the_same_seed_twice_gives_identical_creep_results(tmp_path):

@@ -28,8 +28,8 @@ def test_hybrid_engine_module():
     choices = next(f for f in dataclasses.fields(NumericsParams) if f.name == "engine").metadata["choices"]
     assert "hybrid" in ENGINE_NAMES and tuple(choices) == ENGINE_NAMES
     module = engine("hybrid")
-    assert module.NAME == "hybrid" and module.DYNAMIC is False
-    assert "brazilian" in module.UNSUPPORTED and module.warn_dynamic_only(["numerics.damping=0.7"], None) == []
+    assert module.name == "hybrid" and module.dynamic is False
+    assert module.refusal("brazilian") and module.warn_dynamic_only(["numerics.damping=0.7"], None) == []
 
 
 def test_without_a_stint_the_hybrid_path_is_the_static_one():

@@ -92,6 +92,13 @@ def _reference(spec, out):
     return s
 
 
+@pytest.fixture(scope="module")
+def small_reference(tmp_path_factory):
+    """``SMALL``'s uninterrupted run, once for the module's kills inside its creep (they only read it)."""
+    ref = tmp_path_factory.mktemp("small") / "uninterrupted"
+    return ref, _reference(SMALL, ref)
+
+
 def _assert_same_run(a, b):
     sa, sb = (json.loads((f / "summary.json").read_text()) for f in (a, b))
     for key in ("lifetime_s", "failed", "failure_reason", "n_events", "broken_ramp", "broken_creep", "macrocracks",
@@ -104,11 +111,12 @@ def _assert_same_run(a, b):
         assert (a / name).read_text() == (b / name).read_text(), name
 
 
+@pytest.mark.slow   # the kill inside a relaxation (below) resumes this run mid-creep, after 8 events, to the same
+#                     bit-for-bit comparison; a finished run's resume: test_a_bad_resume_is_one_line[finished]
 @needs_yade
 @pytest.mark.yade
-def test_a_run_killed_mid_creep_resumes_to_the_uninterrupted_result(tmp_path):
-    ref = tmp_path / "uninterrupted"
-    s = _reference(SMALL, ref)
+def test_a_run_killed_mid_creep_resumes_to_the_uninterrupted_result(tmp_path, small_reference):
+    ref, s = small_reference
     assert s["failed"] and s["n_events"] >= 10 and "resumed_from" not in s
     killed = tmp_path / "killed"
     state = _start_and_kill(SMALL, killed, lambda st: st["phase"] == "event" and st["loop"]["n_events"] >= 8)
@@ -399,12 +407,11 @@ def test_a_ucs_test_killed_mid_loading_resumes_to_the_uninterrupted_result(tmp_p
 
 @needs_yade
 @pytest.mark.yade
-def test_a_run_killed_inside_a_relaxation_resumes_to_the_uninterrupted_result(tmp_path):
+def test_a_run_killed_inside_a_relaxation_resumes_to_the_uninterrupted_result(tmp_path, small_reference):
     """A relaxation after a creep step has safe points between its checks (a collapse at paper size
     relaxes for hours): killed there, the run resumes inside it, with the servo's clip count and the
     collapse watch as they were, to the uninterrupted run's results bit for bit."""
-    ref = tmp_path / "uninterrupted"
-    s = _reference(SMALL, ref)
+    ref, s = small_reference
     killed = tmp_path / "killed"
     state = _start_and_kill(SMALL, killed, lambda st: st["phase"] == "relaxation" and st["loop"]["n_events"] >= 8
                             and st["loop"]["relaxation"]["done"] >= 500)

@@ -21,8 +21,9 @@ import pytest
 
 from conftest import ROOT, needs_yade
 from grainfrac_yade.errors import GrainfracError
-from grainfrac_yade.runs.slurm import (FAILED, QueueView, SubmitOptions, compress_rows, frozen_table_text,
-                                  read_batch_table, render_sbatch, row_states)
+from grainfrac_yade.runs.slurm import (FAILED, SubmitOptions, compress_rows, frozen_table_text, read_batch_table,
+                                  render_sbatch)
+from grainfrac_yade.runs.slurm_states import QueueView, row_states
 
 PYTHON = "/usr/bin/python3"
 TINY = ROOT / "params" / "slurm_tiny.table"

@@ -69,6 +69,28 @@ def test_creep_with_checkpoints_is_the_creep_without(tmp_path, monkeypatch, mode
     assert np.array_equal(resumed.scene.broken, plain.scene.broken)
 
 
+def _as_older_code_wrote_it(folder):
+    """Make the checkpoint of run ``folder`` as code before each engine named its scene file wrote it: the static
+    scene's npz under YADE's name, state.json naming no scene file."""
+    from grainfrac_yade.runs.runio import CHECKPOINT, CHECKPOINT_STATE, LEGACY_SCENE_FILE, SCENE_FILE_KEY
+    ck = folder / CHECKPOINT
+    state = json.loads((ck / CHECKPOINT_STATE).read_text())
+    assert state.pop(SCENE_FILE_KEY) == "scene.npz" and not (ck / LEGACY_SCENE_FILE).exists()
+    (ck / "scene.npz").rename(ck / LEGACY_SCENE_FILE)
+    (ck / CHECKPOINT_STATE).write_text(json.dumps(state, indent=1) + "\n")
+
+
+def test_a_checkpoint_written_by_older_code_resumes_to_the_uninterrupted_run(tmp_path, monkeypatch):
+    """A static run's checkpoint with its scene in scene.yade.gz (as every engine's was before each named its own
+    file) resumes as one written today: the same history (wall times aside), events, break times and broken set."""
+    p = _params("rigid", "numerics.checkpoint_interval=1e-9")
+    whole, resumed = run_killed_and_resumed(tmp_path, monkeypatch, p, 1, 160e6, lambda run, written: written == 5,
+                                            before_resume=_as_older_code_wrote_it)
+    assert whole.n_events > 1 and resumed.resumes
+    assert_resumed_as_whole(resumed, whole)
+    assert np.array_equal(resumed.scene.broken, whole.scene.broken)
+
+
 def _creep_cli(capsys, out, *extra):
     from grainfrac_yade.cli import main
     rc = main(["creep", "--engine", "static", "--width", "4e-3", "--height", "8e-3", "--stress", "160", "--seed", "1",
@@ -77,6 +99,9 @@ def _creep_cli(capsys, out, *extra):
     return rc
 
 
+@pytest.mark.slow   # the same run with and without checkpoints: test_creep_with_checkpoints_is_the_creep_without[rigid]
+#                     (bit for bit); the command line's static creep with a checkpoint against the uninterrupted one
+#                     (summary keys, cracks.csv byte for byte): test_static_engine.py's creep resumed through the command line
 def test_creep_command_with_a_tiny_checkpoint_interval_gives_the_same_files(capsys, tmp_path):
     """Through the command line: a checkpoint at every safe point against the default interval (none in a run this
     short but the ramp's): summary.json (the code, the machine's times and the checkpoint record aside) and
@@ -87,3 +112,16 @@ def test_creep_command_with_a_tiny_checkpoint_interval_gives_the_same_files(caps
     assert {k: v for k, v in a.items() if k not in NOT_THE_RUN} == {k: v for k, v in b.items() if k not in NOT_THE_RUN}
     assert a["n_events"] > 1
     assert (tmp_path / "default" / "cracks.csv").read_bytes() == (tmp_path / "tiny" / "cracks.csv").read_bytes()
+
+
+def test_a_state_file_naming_no_plain_scene_file_is_one_line(tmp_path):
+    """The scene file a checkpoint's state.json names must be a file of the checkpoint folder: a path elsewhere, or
+    no name, is refused in one line naming the fix; a state.json naming none is the older code's scene.yade.gz."""
+    from grainfrac_yade.errors import GrainfracError
+    from grainfrac_yade.runs.runio import LEGACY_SCENE_FILE, scene_file_of
+    assert scene_file_of({}, tmp_path) == LEGACY_SCENE_FILE
+    assert scene_file_of({"scene_file": "scene.npz"}, tmp_path) == "scene.npz"
+    for bad in ("../scene.npz", "/tmp/scene.npz", "", None, 3):
+        with pytest.raises(GrainfracError) as err:
+            scene_file_of({"scene_file": bad}, tmp_path)
+        assert str(err.value).count("\n") == 0 and "fix:" in str(err.value)

@@ -26,7 +26,7 @@ def test_static_engine_module_and_scene_interface():
     """The registry's "static" module: no dynamics, a scene that implements the protocol's Scene."""
     p = _params()
     module = engine_for(p)
-    assert module is engine("static") and module.NAME == "static" and module.DYNAMIC is False
+    assert module is engine("static") and module.name == "static" and module.dynamic is False
     assert "scipy" in module.version()
     scene = module.build_scene(build_specimen(p, 1), p)
     assert isinstance(scene, Scene)
@@ -321,7 +321,7 @@ def test_creep_resumed_through_the_command_line(capsys, tmp_path, monkeypatch):
     assert not (tmp_path / "cut" / "summary.json").exists()
     import shutil
     shutil.copytree(tmp_path / "cut", tmp_path / "broken")
-    scene = tmp_path / "broken" / "checkpoint" / "scene.yade.gz"
+    scene = tmp_path / "broken" / "checkpoint" / engine("static").scene_file
     scene.write_bytes(scene.read_bytes()[:200])           # a truncated npz: one line, nothing written
     rc, out = _cli(capsys, "creep", "--resume", str(tmp_path / "broken"))
     assert rc == 2 and out.err.count("\n") == 1 and "static scene is unreadable" in out.err and "fix:" in out.err

@@ -16,4 +16,4 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0]))
 from grainfrac_yade.commands.creep import run_creep_in_yade  # noqa: E402
 from grainfrac_yade.engines.registry import engine  # noqa: E402
 
-run_creep_in_yade(engine("yade"))   # yade-batch rows: YADE reads the table
+run_creep_in_yade(engine("yade").batch_rows)   # yade-batch rows: YADE reads the table

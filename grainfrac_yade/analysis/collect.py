@@ -11,7 +11,8 @@ from ..errors import GrainfracError
 from ..params import RENAMED_KEYS, migrate_tree
 from ..params import flatten as flatten_tree
 from ..runs.columns import summary_as_today
-from ..runs.slurm import FAILED, rows_without_runs
+from ..runs.slurm import FAILED
+from ..runs.slurm_states import rows_without_runs
 
 #: Parameter paths copied from each run's params.json into the table (older params.json are read through
 #: :func:`~grainfrac_yade.params.migrate_tree`: ``stress_corrosion.mode`` becomes ``stress_corrosion.law``).

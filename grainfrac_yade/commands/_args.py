@@ -11,6 +11,7 @@ from ..errors import GrainfracError
 from ..params import FlagOverride, check_conflicting_overrides, load_parameters, override_origin
 from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
+from ._loads import positive_int
 
 
 def seed_type(text: str, example: str = "1") -> int:
@@ -71,17 +72,25 @@ def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
     """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
     without dynamics, a test the engine does not have yet, a VTK series ``vtk`` it does not write), and warn
     once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  Nothing for
-    a dynamic engine (YADE); an engine without dynamics says what it refuses in its module (``UNSUPPORTED``,
-    ``VTK_REFUSED``, ``warn_dynamic_only``: docs/maintainers.md, adding an engine)."""
+    a dynamic engine (YADE); an engine without dynamics says what it refuses in its
+    :class:`~grainfrac_yade.engines.EngineModule` (``unsupported``, ``vtk_refused``, ``warn_dynamic_only``:
+    docs/maintainers.md, adding an engine)."""
     module = engine_for(params)
-    if getattr(module, "DYNAMIC", False):
+    if module.dynamic:
         return
     if command == "creep" and params.stress_corrosion.clock == "paper":
         require_dynamic(params, "the paper clock (its unbalanced force, Eq. 8)")
-    refusal = module.UNSUPPORTED.get(command)
+    refusal = module.refusal(command)
     if refusal:
         raise GrainfracError(refusal)
-    if vtk and module.VTK_REFUSED:
-        raise GrainfracError(module.VTK_REFUSED)
+    if vtk and module.vtk_refused:
+        raise GrainfracError(module.vtk_refused)
     for line in module.warn_dynamic_only([o for o in overrides if override_origin(o) == "--set"], params):
         print(line, file=sys.stderr)
+
+
+def add_vtk_every_option(parser, strain: str):
+    """``--vtk-every K``: VTK series of a strain-controlled test, timestep the ``strain`` strain."""
+    parser.add_argument("--vtk-every", type=positive_int, default=None, metavar="K",
+                        help=f"write VTK files of cells and bonds at every K-th history row and at the end into "
+                             f"DIR/vtk/ (cells.pvd, bonds.pvd: time series whose timestep is the {strain} strain)")

@@ -141,3 +141,13 @@ def resolve_stress(params, stress=None, ratio=None, ucs=None, cli=False):
                              f"({ref / PA_PER_MPA:.4g} MPa): the specimen fails during the ramp; fix: give a stress "
                              "below it (or --ucs)")
     return stress, (stress - confining) / (ref - confining), ref
+
+
+#: yade-batch columns of a creep row that are not model parameters [Pa or 1; 0 = not given].
+CREEP_ROW_COLUMNS = {"ratio": 0.0, "stress": 0.0, "ucs": 0.0}
+
+
+def creep_name_parts(controls: dict) -> list:
+    """The load columns that name a creep row's folder, before its parameters: ratio (or stress), and ucs if given."""
+    parts = [("ratio", controls["ratio"])] if float(controls["ratio"]) else [("stress", controls["stress"])]
+    return parts + ([("ucs", controls["ucs"])] if float(controls["ucs"]) else [])

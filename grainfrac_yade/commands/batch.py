@@ -24,10 +24,9 @@ from ..params import load_parameters, require_plane, shipped_values
 from ..params.schema import field_spec
 from ..runs.batchrun import (ON_CHANGE, RUN_COLUMNS, cell_value, check_columns, read_table_rows, row_outcomes,
                              run_batch, run_folder_name)
-from .brazilian import require_disc_model
-from ._loads import check_stress_range, resolve_stress
+from ..protocols.brazilian_output import require_disc_model
+from ._loads import CREEP_ROW_COLUMNS, check_stress_range, creep_name_parts, resolve_stress
 from ._outcome import outcome
-from .creep import CREEP_ROW_COLUMNS, creep_name_parts
 
 #: The scripts of each kind of row, in yade_scripts/.
 SCRIPTS = {"creep": "creep.py", "ucs": "ucs.py", "brazilian": "brazilian.py"}

@@ -231,8 +231,8 @@ def bench_scene(params, seed, ratio, settings: BenchSettings) -> dict:
     stress = ratio * params.calibration.reference_ucs
     specimen = build_specimen(params, seed)
     run = TimedCreepRun(specimen, params, stress, max_events=settings.events,
-                        at_hold=lambda r: {**engine.time_stepping(r, settings.window_s, settings.repeats),
-                                           **engine.time_bond_io(r.corr, settings.repeats)})
+                        at_hold=lambda r: {**engine.timings.time_stepping(r, settings.window_s, settings.repeats),
+                                           **engine.timings.time_bond_io(r.corr, settings.repeats)})
     run.run()
     if run.measured is None:
         raise GrainfracError(f"bench: the scene ({params.resolution.grain_model} cells, "
@@ -323,7 +323,7 @@ def run_fem_sizes(extra_files=(), overrides=(), creep_stress_mpa=None, progress=
             row = {"specimen": name, "seed": seed, "n_cells": specimen.n_cells,
                    "edges_collapsed": specimen.edges_collapsed,
                    "critical_step_core_s": critical_dem_step(specimen, params),
-                   **engine_for(params).loading_step_cost(specimen, params, FEM_WARMUP_STEPS, FEM_TIMED_STEPS)}
+                   **engine_for(params).timings.loading_step_cost(specimen, params, FEM_WARMUP_STEPS, FEM_TIMED_STEPS)}
             result["scenes"].append(row)
             progress(f"fem {name}, seed {seed}: critical step {row['critical_step_s']:.3g} s, "
                      f"{row['dem_steps_per_cpu_s']:.1f} DEM steps / CPU s, "

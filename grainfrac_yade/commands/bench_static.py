@@ -172,7 +172,7 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
     adds to a run's summary (``engine_keys``: e.g. its relaxations) and the events' creep times (``times``).  ``progress``:
     called with a dict after the ramp (event 0) and after each event."""
     static = engine_for(params)
-    if not hasattr(static, "solver_counters"):
+    if static.timings is None or not hasattr(static.timings, "solver_counters"):
         raise GrainfracError(f"a timed static hold: numerics.engine = {params.numerics.engine!r} has no static solver "
                              "to count; fix: numerics.engine=static")
     c0 = time.process_time()
@@ -184,7 +184,7 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
             cpu, _, broken, _, strain, c = run.marks[-1]
             progress({"event": len(run.marks) - 1, "cpu_s": cpu - t_run, "creep_time_s": run.clock.creep_time,
                       "broken": broken, "strain": strain, "equilibria": c["equilibria"]})
-    run = EventCpuRun(specimen, params, stress, max_events=events, counters=static.solver_counters, on_mark=mark)
+    run = EventCpuRun(specimen, params, stress, max_events=events, counters=static.timings.solver_counters, on_mark=mark)
     t_run = time.process_time()
     build = t_run - t0
     run.run()
@@ -197,8 +197,8 @@ def static_hold(params, seed, stress, events, progress=None) -> dict:
     cpu_ev, broken, law_failed, eqs, its = d[:, 0], d[:, 1], d[:, 2], d[:, 4], d[:, 5]
     quiet = broken <= law_failed
     n = len(d)
-    path = static.path_summary(run.scene)
-    c = static.solver_counters(run.scene)
+    path = static.timings.path_summary(run.scene)
+    c = static.timings.solver_counters(run.scene)
     c.update(cpu_s=cpu, cpu_per_equilibrium_s=cpu / max(c["equilibria"], 1),
              equilibria_per_break=c["equilibria"] / max(path["records"], 1),
              cpu_per_break_s=cpu / max(path["records"], 1), cpu_per_bond_s=cpu / max(path["bonds"], 1),

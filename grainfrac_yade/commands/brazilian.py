@@ -15,7 +15,9 @@ import sys
 from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
 from ..protocols.brazilian_output import require_disc_model, run_brazilian_to_folder
 from ..kernel.levers import Levers
+from ._args import add_vtk_every_option
 from ._outcome import numerical_failure_line, steps_phrase
+from ._resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
 def register(sub, common):
@@ -37,9 +39,7 @@ def register(sub, common):
     lv.add_argument("--strength-cv", type=float, default=0.0, metavar="C",
                     help="coefficient of variation of a lognormal factor (mean 1) on each bond's J^T and J^C")
     lv.add_argument("--block-rotation", action="store_true", help="cells do not rotate (rigid cells)")
-    from .resume import add_resume_option
     add_resume_option(p, "Brazilian test")
-    from .ucs import add_vtk_every_option
     add_vtk_every_option(p, "diametral")
     p.set_defaults(func=cmd_brazilian)
 
@@ -47,7 +47,6 @@ def register(sub, common):
 def cmd_brazilian(args) -> int:
     from ._args import load_params_from_args
     if args.resume:
-        from .resume import refuse_resume_conflicts, resumable_run
         refuse_resume_conflicts(args)
         found = resumable_run(args.resume, "brazilian")
         if found is None:
@@ -128,8 +127,9 @@ def check_tensile_scale(base, scaled, factor: float):
 def run_brazilian_in_yade(rows):
     """Entry of ``yade_scripts/brazilian.py``: parameters from the batch row (or defaults); a finished row
     is skipped or stops as a UCS row does, an unfinished one with a checkpoint of this row (no levers)
-    goes on from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
-    ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.engines.yade.batch`)."""
+    goes on from it.  ``rows``: the engine's reader of the batch table
+    (its ``batch_rows``: ``read_table``, ``row_errors``, ``row_plan``, ``run_folder_name``;
+    :mod:`grainfrac_yade.engines.yade.batch`)."""
     from ..params import load_parameters
     from ..runs.runio import read_checkpoint_state
     read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name

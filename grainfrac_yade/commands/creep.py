@@ -4,8 +4,8 @@ from __future__ import annotations
 import math
 
 from ..errors import EXIT_NUMERICAL_FAILURE, GrainfracError
-from ._loads import (PA_PER_MPA, add_confinement_option, check_stress_range, confinement_override, positive_int,
-                     resolve_stress)
+from ._loads import (CREEP_ROW_COLUMNS, PA_PER_MPA, add_confinement_option, check_stress_range, confinement_override,
+                     creep_name_parts, positive_int, resolve_stress)
 from ._outcome import numerical_failure_line, outcome, steps_phrase
 from ..protocols.creep_output import UCS_FROM_CALIBRATION, resume_creep_folder, run_creep_to_folder, ucs_reference
 
@@ -149,16 +149,6 @@ def creep_exit_status(summary: dict, out) -> int:
 def _pa(mpa):
     """A CLI stress [MPa] in Pa (None stays None)."""
     return None if mpa is None else mpa * PA_PER_MPA
-
-
-#: yade-batch columns of a creep row that are not model parameters [Pa or 1; 0 = not given].
-CREEP_ROW_COLUMNS = {"ratio": 0.0, "stress": 0.0, "ucs": 0.0}
-
-
-def creep_name_parts(controls: dict) -> list:
-    """The load columns that name a creep row's folder, before its parameters: ratio (or stress), and ucs if given."""
-    parts = [("ratio", controls["ratio"])] if float(controls["ratio"]) else [("stress", controls["stress"])]
-    return parts + ([("ucs", controls["ucs"])] if float(controls["ucs"]) else [])
 
 
 def run_creep_in_yade(rows):

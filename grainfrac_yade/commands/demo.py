@@ -44,7 +44,7 @@ def _say(t0, msg):
 
 
 def cmd_demo(args, params) -> int:
-    from .specimen import run_specimen
+    from ._specimen import run_specimen
     t0 = time.time()
     repo = Path(__file__).resolve().parents[2]
     out = Path(args.out or time.strftime("results/demo_%Y%m%d-%H%M%S")).resolve()  # a new folder each run

@@ -12,7 +12,8 @@ import json
 import os
 from pathlib import Path
 
-from ..runs.slurm import STATES, study_states
+from ..runs.slurm import STATES
+from ..runs.slurm_states import study_states
 
 
 def register(sub, common):

@@ -21,9 +21,10 @@ from ..errors import GrainfracError
 from ..params import shipped_values
 from ..runs.batchrun import RUN_COLUMNS, check_columns
 from ..runs.slurm import (SubmitOptions, cell_value, frozen_table_text, log_path, new_record, now_iso, read_batch_table,
-                          read_json_file, record_path, render_sbatch, slurm_dir, study_dir_of, study_states,
-                          table_digest, write_record, write_text_atomically)
-from .creep import CREEP_ROW_COLUMNS
+                          read_json_file, record_path, render_sbatch, slurm_dir, study_dir_of, table_digest,
+                          write_record, write_text_atomically)
+from ..runs.slurm_states import study_states
+from ._loads import CREEP_ROW_COLUMNS
 
 #: Scripts by the table columns that make a row a creep row.
 CREEP_COLUMNS = ("ratio", "stress")

@@ -7,16 +7,10 @@ import numpy as np
 
 from ..protocols.ucs_output import run_ucs_to_folder
 from ..errors import EXIT_NUMERICAL_FAILURE
-from ._loads import add_confinement_option, check_stress_range, confinement_override, positive_int
+from ._loads import add_confinement_option, check_stress_range, confinement_override
 from ._outcome import numerical_failure_line, steps_phrase
-from .resume import add_resume_option, refuse_resume_conflicts, resumable_run
-
-
-def add_vtk_every_option(parser, strain: str):
-    """``--vtk-every K``: VTK series of a strain-controlled test, timestep the ``strain`` strain."""
-    parser.add_argument("--vtk-every", type=positive_int, default=None, metavar="K",
-                        help=f"write VTK files of cells and bonds at every K-th history row and at the end into "
-                             f"DIR/vtk/ (cells.pvd, bonds.pvd: time series whose timestep is the {strain} strain)")
+from ._args import add_vtk_every_option
+from ._resume import add_resume_option, refuse_resume_conflicts, resumable_run
 
 
 def register(sub, common):
@@ -70,8 +64,9 @@ def _fmt(value, unit=1e6, digits=1) -> str:
 def run_ucs_in_yade(rows):
     """Entry of ``yade_scripts/ucs.py``: parameters from the batch row (or defaults); a finished row
     is skipped or stops as a creep row does, an unfinished one with a checkpoint of this row goes on
-    from it.  ``rows``: the engine that reads the batch table (``read_table``, ``row_errors``,
-    ``row_plan``, ``run_folder_name``: :mod:`grainfrac_yade.engines.yade.batch`)."""
+    from it.  ``rows``: the engine's reader of the batch table
+    (its ``batch_rows``: ``read_table``, ``row_errors``, ``row_plan``, ``run_folder_name``;
+    :mod:`grainfrac_yade.engines.yade.batch`)."""
     from ..params import load_parameters, require_plane
     read_table, row_errors, row_plan, run_folder_name = rows.read_table, rows.row_errors, rows.row_plan, rows.run_folder_name
     with row_errors():

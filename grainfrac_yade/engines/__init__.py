@@ -10,13 +10,13 @@ Three engines, selected by ``numerics.engine`` (``--engine`` on ``ucs``, ``creep
 * ``"hybrid"``: the static engine with the relaxation strategy of YADE's dynamic stints where the statics give
   out (:mod:`grainfrac_yade.engines.hybrid.engine`; UCS, confined and creep tests).
 
-Every engine module offers ``NAME``, ``build_scene(specimen, params, layout=None)`` and
-``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements
-:class:`Scene` (``_interface.py``), and the hooks the test protocols (:mod:`grainfrac_yade.protocols`)
-and the commands call on it by name (``consolidate``, ``apply_levers``, ``stress_corrosion``, the VTK
-series, the timings of ``bench``; listed in the interface's docstring).  :func:`.registry.engine_for` finds the engine of a run's
+Every engine module declares ``ENGINE``, an :class:`EngineModule` (``_interface.py``): its ``name``, whether it is
+``dynamic``, its checkpoint ``scene_file``, ``build_scene(specimen, params, layout=None)`` and
+``scene_from_state(specimen, params, state, layout=None)`` returning a scene that implements :class:`Scene`, and the
+hooks the test protocols (:mod:`grainfrac_yade.protocols`) and the commands call on it (``consolidate``,
+``apply_levers``, ``stress_corrosion``, what it refuses, the timings of ``bench``).  :func:`.registry.engine_for` finds the engine of a run's
 parameters; a command never imports an engine's package itself.  Adding an engine: a module
-implementing the interface, its name in :data:`.registry.ENGINE_MODULES` and among the choices of
+declaring its ``ENGINE``, its name in :data:`.registry.ENGINE_MODULES` and among the choices of
 ``numerics.engine`` (docs/maintainers.md).  Each engine is a sub-package beside the interface and the registry
 (``yade/``, ``static/``, ``hybrid/``) and imports only the pure core and ``_interface`` (the hybrid also the
 static engine, whose scene it runs with its own relaxation strategy through the scene's public hooks, and, in its
@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from importlib import import_module
 
-__all__ = ["PlatenDrive", "Scene", "SceneState"]
+__all__ = ["EngineModule", "PlatenDrive", "Scene", "SceneState"]
 
 
 def __getattr__(name):

@@ -11,15 +11,16 @@ loaded by platens.  Two kinds are meant to implement it:
 * a quasi-static engine: :meth:`Scene.run` applies load increments, each solved, and
   :meth:`Scene.equilibrate` is one solve.
 
-Engines that integrate motion in time (``DYNAMIC`` in the engine module) have an unbalanced force
+Engines that integrate motion in time (:attr:`EngineModule.dynamic`) have an unbalanced force
 (:meth:`Scene.unbalanced`), which the paper clock (Eq. 8) needs; a creep test's hold is force control by
-the platens (:meth:`PlatenDrive.hold_stress`).  Besides the scene, an engine module offers what the
-protocols call on it by name: ``build_scene``, ``scene_from_state``, ``consolidate`` (a confined test's
-isotropic stage), ``apply_levers`` (Brazilian levers) and ``stress_corrosion(scene, sc_params, saved=None)``,
-the bond writer of a creep test: a :class:`grainfrac_yade.kernel.corrosion.BondCorrosion` (the
-degradation law's state, engine-neutral) that also reads the bond stresses (``stresses``, ``intact``)
-and writes what the law says they carry (``write``, ``degrade``, ``hand_over_failures``), listed among
-the scene's engines (``saved``: its state from a checkpoint).
+the platens (:meth:`PlatenDrive.hold_stress`).  Besides the scene, an engine offers the protocols and the
+commands an :class:`EngineModule` (its ``engine.py``'s ``ENGINE``): ``build_scene``, ``scene_from_state``,
+``consolidate`` (a confined test's isotropic stage), ``apply_levers`` (Brazilian levers) and
+``stress_corrosion(scene, sc_params, saved=None)``, the bond writer of a creep test: a
+:class:`grainfrac_yade.kernel.corrosion.BondCorrosion` (the degradation law's state, engine-neutral) that
+also reads the bond stresses (``stresses``, ``intact``) and writes what the law says they carry (``write``,
+``degrade``, ``hand_over_failures``), listed among the scene's engines (``saved``: its state from a
+checkpoint); and its checkpoint's scene file, what it refuses and its version.
 
 Counters: :attr:`Scene.steps` counts DEM steps (dynamic) or solves (static); :attr:`Scene.time` is
 the engine's own time (DEM time; a static engine's load parameter), both written to the histories
@@ -30,7 +31,7 @@ positive for the normal force; strengths per intact bond area ``layout.bond_area
 modes the codes of :mod:`grainfrac_yade.law` (``MODE_TENSION``, ``MODE_SHEAR``).
 
 :class:`SceneState` is the state that one engine exports (:meth:`Scene.export_state`) and another
-builds its scene from (the engine module's ``scene_from_state``), so that a run can change engine
+builds its scene from (its :class:`EngineModule`'s ``scene_from_state``), so that a run can change engine
 mid-way, e.g. a quasi-static engine handing a collapse to a dynamic one and taking the result back.
 """
 from __future__ import annotations
@@ -131,6 +132,15 @@ class PlatenDrive(Protocol):
 
     def resume_hold(self, saved: dict) -> object:
         """:meth:`hold_stress` as a checkpoint saved it (``saved``: the servo's attributes by name)."""
+
+    def state_dict(self) -> dict:
+        """What a checkpoint keeps of the platens (JSON values by name): the closing speed ``velocity`` [m/s], the
+        last reaction ``reaction_pa`` [Pa] and the engine's own reference positions from which the strains are
+        measured; also a state's ``platens`` (:meth:`Scene.export_state`)."""
+
+    def restore_state(self, saved: dict) -> None:
+        """After the scene's restore from a checkpoint (:meth:`Scene.restore_checkpoint`): the platens as
+        :meth:`state_dict` saved them (``saved``), their handles on the restored scene fetched anew."""
 
 
 @runtime_checkable
@@ -265,4 +275,53 @@ class Scene(Protocol):
         """The scene's state in the engine-neutral form (with ``platens``' state if given)."""
 
 
-__all__ = ["PlatenDrive", "Scene", "SceneState"]
+def _no_warnings(overrides, params) -> list:
+    """A dynamic engine reads every setting: no warning."""
+    return []
+
+
+@dataclass(frozen=True)
+class EngineModule:
+    """What one engine offers the test protocols and the commands: the ``ENGINE`` of its sub-package's
+    ``engine.py``, which the registry (:func:`grainfrac_yade.engines.registry.engine`) returns.
+
+    ``name``: the value of ``numerics.engine`` that selects it.  ``dynamic``: it integrates motion in time (inertia,
+    an unbalanced force: the paper clock's Eq. 8 needs one).  ``scene_file``: the name of the file a checkpoint
+    keeps its scene in (:meth:`Scene.save`, :meth:`Scene.restore_checkpoint`).  ``version()``: the versions of
+    what it computes with (what a run records).
+
+    The scene: ``build_scene(specimen, params, layout=None)`` and ``scene_from_state(specimen, params, state,
+    layout=None)`` (a :class:`Scene`); the hooks the protocols call on it: ``consolidate(scene, platens, stress,
+    params)`` (a confined test's isotropic stage), ``apply_levers(scene, levers, seed)`` (Brazilian levers: what
+    was done) and ``stress_corrosion(scene, sc_params, saved=None)`` (a creep test's bond writer, a
+    :class:`grainfrac_yade.kernel.corrosion.BondCorrosion` listed among the scene's drivers; ``saved``: its
+    state from a checkpoint).
+
+    What the command line refuses before a run folder is made: ``unsupported`` (command -> the one line that
+    says so and the fix), ``vtk_refused`` (the line refusing a VTK series, "" if it writes them), and
+    ``warn_dynamic_only(overrides, params)`` (one warning line per setting given that the engine does not read).
+    Engine-specific tools, None where an engine has none: ``timings`` (the module of ``bench``'s timings) and
+    ``batch_rows`` (the module that reads a yade-batch row: ``read_table``, ``row_errors``, ``row_plan``,
+    ``run_folder_name``).
+    """
+    name: str
+    dynamic: bool
+    scene_file: str
+    version: Callable[[], str]
+    build_scene: Callable[..., Scene]
+    scene_from_state: Callable[..., Scene]
+    consolidate: Callable
+    apply_levers: Callable[..., dict]
+    stress_corrosion: Callable
+    unsupported: dict = field(default_factory=dict)
+    vtk_refused: str = ""
+    warn_dynamic_only: Callable[[list, object], list] = _no_warnings
+    timings: object = None
+    batch_rows: object = None
+
+    def refusal(self, command: str) -> str:
+        """The one line that refuses ``command`` on this engine, "" if it runs it."""
+        return self.unsupported.get(command, "")
+
+
+__all__ = ["EngineModule", "PlatenDrive", "Scene", "SceneState"]

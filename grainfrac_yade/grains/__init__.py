@@ -34,6 +34,11 @@ def grain_model(name: str) -> GrainModel:
     return importlib.import_module(f"{__name__}.{name}").MODEL
 
 
+def rotating_grain_models() -> list:
+    """The names of the grain models whose bodies rotate in the plane (``GrainModel.rotating``)."""
+    return [name for name in GRAIN_MODEL_NAMES if grain_model(name).rotating]
+
+
 def model_of(layout: ClumpLayout) -> GrainModel:
     """The grain model that built ``layout``."""
     return grain_model(layout.model)
@@ -52,4 +57,5 @@ def critical_dem_step(specimen: Specimen, params: Parameters, layout: ClumpLayou
     return model_of(layout).masses_and_step(specimen, params, layout, props)[2]
 
 
-__all__ = ["GRAIN_MODEL_NAMES", "GrainModel", "critical_dem_step", "grain_model", "layout_for", "model_of"]
+__all__ = ["GRAIN_MODEL_NAMES", "GrainModel", "critical_dem_step", "grain_model", "layout_for", "model_of",
+           "rotating_grain_models"]

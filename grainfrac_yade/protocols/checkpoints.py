@@ -4,7 +4,10 @@ any engine: the engine saves and restores its scene (:meth:`grainfrac_yade.engin
 
 A checkpoint is the folder ``DIR/checkpoint/`` (:data:`grainfrac_yade.runs.runio.CHECKPOINT`):
 
-* ``scene.yade.gz``: the YADE scene (``O.save``, YADE's binary archive, gzip'd: exact doubles);
+* the engine's scene, in the file the engine names (:attr:`grainfrac_yade.engines.EngineModule.scene_file`,
+  recorded in ``state.json``): ``scene.yade.gz`` for YADE (``O.save``, YADE's binary archive, gzip'd: exact
+  doubles), ``scene.npz`` for the static and hybrid engines; a checkpoint written before the engines named theirs
+  has its scene in ``scene.yade.gz`` whatever the engine (:data:`grainfrac_yade.runs.runio.LEGACY_SCENE_FILE`);
 * ``arrays.npz``: the driver's per-bond arrays (bookkeeping of breaks; creep: the degradation law's
   state: strengths J^T, J^C of paper Eq. 7 or area fractions, break and macrocrack times, the bond
   stresses at the start of creep; UCS and Brazilian: the history so far and the snapshot at the peak);
@@ -55,8 +58,8 @@ import numpy as np
 
 from ..errors import GrainfracError
 from ..grains import grain_model
-from ..runs.runio import (ARRAYS_FILE, CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP, SCENE_FILE,  # noqa: F401
-                          check_files, checkpoint_folder, code_version)
+from ..runs.runio import (ARRAYS_FILE, CHECKPOINT, CHECKPOINT_OLD, CHECKPOINT_STATE, CHECKPOINT_TMP,  # noqa: F401
+                          SCENE_FILE_KEY, check_files, checkpoint_folder, code_version, scene_file_of)
 from ..runs.columns import HISTORY_RENAMED
 
 #: Layout of state.json and arrays.npz; a checkpoint of another layout is refused.
@@ -135,11 +138,12 @@ class Checkpointer:
             shutil.rmtree(tmp, ignore_errors=True)
             tmp.mkdir(parents=True)
             state, arrays = self.capture(run, phase, loop, self.run_values, self.code_version)
-            run.scene.save(tmp / SCENE_FILE)
+            scene_file = state[SCENE_FILE_KEY] = run.engine.scene_file   # the engine's name for its scene's file
+            run.scene.save(tmp / scene_file)
             with open(tmp / ARRAYS_FILE, "wb") as fh:
                 np.savez(fh, **arrays)
             text = json.dumps(state, indent=1, default=_json_value) + "\n"
-            for name in (SCENE_FILE, ARRAYS_FILE):
+            for name in (scene_file, ARRAYS_FILE):
                 _fsync(tmp / name)
             (tmp / CHECKPOINT_STATE).write_text(text)   # last, once the rest is on disk: marks it complete
             _fsync(tmp / CHECKPOINT_STATE)
@@ -213,13 +217,13 @@ def restore_scene(sc, where, state: dict, arrays: dict, confinement=None):
     """Replace scene ``sc`` (freshly built from the same specimen and parameters) by the checkpoint's
     (:meth:`Scene.restore_checkpoint`) with its bond bookkeeping; ``confinement``: the side-wall forces
     set again (None: unconfined)."""
-    sc.restore_checkpoint(where, where / SCENE_FILE, state["scene"], arrays, confinement)
+    sc.restore_checkpoint(where, where / scene_file_of(state, where), state["scene"], arrays, confinement)
 
 
 def restore_platens(pl, p: dict):
-    """After :func:`restore_scene`: the platens' body handles anew, their reference positions and speed."""
-    pl.rebind(p["reaction_pa"])
-    pl.velocity, pl.y0_top, pl.y0_bottom, pl.x0_gap = p["velocity"], p["y0_top"], p["y0_bottom"], p["x0_gap"]
+    """After :func:`restore_scene`: the platens (:class:`grainfrac_yade.engines.PlatenDrive`) as the checkpoint
+    saved them (:meth:`~grainfrac_yade.engines.PlatenDrive.restore_state`)."""
+    pl.restore_state(p)
 
 
 

@@ -49,9 +49,9 @@ class LoadingTest:
         result = {STEPS: int(scene.steps), "wall_s": time.time() - self.t0}
         if cpu:
             result["cpu_s"] = time.process_time() - self.c0
-        engine = self.engine   # the engine module of the run (its NAME, its DYNAMIC flag)
-        step = "dem_timestep_s" if getattr(engine, "DYNAMIC", False) else "load_increment_s"
-        result.update({STEPS_COUNTED_KEY: steps_counted(engine), "engine": engine.NAME,
+        engine = self.engine   # the engine of the run (an EngineModule: its name, whether it is dynamic)
+        step = "dem_timestep_s" if engine.dynamic else "load_increment_s"
+        result.update({STEPS_COUNTED_KEY: steps_counted(engine), "engine": engine.name,
                        step: scene.dt, "n_bonds": scene.n_bonds, **counts,
                        "numerical_failure": numerical, "bonds_erased_by_sliding": scene.sliding_erasures(),
                        "peak_reached": peak_reached, "end_reason": end, **extra})

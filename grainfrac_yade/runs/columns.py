@@ -10,7 +10,7 @@ from __future__ import annotations
 STEP, TIME = "step", "time_s"
 #: Summary key of the steps the run took.
 STEPS = "steps"
-#: What a scene's ``steps`` count, by whether its engine integrates motion (the engine module's ``DYNAMIC``): summary
+#: What a scene's ``steps`` count, by whether its engine integrates motion (the engine's ``dynamic``): summary
 #: key ``steps_counted`` and the commands' result lines.  A static (or hybrid) engine solves equilibria; the hybrid's
 #: dynamic stints count their DEM steps apart (``dynamic_stint_dem_steps``).
 STEPS_COUNTED = {True: "DEM steps", False: "equilibria solved"}
@@ -18,9 +18,10 @@ STEPS_COUNTED = {True: "DEM steps", False: "equilibria solved"}
 STEPS_COUNTED_KEY = "steps_counted"
 
 
-def steps_counted(engine_module) -> str:
-    """What the ``steps`` of a run on ``engine_module`` (:func:`grainfrac_yade.engines.registry.engine_for`) count."""
-    return STEPS_COUNTED[bool(getattr(engine_module, "DYNAMIC", False))]
+def steps_counted(engine) -> str:
+    """What the ``steps`` of a run on ``engine`` (an :class:`grainfrac_yade.engines.EngineModule`,
+    :func:`grainfrac_yade.engines.registry.engine_for`) count."""
+    return STEPS_COUNTED[bool(engine.dynamic)]
 
 
 #: History columns renamed: the old name -> today's (UCS and Brazilian histories had ``dem_step`` and

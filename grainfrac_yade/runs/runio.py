@@ -49,11 +49,15 @@ RESULT_NEUTRAL_KEYS = ("numerics.checkpoint_interval",)
 CHECKPOINT = "checkpoint"
 CHECKPOINT_STATE = "state.json"
 CHECKPOINT_TMP, CHECKPOINT_OLD = CHECKPOINT + ".tmp", CHECKPOINT + ".old"
-#: The YADE scene inside a checkpoint (``O.save``; the extension selects the gzip'd binary archive).
-SCENE_FILE = "scene.yade.gz"
+#: The state.json key naming the file that holds a checkpoint's scene: the engine's own name for it
+#: (:attr:`grainfrac_yade.engines.EngineModule.scene_file`).
+SCENE_FILE_KEY = "scene_file"
+#: The scene's file in a checkpoint whose state.json names none: code before each engine named its own kept every
+#: engine's scene under YADE's name (a static or hybrid scene's npz too, told apart by its first bytes).
+LEGACY_SCENE_FILE = "scene.yade.gz"
 #: Per-bond arrays of the driver.
 ARRAYS_FILE = "arrays.npz"
-#: The first bytes of a zip archive (numpy's npz: the static engines' saved scene in SCENE_FILE).
+#: The first bytes of a zip archive (numpy's npz: the static engines' saved scene, also under the legacy name).
 ZIP_MAGIC = b"PK\x03\x04"
 
 
@@ -330,6 +334,21 @@ def run_digest(params, run_values: dict) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:8]
 
 
+#: The fix a damaged checkpoint's one line names.
+RESTART_FIX = "fix: start the run again with the same command (run.json) and --overwrite"
+
+
+def scene_file_of(state: dict, where) -> str:
+    """The name of the file that holds the scene of the checkpoint ``where`` whose state.json is ``state``: the one
+    it names (:data:`SCENE_FILE_KEY`), else :data:`LEGACY_SCENE_FILE`; GrainfracError (one line) if what it names
+    is not a file name."""
+    name = state.get(SCENE_FILE_KEY, LEGACY_SCENE_FILE)
+    if not isinstance(name, str) or not name or Path(name).name != name or name in (".", ".."):
+        raise GrainfracError(f"{where}: the checkpoint's state file names no scene file ({SCENE_FILE_KEY} "
+                             f"{name!r}); {RESTART_FIX}")
+    return name
+
+
 def check_files(where) -> None:
     """GrainfracError (one line naming the file) if checkpoint folder ``where`` has a state file that is not JSON,
     an arrays file that numpy cannot read whole, or a scene that is neither a complete gzip stream (YADE's) nor an npz
@@ -337,7 +356,7 @@ def check_files(where) -> None:
     before YADE is loaded and before anything is written.  Reads every file once (the scene's gzip stream to its
     end: about a second per 100 MB)."""
     where = Path(where)
-    fix = "fix: start the run again with the same command (run.json) and --overwrite"
+    fix = RESTART_FIX
     try:
         state = json.loads((where / CHECKPOINT_STATE).read_text())
         if not isinstance(state, dict):
@@ -353,7 +372,7 @@ def check_files(where) -> None:
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise GrainfracError(f"{where / ARRAYS_FILE}: the checkpoint's arrays are unreadable "
                              f"(truncated or not numpy's npz; {type(exc).__name__}: {exc}); {fix}") from None
-    scene = where / SCENE_FILE
+    scene = where / scene_file_of(state, where)
     try:
         with open(scene, "rb") as fh:
             npz = fh.read(len(ZIP_MAGIC)) == ZIP_MAGIC

@@ -12,12 +12,10 @@ Importing this module does not import YADE: the first stint does.
 """
 from __future__ import annotations
 
-from ..static.engine import (VTK_REFUSED,  # noqa: F401
-                             apply_levers, consolidate, stress_corrosion)
-from ..static.engine import UNSUPPORTED as STATIC_UNSUPPORTED
-from ..static.engine import version as static_version
-from ..static.scene import StaticScene
+from .._interface import EngineModule
 from ..dynamic import dynamic_engine
+from ..static.engine import ENGINE as STATIC
+from ..static.scene import StaticScene
 from .stints import DynamicStints
 from .settings import warn_not_used
 
@@ -30,14 +28,14 @@ DYNAMIC_ENGINE = "yade"
 DYNAMIC = False
 #: Commands the hybrid engine cannot run -> the one line that says so and the fix: the static engine's, and the
 #: Brazilian test (its stints would need YADE's jaws handed the static state).
-UNSUPPORTED = {**STATIC_UNSUPPORTED,
+UNSUPPORTED = {**STATIC.unsupported,
                "brazilian": ("the hybrid engine has no Brazilian test (its dynamic stints would need YADE's jaws); fix: "
                              "--engine yade or --engine static")}
 
 
 def version() -> str:
     """The static engine's libraries (the stints' YADE version is recorded with the stints' engine)."""
-    return static_version()
+    return STATIC.version()
 
 
 def warn_dynamic_only(overrides, params) -> list:
@@ -58,3 +56,11 @@ def scene_from_state(specimen, params, state, layout=None) -> StaticScene:
     scene = build_scene(specimen, params, layout)
     scene.apply_state(state)
     return scene
+
+
+#: What the registry returns for ``numerics.engine = "hybrid"``: the static engine's tests, bond writer and
+#: checkpoint scene file (a static scene's npz, stints and all) with the static scene run by the stints' strategy.
+ENGINE = EngineModule(name=NAME, dynamic=DYNAMIC, scene_file=STATIC.scene_file, version=version,
+                      build_scene=build_scene, scene_from_state=scene_from_state, consolidate=STATIC.consolidate,
+                      apply_levers=STATIC.apply_levers, stress_corrosion=STATIC.stress_corrosion,
+                      unsupported=UNSUPPORTED, vtk_refused=STATIC.vtk_refused, warn_dynamic_only=warn_dynamic_only)

@@ -10,6 +10,8 @@ explicit dynamic relaxation (docs/engines.md).  One module per job:
   shear, paper Eq. 4-5), broken ones (compression only, residual friction, return mapping), stress-to-strength ratios;
 * :mod:`.solver`: equilibrium at a platen closure: the active-set iteration on open/closed and stick/slip
   contacts, SuperLU factors, split steps where statuses cycle, cells cut loose, ground springs of a singular factor;
+* :mod:`.factoring`: the kept SuperLU factor of the equilibrium's tangent (plain, grounded or the fast path's
+  reference), its pivot and residual checks, saved and rebuilt bit for bit;
 * :mod:`.tangent`: the fast linear algebra: the tangent assembled on one cached pattern, a kept factor reused by
   low-rank (Woodbury) updates;
 * :mod:`.cascade`: bonds broken one at a time, the most overstressed first; the sequentially linear path in the

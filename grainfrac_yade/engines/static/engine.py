@@ -15,7 +15,7 @@ stiffness-changing law, rough platens, blocked rotation of fem cells) is refused
 Brazilian test runs on the disc's jaws of :mod:`.jaws` (``attach_jaws``) with the levers of ``apply_levers``.
 What ``bench --static`` and the static study scripts read of a scene beside the protocols (:mod:`.bench_timing`:
 the solver's counters, the path's breaks, the path alone timed for a number of breaks, in CPU time) is reached
-here, as YADE's timings are in its engine module.  VTK series are written as on any engine
+here (:data:`ENGINE`'s ``timings``), as YADE's timings are in its engine module.  VTK series are written as on any engine
 (:mod:`grainfrac_yade.protocols.snapshots` reads the scene's ``cell_motion`` and ``bond_shift``; :data:`VTK_REFUSED`
 is empty).
 
@@ -34,14 +34,17 @@ from ...errors import GrainfracError
 from ...law import MODE_CORRODED, Stresses, check_finite
 from ...kernel.corrosion import BondCorrosion
 from ...geometry.disc import DiscTessellation
-from .bench_timing import path_summary, solver_counters, timed_path  # noqa: F401
+from .._interface import EngineModule
+from . import bench_timing
 from .jaws import DiscScene
 from .jaws import apply_levers as _apply_levers
-from .scene import (STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state)  # noqa: F401
-from .settings import DYNAMIC_ONLY, NAME, summary_keys, warn_dynamic_only  # noqa: F401
+from .scene import STIFFNESS_LAW_REFUSED, VTK_REFUSED, StaticScene, consolidate, scene_from_state
+from .settings import NAME, warn_dynamic_only
 
 #: No time integration: no inertia and no unbalanced force (the paper clock's Eq. 8 needs one).
 DYNAMIC = False
+#: A checkpoint's scene: numpy's npz of the core's state (:meth:`.scene.StaticScene.save`).
+SCENE_FILE = "scene.npz"
 
 #: Commands the static engine cannot run -> the one line that says so and the fix: none (the hybrid engine adds its own).
 UNSUPPORTED: dict = {}
@@ -114,3 +117,10 @@ def apply_levers(scene: StaticScene, levers, seed: int) -> dict:
     """The Brazilian levers on a static scene before its loading (:func:`.jaws.apply_levers`: strength scatter and
     slits on both grain models, blocked rotation on rigid cells); what was done, as YADE's counts."""
     return _apply_levers(scene, levers, seed)
+
+
+#: What the registry returns for ``numerics.engine = "static"``.
+ENGINE = EngineModule(name=NAME, dynamic=DYNAMIC, scene_file=SCENE_FILE, version=version, build_scene=build_scene,
+                      scene_from_state=scene_from_state, consolidate=consolidate, apply_levers=apply_levers,
+                      stress_corrosion=stress_corrosion, unsupported=UNSUPPORTED, vtk_refused=VTK_REFUSED,
+                      warn_dynamic_only=warn_dynamic_only, timings=bench_timing)

@@ -39,6 +39,7 @@ import numpy as np
 
 from ...errors import GrainfracError
 from ...geometry.disc import DiscTessellation
+from ...grains import rotating_grain_models
 from ...kernel.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
 from .network import StaticNetwork, _side_weights
@@ -48,9 +49,11 @@ from .solver import Equilibrium
 
 #: Lateral conditions of the jaws (``brazilian.platen_lateral``): "fixed" u_x = 0, "free" u_x free.
 LATERALS = ("fixed", "free")
-#: The one line that refuses ``block_rotation`` on a grain model without rotation dofs.
-BLOCK_ROTATION_REFUSED = ("static engine: --block-rotation blocks the rotation of rigid cells; fem cells' nodes "
-                          "have no rotation dof; fix: leave it out, or resolution.grain_model = \"rigid\"")
+#: The one line that refuses ``block_rotation`` on a grain model without rotation dofs (the grain models whose
+#: bodies rotate named as the fix).
+BLOCK_ROTATION_REFUSED = ("static engine: --block-rotation blocks the rotation of cells whose bodies rotate; this grain "
+                          "model's nodes have no rotation dof; fix: leave it out, or resolution.grain_model = one of "
+                          f"{rotating_grain_models()}")
 
 
 def jaw_cells(tessellation, loading_arc: float) -> tuple:
@@ -173,6 +176,10 @@ class StaticJaws(StaticPlatens):
         return {"velocity": self.velocity, "closure": float(self.scene.state.closure), "load_n": self.load(),
                 "lateral": self.lateral, "path_max_load_n": self.path_max_load(),
                 "rotation_blocked": bool(getattr(self.scene, "rotation_blocked", False))}
+
+    def restore_state(self, saved: dict) -> None:
+        """The platens' restore (:class:`grainfrac_yade.engines.PlatenDrive`) of the jaws: :meth:`rebind`."""
+        self.rebind(saved)
 
     def rebind(self, state) -> None:
         """After a restore: the closing speed, the largest load so far and a blocked rotation (the lever, applied

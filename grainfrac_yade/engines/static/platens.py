@@ -79,8 +79,11 @@ class StaticPlatens:
                 "x0_gap": float(self.x0_gap), "reaction_pa": self.axial_stress(),
                 "closure": float(self.scene.state.closure)}
 
-    def rebind(self, reaction: float) -> None:
-        """After a restore: nothing to fetch (the stress is the restored state's)."""
+    def restore_state(self, saved: dict) -> None:
+        """After a restore: the speed and the reference positions of :meth:`state_dict` (nothing to fetch: the
+        closure and the stress are the restored state's)."""
+        self.velocity, self.y0_top, self.y0_bottom, self.x0_gap = (saved["velocity"], saved["y0_top"],
+                                                                   saved["y0_bottom"], saved["x0_gap"])
 
 
 class StaticServo:

@@ -4,8 +4,9 @@ Each grain model of :mod:`grainfrac_yade.grains` has its YADE side in a module o
 (:mod:`.rigid_cells`, :mod:`.fem_cells`) with the same functions: ``configure_geometry``,
 ``engines``, ``collider_mask_bit``, ``append_bodies`` (returning :class:`CellBodies`),
 ``bond_kinematics``, ``finish``, and the readers ``bodies_of``, ``cell_positions``, ``cell_motion``
-and ``bond_shift``, and the flag ``BONDS_ON_FACES`` (the bonds act on their face's plane, YADE's smooth
-joint, rather than along the line of the sphere centres).  :func:`grainfrac_yade.engines.yade.scene.build_scene` calls them.
+and ``bond_shift``, and the grain model it builds (``MODEL``, whose name selects the module and whose
+``bonds_on_faces`` says whether the bonds act on their face's plane, YADE's smooth joint, rather than along the
+line of the sphere centres).  :func:`grainfrac_yade.engines.yade.scene.build_scene` calls them.
 """
 from __future__ import annotations
 

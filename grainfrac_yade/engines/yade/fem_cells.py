@@ -28,9 +28,6 @@ from .cell_bodies import CellBodies, cell_spheres, set_mass_inertia, sphere_posi
 #: a spring between non-touching spheres would act with k_s (r1 + r2)/d (measured: 1/2 at d = 2(r1 + r2)).
 #: False: the plain relative displacement, k_s as given, the static solve's kinematics.
 RATCHETING_GUARD = False
-#: The bonds act on their face's plane (YADE's smooth joint: normal and opening along the face normal,
-#: ``jointNormal``), as the static solve's two-node springs do.
-BONDS_ON_FACES = True
 
 #: Collision mask bit shared by every sphere of a scene with per-cell masks (and the collider's
 #: ``avoidSelfInteractionMask``): YADE makes no contact between two bodies of equal masks that

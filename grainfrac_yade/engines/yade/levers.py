@@ -25,10 +25,10 @@ Random draws use their own stream, seeded by the specimen's seed: the specimen i
 """
 from __future__ import annotations
 
-
 import numpy as np
 
 from ...errors import GrainfracError
+from ...grains import rotating_grain_models
 from ...kernel.levers import LEVER_STREAM, PRE_EXISTING, Levers, lever_draws, new_breaks  # noqa: F401
 
 def apply_levers(scene, levers: Levers, seed: int) -> dict:
@@ -38,8 +38,10 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         return done
     if scene.O.iter != 0:
         raise GrainfracError("levers: the scene has already run; fix: apply levers right after build_scene")
-    if scene.model.name != "rigid":
-        raise GrainfracError("levers: built for rigid cells; fix: use resolution.grain_model = \"rigid\"")
+    if not scene.model.rotating:   # the levers act on each cell's one body, which rotates
+        rotating = rotating_grain_models()
+        raise GrainfracError(f"levers: built for cells that are one rotating body each (grain models {rotating}), "
+                             f"not {scene.model.name!r} cells; fix: use resolution.grain_model = \"{rotating[0]}\"")
     factor, slits = lever_draws(levers, seed, scene.n_bonds)
     if factor is not None:
         for k, inter in enumerate(scene.interactions):

@@ -73,6 +73,13 @@ class Platens:
         return {"velocity": self.velocity, "y0_top": float(self.y0_top), "y0_bottom": float(self.y0_bottom),
                 "x0_gap": float(self.x0_gap), "reaction_pa": float(self.axial_stress())}
 
+    def restore_state(self, saved: dict) -> None:
+        """After ``O.load`` of a checkpoint: the handles anew and the saved reaction (:meth:`rebind`), then the
+        speed and the reference positions of :meth:`state_dict`."""
+        self.rebind(saved["reaction_pa"])
+        self.velocity, self.y0_top, self.y0_bottom, self.x0_gap = (saved["velocity"], saved["y0_top"],
+                                                                   saved["y0_bottom"], saved["x0_gap"])
+
     def _cache_handles(self):
         """Body ids and state handles of the platen bodies, fetched once: the servo reads their forces
         and sets their velocities before every DEM step, and each ``body.state`` / ``body.id`` lookup

@@ -12,10 +12,6 @@ import numpy as np
 from ...grains.rigid import MODEL
 from .cell_bodies import CellBodies, cell_spheres, set_mass_inertia
 
-#: The bonds act along the line of the two sphere centres (YADE's default JCFpm kinematics), not on
-#: their face's plane.
-BONDS_ON_FACES = False
-
 
 def _blocked_dofs(dim: int) -> str:
     """Pseudo-2D: no out-of-plane translation (z) or rotation about x, y."""
