@@ -70,3 +70,14 @@ def test_the_post_peak_rule_is_the_protocol_s():
     assert run.scene.load_loss_ratio == 0.6 and run.scene.path.load_loss_ratio == 0.6
     run.scene.confine(1e6)
     assert run.scene.path.load_loss_ratio == 0.6
+
+
+def test_a_confined_hybrid_scene_keeps_its_hand_over_size():
+    """Confinement rebuilds the static path; the hybrid's hand-over size (``numerics.handover_cascade_bonds``)
+    stays set on the rebuilt path (it was dropped once, so that a confined hybrid run never handed a large
+    cascade to YADE)."""
+    p = load_parameters(overrides=[*TINY, "numerics.engine=hybrid", "numerics.handover_cascade_bonds=2"])
+    scene = engine("hybrid").build_scene(build_specimen(p, 1), p)
+    assert scene.path.max_cascade == 2
+    scene.confine(10e6)
+    assert scene.path.max_cascade == 2

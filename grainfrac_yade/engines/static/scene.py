@@ -379,6 +379,7 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         self.path.load_loss_ratio = self.load_loss_ratio
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)
+        self.strategy.attach(self)          # the rebuilt path takes the strategy's settings again (a hand-over size)
         self.state = self.eq.solve(self.state.closure, self.state)
 
     def summary_keys(self) -> dict:
