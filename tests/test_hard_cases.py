@@ -6,6 +6,7 @@ Each run asserts that no output holds NaN or inf, that no bond strength is negat
 with its reason (``end_reason`` in summary.json), and that a numerical failure is that outcome and
 nothing else.  Run times (one thread, this 2-core machine) are in each test's docstring.
 """
+import dataclasses
 import itertools
 import json
 import math
@@ -136,7 +137,9 @@ def step_ten_times_critical(monkeypatch):
             scene.O.dt = 10 * scene.dt_critical
             return scene
         return build_then_step_up
-    monkeypatch.setattr(engine, "build_scene", stepping_up(engine.build_scene))   # what every test protocol builds with
+    # the engine the registry gives every test protocol (its module's ENGINE, read at each lookup)
+    monkeypatch.setattr(engine, "ENGINE", dataclasses.replace(engine.ENGINE,
+                                                             build_scene=stepping_up(engine.ENGINE.build_scene)))
 
 
 @needs_yade
