@@ -17,6 +17,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, Voronoi
 
 from ..errors import GrainfracError
+from ..params.cells import cell_count
 
 #: Faces shorter than this fraction of the grain size are dropped as degenerate
 #: (they come from four nearly co-circular seeds; their bonds would carry nothing).
@@ -83,14 +84,6 @@ class Tessellation:
     def cells_on_side(self, side: str) -> np.ndarray:
         """Indices of cells with a face on wall ``side`` (e.g. "top")."""
         return np.unique(self.boundary_cell[self.boundary_side == SIDES.index(side)])
-
-
-def cell_count(box, grain_size: float) -> float:
-    """Number of cells whose mean equivalent diameter is ``grain_size``, as a float: the box's area (volume) over a
-    cell's, pi d^2 / 4 (pi d^3 / 6); inf where that overflows a float (a box of 1e308 m), never an error."""
-    box = [float(b) for b in box]
-    cell = math.pi / 4 * grain_size**2 if len(box) == 2 else math.pi / 6 * grain_size**3
-    return math.prod(box) / cell
 
 
 def n_cells_for(box, grain_size: float) -> int:

@@ -17,7 +17,7 @@ from typing import Mapping
 from ..arrhenius import betas_from_physical
 from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
-from ..geometry.tessellation import cell_count
+from .cells import cell_count
 from .files import read_toml
 from .schema import (DEFAULT_FILES, FRACTION_SUM_TOLERANCE, PARAMS_DIR, SECTION_CLASSES, ContactParams, GrainParams,
                      Parameters, SpecimenParams, StressCorrosionParams, _check_value, average_contact, field_spec,
