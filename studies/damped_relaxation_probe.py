@@ -2,7 +2,7 @@
 not settle (``numerics.static_relaxation = "overdamped"``), or on its plain path (``--plain``): one JSON line (no
 YADE).
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.damped_relaxation_probe --params params/presets/fem.toml \
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.damped_relaxation_probe --params params/presets/fem_coarse.toml \
         --width 10e-3 --height 20e-3 --seed 1 --creep-stress 160e6 [--plain] [--events N]
 
 The creep protocol (``bench --static``'s timed hold, :func:`grainfrac_yade.api.static_hold`) for at most ``--events``

@@ -19,7 +19,7 @@ print("Tables 1 and 2 as printed (stiffness factor 1), uniaxial compression betw
 print("Run name: specimen width, seed, model, contact nodes per face (k), radial rings (r), platens.")
 print("Ratios are contact stress over the applied stress; `per face` sums the forces of a face's")
 print("contacts over the face.  `mesh` is the triangle-mesh reference (the paper's deformable blocks).")
-print("`fem` is the YADE finite-element cells (params/presets/fem.toml, contact inset 0.001) solved")
+print("`fem` is the YADE finite-element cells (params/presets/fem_coarse.toml, contact inset 0.001) solved")
 print("statically (the YADE scene gives the same forces within 1e-8, tests/test_fem_scene.py).\n")
 print("| run | E [GPa] | nu | shear p50 | p99 | max | per face p99 | per face max | tension p99 | tension max |")
 print("|---|---|---|---|---|---|---|---|---|---|")

@@ -3,7 +3,7 @@
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.fem_profile --size small --seed 3 [--set KEY=VALUE ...]
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.fem_profile --size paper --seed 3
 
-Builds the specimen with ``params/presets/fem.toml`` (plus ``--params``/``--set``), moves the
+Builds the specimen with ``params/presets/fem_coarse.toml`` (plus ``--params``/``--set``), moves the
 platens at ``ucs.strain_rate`` as a UCS test does, takes ``--warmup`` DEM steps, then ``--steps``
 steps with YADE's engine timing on (``O.timingEnabled``) through ``GrainScene.run`` (as every test
 steps), and prints one JSON line: bodies, interactions, the DEM step, DEM steps and body-steps per
@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 from grainfrac_yade.api import load_parameters
 
 SIZES = {"small": (10e-3, 20e-3), "mid": (20e-3, 40e-3), "paper": (31.7e-3, 63.4e-3)}
-FEM_PRESET = ROOT / "params" / "presets" / "fem.toml"
+FEM_PRESET = ROOT / "params" / "presets" / "fem_coarse.toml"
 
 
 def main(argv=None):

@@ -11,7 +11,7 @@ would have called ``--max-steps`` beyond ``creep.max_relaxation_steps`` a failur
 Wave crossings: DEM steps x dt / (H / c), c = sqrt(E / (rho x numerics.density_scale)), E the servo's
 modulus estimate (held stress / axial strain at the end of the ramp), rho the area-weighted Table 1 density.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.hold_relaxation --params params/presets/fem.toml \\
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.hold_relaxation --params params/presets/fem_coarse.toml \\
         --set specimen.min_edge_fraction=0.02 --stress 160 --seed 1 --max-steps 150000 --out results/hold/fem160_s1
 """
 from __future__ import annotations

@@ -9,7 +9,7 @@ Two parts, each writing one CSV into docs/studies/ (units in the column names):
   time, one thread), each against the same specimen without the lever.
 
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_bands grain-size
-    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_bands levers --params params/presets/fem.toml \\
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.lab_bands levers --params params/presets/fem_coarse.toml \\
         --out results/lab_bands [--only NAME ...]
 
 Rows of ``levers`` already in the CSV are kept (a run replaces the row of its setting and seed); ``--only``

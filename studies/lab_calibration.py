@@ -41,7 +41,7 @@ from studies.lab_bands import LEVER_FIELDS, measure
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The base model: finite-element cells, Tables 1 and 2 as printed.
-BASE_PARAMS = [str(ROOT / "params" / "presets" / "fem.toml")]
+BASE_PARAMS = [str(ROOT / "params" / "presets" / "fem_coarse.toml")]
 #: Specimens: the 10 x 20 mm UCS specimen of the fem studies and the smallest disc whose sigma_t the
 #: lever study read (10 mm, about 100 cells) [m].
 UCS_SIZE = (10e-3, 20e-3)

@@ -2,7 +2,7 @@
 (``specimen.min_edge_fraction``): docs/regularisation_tails.csv and its table in docs/studies/regularisation.md.
 
 The static uniaxial solve of ``grainfrac_yade.elastic`` (the one ``python3 -m grainfrac_yade elastic --grains fem``
-runs; no YADE), Tables 1 and 2 as printed (params/presets/fem.toml), 10 x 20 mm and the paper's 31.7 x 63.4 mm,
+runs; no YADE), Tables 1 and 2 as printed (params/presets/fem_coarse.toml), 10 x 20 mm and the paper's 31.7 x 63.4 mm,
 seeds 1-3. Per bond and per face (the forces of a face's bonds summed over the face): the p99 and the largest
 shear and tensile stress over the applied axial stress, and E and nu, each paired against threshold 0 of the
 same seed.
@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 from grainfrac_yade.api import PARAMS_DIR, build_specimen, elastic_summary, grain_model, load_parameters
 
 CSV = ROOT / "docs" / "regularisation_tails.csv"
-FEM_PRESET = PARAMS_DIR / "presets" / "fem.toml"
+FEM_PRESET = PARAMS_DIR / "presets" / "fem_coarse.toml"
 FRACTIONS = (0.0, 0.01, 0.02, 0.05, 0.10)
 SIZES = {"10x20": (10e-3, 20e-3), "paper": (31.7e-3, 63.4e-3)}
 SEEDS = (1, 2, 3)

@@ -1,6 +1,6 @@
 """Cost of the static engine's numerical core against specimen size (no YADE): one JSON line.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.static_engine_cost --params params/presets/fem.toml \
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.static_engine_cost --params params/presets/fem_coarse.toml \
         --width 31.7e-3 --height 63.4e-3 --seed 1 --breaks 20 [--creep-stress 160e6 --events 5] [--direct]
 
 Builds the network, times the first equilibrium and follows the sequentially linear path for ``--breaks`` breaks

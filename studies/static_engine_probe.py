@@ -1,7 +1,7 @@
 """Probe of the static engine on one specimen: the UCS test on its plain path, its cost, and a creep test (no YADE).
 
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.static_engine_probe --width 10e-3 --height 20e-3 --seed 1 \
-        [--params params/presets/fem.toml] [--max-strain 0.008] [--creep-stress 160e6] [--time-limit 1e13]
+        [--params params/presets/fem_coarse.toml] [--max-strain 0.008] [--creep-stress 160e6] [--time-limit 1e13]
 
 The UCS protocol (:func:`grainfrac_yade.api.run_ucs`) on the static engine's plain path (``numerics.engine =
 "static"``, ``numerics.static_relaxation = "none"``: a status set that does not settle ends the test as a numerical

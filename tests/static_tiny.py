@@ -60,7 +60,7 @@ def fem_creep_4x8(*extra):
     the time limit after 15 events, its plain regains all settling."""
     from grainfrac_yade.params import load_parameters
     from grainfrac_yade.protocols.creep import run_creep
-    p = load_parameters(extra_files=["params/presets/fem.toml"],
+    p = load_parameters(extra_files=["params/presets/fem_coarse.toml"],
                         overrides=["numerics.engine=static", "numerics.static_relaxation=none", "specimen.width=4e-3",
                                    "specimen.height=8e-3", *extra])
     return run_creep(build_specimen(p, 4), p, 160e6)

@@ -14,7 +14,7 @@ import pytest
 from conftest import ROOT, needs_yade
 from grainfrac_yade.commands.bench_static import StaticBenchSettings, run_static_bench, static_tables
 
-FEM = ROOT / "params" / "presets" / "fem.toml"
+FEM = ROOT / "params" / "presets" / "fem_coarse.toml"
 #: Two tiny specimens (3 x 6 and 4 x 8 mm: 286 and 522 dofs with fem cells), 3 events each: about a second.
 TINY = StaticBenchSettings(compare=None, compare_events=0, sizes=(("3x6", 3e-3, 6e-3), ("4x8", 4e-3, 8e-3)), events=3)
 SIZE_KEYS = {"specimen", "width_m", "height_m", "dofs", "bonds", "build_cpu_s", "stress_pa", "ramp", "events",

@@ -177,7 +177,7 @@ def test_a_disc_with_weak_contacts_is_split_past_the_start_transient(tmp_path):
     broke, the load rang down below half its first peak, 1.6 MPa); with ``brazilian.stop_min_strain`` 2e-4
     it goes on to its split, past that strain and several times stronger."""
     from grainfrac_yade.protocols.brazilian_output import run_brazilian_to_folder
-    fem = [str(ROOT / "params" / "presets" / "fem.toml")]
+    fem = [str(ROOT / "params" / "presets" / "fem_coarse.toml")]
     out = {}
     for name, extra in (("default", []), ("waits", ["brazilian.stop_min_strain=2e-4"])):
         p = load_parameters(overrides=WEAK_TAILS + extra, extra_files=fem)

@@ -32,7 +32,7 @@ CV_REL_TOLERANCE = 0.01
 MODULI = (1.5, 2.0, 3.0, 5.0, 10.0)
 LEVER_DEFAULTS = {"calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
                   "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0}
-FEM_PRESET = ROOT / "params" / "presets" / "fem.toml"
+FEM_PRESET = ROOT / "params" / "presets" / "fem_coarse.toml"
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
 
 

@@ -17,7 +17,7 @@ from grainfrac_yade.elastic import (cluster_network, contact_statistics, mesh_ne
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
 
-FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem.toml"
+FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem_coarse.toml"
 MEDIAN_VERLET = ["numerics.verlet_radius_quantile=0.5", "numerics.verlet_fraction=0.5"]
 SMALL = ["specimen.width=4e-3", "specimen.height=8e-3", "resolution.grain_model=fem"]
 
@@ -237,7 +237,7 @@ def test_fem_cells_run_the_commands_end_to_end(tmp_path, command):
     from pathlib import Path
     root = Path(__file__).resolve().parents[1]
     out = tmp_path / command[0]
-    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", *command, "--params", "params/presets/fem.toml",
+    res = subprocess.run([sys.executable, "-m", "grainfrac_yade", *command, "--params", "params/presets/fem_coarse.toml",
                           "--width", "4e-3", "--height", "8e-3", "--seed", "1", "--out", str(out)],
                          capture_output=True, text=True, cwd=root)
     assert res.returncode == 0, res.stderr[-2000:]

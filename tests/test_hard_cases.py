@@ -28,7 +28,7 @@ from grainfrac_yade.errors import GrainfracError
 from grainfrac_yade.params import load_parameters
 
 TINY = ["specimen.width=4e-3", "specimen.height=8e-3"]
-FEM = [str(ROOT / "params" / "presets" / "fem.toml")]
+FEM = [str(ROOT / "params" / "presets" / "fem_coarse.toml")]
 
 
 # ------------------------------------------------------------------ checks shared by every run

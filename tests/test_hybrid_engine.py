@@ -15,7 +15,7 @@ from grainfrac_yade.params.schema import NumericsParams
 from grainfrac_yade.wave import steps_for
 
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
-FEM = "params/presets/fem.toml"
+FEM = "params/presets/fem_coarse.toml"
 
 
 def _params(engine_name, *extra, fem=False):

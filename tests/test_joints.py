@@ -15,7 +15,7 @@ from conftest import needs_yade
 from grainfrac_yade.params import load_parameters
 from grainfrac_yade.geometry.specimen import build_specimen
 
-FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem.toml"
+FEM_PRESET = Path(__file__).resolve().parents[1] / "params" / "presets" / "fem_coarse.toml"
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3"]
 #: DEM steps per quarter cycle of the imposed shear.
 QUARTER = 20

@@ -28,7 +28,7 @@ FRACTIONS = (0.02, 0.1, 0.45)
 
 
 def _params(fraction, width=10e-3, height=20e-3, fem=False):
-    extra = [PARAMS_DIR / "presets" / "fem.toml"] if fem else []
+    extra = [PARAMS_DIR / "presets" / "fem_coarse.toml"] if fem else []
     return load_parameters(extra_files=extra, overrides=[f"specimen.width={width}", f"specimen.height={height}",
                                                          f"specimen.min_edge_fraction={fraction}"])
 

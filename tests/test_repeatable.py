@@ -90,7 +90,7 @@ def test_a_hybrid_fem_run_with_stints_gives_the_same_files_in_two_processes(tmp_
     outcomes, floats within ROUND_OFF; run.json records a repeatable process."""
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "grainfrac_yade", "creep", "--engine", "hybrid", "--params",
-           str(ROOT / "params/presets/fem.toml"), "--stress", "160", "--width", "4e-3", "--height", "8e-3",
+           str(ROOT / "params/presets/fem_coarse.toml"), "--stress", "160", "--width", "4e-3", "--height", "8e-3",
            "--seed", "1", "--set", "numerics.handover_cascade_bonds=3", "--out", str(out)]
     env = {k: v for k, v in os.environ.items() if k not in ("GRAINFRAC_NO_REEXEC", "GRAINFRAC_REPEATABLE")}
     env.update(OMP_NUM_THREADS="1", PYTHONPATH=str(ROOT))

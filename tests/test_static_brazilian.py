@@ -30,7 +30,7 @@ ROUND_OFF = 1e-9
 
 
 def _params(*extra, fem=False):
-    return load_parameters(extra_files=["params/presets/fem.toml"] if fem else [], overrides=[*TINY, *extra])
+    return load_parameters(extra_files=["params/presets/fem_coarse.toml"] if fem else [], overrides=[*TINY, *extra])
 
 
 def _jawed(p, seed=1, lateral=None):

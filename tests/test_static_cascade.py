@@ -22,7 +22,7 @@ BREAKS = 12
 
 
 def _tiny(model):
-    extra = ["params/presets/fem.toml"] if model == "fem" else []
+    extra = ["params/presets/fem_coarse.toml"] if model == "fem" else []
     p = load_parameters(extra_files=extra, overrides=TINY[model])
     s = build_specimen(p, 1)
     return s, p, layout_for(s, p)

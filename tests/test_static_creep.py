@@ -72,7 +72,7 @@ def test_failure_rule_collapse_and_its_switch():
 
 
 def _tiny_creep(**settings):
-    p = load_parameters(extra_files=["params/presets/fem.toml"], overrides=["specimen.width=3e-3",
+    p = load_parameters(extra_files=["params/presets/fem_coarse.toml"], overrides=["specimen.width=3e-3",
                                                                             "specimen.height=6e-3"])
     s = build_specimen(p, 1)
     net = build_static_network(s, p, layout_for(s, p))

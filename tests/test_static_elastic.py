@@ -18,7 +18,7 @@ ROUND_OFF = 1e-9
 
 @pytest.fixture(scope="module", params=["rigid", "fem"])
 def pair(request):
-    extra = ["params/presets/fem.toml"] if request.param == "fem" else []
+    extra = ["params/presets/fem_coarse.toml"] if request.param == "fem" else []
     p = load_parameters(extra_files=extra, overrides=TINY)
     s = build_specimen(p, 1)
     lay = layout_for(s, p)

@@ -19,7 +19,7 @@ AGREEMENT = 1e-10
 
 
 def _equilibrium():
-    p = load_parameters(extra_files=["params/presets/fem.toml"],
+    p = load_parameters(extra_files=["params/presets/fem_coarse.toml"],
                         overrides=["specimen.width=3e-3", "specimen.height=6e-3"])
     s = build_specimen(p, 1)
     net = build_static_network(s, p, layout_for(s, p))

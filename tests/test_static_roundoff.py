@@ -78,7 +78,7 @@ def _ucs(seed, *extra):
 def _creep(model, seed, stress):
     from grainfrac_yade.geometry.specimen import build_specimen
     from grainfrac_yade.protocols.creep import run_creep
-    files = ["params/presets/fem.toml"] if model == "fem" else []
+    files = ["params/presets/fem_coarse.toml"] if model == "fem" else []
     p = load_parameters(extra_files=files, overrides=["numerics.engine=static", "numerics.static_relaxation=none",
                                                       "specimen.width=4e-3", "specimen.height=8e-3"])
     run = run_creep(build_specimen(p, seed), p, stress)

@@ -15,7 +15,7 @@ pytest.importorskip("vtkmodules")
 
 #: 3 x 6 mm, seed 1 (23 cells, 50 rigid bonds): the UCS path breaks 11 bonds in about 0.3 s.
 TINY = ["specimen.width=3e-3", "specimen.height=6e-3", "numerics.engine=static"]
-FEM = "params/presets/fem.toml"
+FEM = "params/presets/fem_coarse.toml"
 #: The arrays a YADE run's series carry (tests/test_vtkio.py), which the static engine's must carry too.
 CELL_ARRAYS = {"mineral", "mineral_name", "cell_id", "clump"}
 UCS_BOND_ARRAYS = {"bond_id", "state", "state_name", "inter", "cell_a", "cell_b", "break_dem_step",

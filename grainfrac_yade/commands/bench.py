@@ -1,7 +1,7 @@
 """``bench``: what a creep run costs on this machine, every number from one run.
 
 Scenes: the specimen (10 x 20 mm, seed 1; ``--quick`` a smaller one) with rigid cells at 1 and at 8
-spheres per cell and with finite-element cells (``params/presets/fem.toml``), each ramped as a
+spheres per cell and with finite-element cells (``params/presets/fem_coarse.toml``), each ramped as a
 creep run ramps it to 0.7 x its own ``calibration.reference_ucs`` (``--ratio``), then held by the
 servo with the stress-corrosion engine in place and relaxed to equilibrium, as in a creep run; then
 a few events of the event clock are timed, and the scene is measured at the held load after them:
@@ -53,7 +53,7 @@ from .bench_static import HOLD_STRESS_PA, STATIC_OUT, STATIC_QUICK_OUT, run_stat
 #: Where the full bench writes by default.
 DEFAULT_OUT = Path(__file__).resolve().parents[2] / "docs" / "bench.json"
 #: The finite-element-cells preset.
-FEM_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "fem.toml"
+FEM_PRESET = Path(__file__).resolve().parents[2] / "params" / "presets" / "fem_coarse.toml"
 #: Benchmarked scenes: key, label, extra parameter files, overrides (applied after the user's).
 SCENES = (
     ("rigid_1", "rigid, 1 sphere/cell", (), ("resolution.grain_model=rigid", "resolution.spheres_per_cell=1")),
@@ -110,7 +110,7 @@ def register(sub, common):
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one parameter in every scene (a scene's own keys win)")
     p.add_argument("--fem-sizes", action="store_true",
-                   help="only the finite-element size comparison: params/presets/fem.toml on 10 x 20 mm and the "
+                   help="only the finite-element size comparison: params/presets/fem_coarse.toml on 10 x 20 mm and the "
                         "paper's 31.7 x 63.4 mm, seeds 1-3, critical and actual DEM step and the CPU cost of "
                         f"{FEM_TIMED_STEPS} loading steps (default out: "
                         f"{FEM_SIZES_OUT.relative_to(FEM_SIZES_OUT.parents[1])}; about 5 CPU min)")

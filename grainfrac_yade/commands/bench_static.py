@@ -1,6 +1,6 @@
 """``bench --static``: what the static engine costs per creep event, every number from one run of one process.
 
-Finite-element cells (``params/presets/fem.toml``), seed 1 (``--seed``), a creep hold at 160 MPa
+Finite-element cells (``params/presets/fem_coarse.toml``), seed 1 (``--seed``), a creep hold at 160 MPa
 (``--creep-stress``) with the event clock, as the static engine's cost tables (docs/studies/static_bench.md):
 
 1. **Static against YADE per creep event** on 10 x 20 mm (``--quick``: 4 x 8 mm): the creep test of
@@ -305,7 +305,7 @@ def dofs_exponent(rows) -> dict:
 def run_static_bench(settings: StaticBenchSettings, preset, seed=1, stress=HOLD_STRESS_PA, extra_files=(),
                      overrides=(), header=None, peak_rss=None, progress=None, out=None) -> dict:
     """Every measurement of ``bench --static``, as the JSON stores it; ``preset``: the fem cells' parameter file
-    (``params/presets/fem.toml``), ``header``: entries put first (the machine), ``peak_rss``: the process's peak
+    (``params/presets/fem_coarse.toml``), ``header``: entries put first (the machine), ``peak_rss``: the process's peak
     memory so far [MB], ``out``: the JSON rewritten after each part."""
     if not stress > 0:
         raise GrainfracError(f"--creep-stress {stress / 1e6:g}: a creep stress must be positive [MPa]; fix: e.g. "

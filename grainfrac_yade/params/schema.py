@@ -472,7 +472,8 @@ def nearest_key(word: str, keys) -> str | None:
 RETIRED_VALUES = {"resolution.grain_model": {
     "deformable": ("'deformable' (the spring lattice) was retired: fem cells superseded it (they agree with "
                    "the mesh reference within 2 %, the lattice missed nu by 8-11 % and tension by 2-3 x)",
-                   "use resolution.grain_model = \"fem\" (params/presets/fem.toml; docs/models.md)")}}
+                   "use resolution.grain_model = \"fem\" (params/presets/fem.toml, converged; "
+                   "fem_coarse.toml, fast; docs/models.md)")}}
 
 
 __all__ = ["PARAMS_DIR", "DEFAULT_FILES", "FRACTION_SUM_TOLERANCE", "NEAREST_KEY_CUTOFF", "SpecimenParams", "GrainParams", "ContactParams", "ResolutionParams", "NumericsParams", "StressCorrosionParams", "unbalanced_threshold", "UcsParams", "CreepParams", "BrazilianParams", "ConfinementParams", "CalibrationParams", "Parameters", "SECTION_CLASSES", "pair_key", "average_contact", "calibrated_contact", "field_spec", "_check_value", "nearest_key", "RETIRED_VALUES"]
