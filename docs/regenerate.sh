@@ -83,7 +83,7 @@ run_target() {
                    cp results/accuracy_cost/accuracy_cost.png docs/figures/accuracy_cost.png ;;
     step_floor) $PY -m studies.step_floor_steps ;;
     lab_bands) $PY -m studies.lab_bands grain-size
-               $PY -m studies.lab_bands levers --params params/presets/fem.toml --out results/lab_bands ;;
+               $PY -m studies.lab_bands levers --params params/presets/fem_coarse.toml --out results/lab_bands ;;
     regularisation) $PY -m studies.regularisation_steps
                     $PY -m studies.regularisation_ucs
                     $PY -m studies.regularisation_tails ;;

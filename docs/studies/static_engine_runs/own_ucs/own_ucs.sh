@@ -10,6 +10,6 @@ for R in 0.85 0.7; do for S in 1 2 3; do
     ST=$(python3 -c "print(round($R*$U,2))")
     D=results/own_ucs/own_${E}_r${R}_s$S
     [ -f $D/summary.json ] && continue
-    OMP_NUM_THREADS=1 /usr/bin/python3 -m grainfrac_yade creep --engine $E --params params/presets/fem.toml --stress $ST --width 10e-3 --height 20e-3 --seed $S $X --out $D > $D.log 2>&1
+    OMP_NUM_THREADS=1 /usr/bin/python3 -m grainfrac_yade creep --engine $E --params params/presets/fem_coarse.toml --stress $ST --width 10e-3 --height 20e-3 --seed $S $X --out $D > $D.log 2>&1
   done
 done; done
