@@ -18,9 +18,8 @@ from .solver import Equilibrium, solver_options
 PATHS = {
     "none": lambda eq, params, confinement, masses: Path(eq),
     "overdamped": lambda eq, params, confinement, masses: damped.RelaxingPath(
-        eq, damped.AnchoredEquilibrium(eq.net, confinement=confinement,
-                                             **solver_options(params)), damped.REST_TOLERANCE,
-        max_steps=params.numerics.static_relaxation_steps),
+        eq, damped.AnchoredEquilibrium(eq.net, confinement=confinement, **solver_options(params)),
+        damped.REST_TOLERANCE, max_steps=params.numerics.static_relaxation_steps),
     "inertial": lambda eq, params, confinement, masses: InertialPath(eq, InertialRelaxation(eq, masses(), params)),
 }
 
