@@ -135,6 +135,14 @@ class NumericsParams:
                                    "(YADE's dynamic stints relax there)", ("none", "overdamped", "inertial"))
     static_relaxation_steps: int = _spec("1", "positive_int", "static_relaxation = overdamped: pseudo-time steps one "
                                          "relaxation may take before the engine gives out there")
+    static_low_rank_contacts: int = _spec("1", "positive_int", "static engine: contacts whose status may differ from "
+                                          "the kept factor's before the tangent is factorised anew (below it, a "
+                                          "low-rank Woodbury update of the kept factor; "
+                                          "grainfrac_yade.engines.static.tangent); changes results at round-off")
+    static_update_columns: str = _spec("", "choice", "static engine: how a low-rank update's K^-1 U columns are made: "
+                                       "changes = both U columns of a changed contact for each status it takes; rows "
+                                       "= each of its rows once per factor, combined with the change (fewer "
+                                       "back-substitutions; results change at round-off)", ("changes", "rows"))
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")

@@ -175,7 +175,8 @@ class KeptFactor:
         d = np.abs(lu.U.diagonal())
         if d.min() <= PIVOT_RATIO * d.max():
             raise NumericalFailure("static equilibrium: a pivot of the factor vanishes (a mechanism)")
-        self._lr = LowRankSolver(self.net, lu, self._coef, ~self._fixed, self.max_low_rank_contacts)
+        self._lr = LowRankSolver(self.net, lu, self._coef, ~self._fixed, self.max_low_rank_contacts,
+                                 self.update_columns, self._rows_kinematic)
         self._lr_fixed = self._fixed
         return self._lr.prepare(self._coef)
 

@@ -244,12 +244,14 @@ class InertialMotion(HeldRelaxing):
 
     def advance(self, steps: int) -> None:
         net, eq, control = self.net, self.eq, self.control
-        jt, jc, e, plat, inv_m = self.jt, self.jc, eq.e, eq.platen_fixed, self.inv_m
+        jt, jc, inv_m = self.jt, self.jc, self.inv_m
+        plat = np.flatnonzero(eq.platen_fixed)     # the driven dofs by index (the same values as by the mask)
+        e_plat = eq.e[plat]
         dt, damping = self.dyn.dt, self.dyn.damping
         u, v, broken, s_p, mode = self.u, self.v, self.broken, self.s_p, self.mode
         status, sign, rows, closure = self.status, self.sign, self.rows, self.closure
         for _ in range(steps):
-            u[plat] = closure * e[plat]
+            u[plat] = closure * e_plat
             dn, ds = net.cn @ u, net.ct @ u
             status, sign = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual, status, sign)[:2]
             fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)

@@ -45,7 +45,7 @@ from .cascade import Path
 from .network import StaticNetwork, _side_weights
 from .platens import StaticPlatens
 from .scene import StaticScene
-from .solver import Equilibrium
+from .solver import Equilibrium, solver_options
 
 #: Lateral conditions of the jaws (``brazilian.platen_lateral``): "fixed" u_x = 0, "free" u_x free.
 LATERALS = ("fixed", "free")
@@ -192,7 +192,8 @@ class StaticJaws(StaticPlatens):
         scene = self.scene
         if state.get("rotation_blocked") and not getattr(scene, "rotation_blocked", False):
             scene.rotation_blocked = True
-            set_equilibrium(scene, JawEquilibrium(scene.net, self.lateral == "fixed", True), solve=False)
+            set_equilibrium(scene, JawEquilibrium(scene.net, self.lateral == "fixed", True,
+                                                  **solver_options(scene.params)), solve=False)
 
 
 def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws:
@@ -206,7 +207,8 @@ def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws
                              "confinement yet); fix: attach_jaws right after build_scene and the levers")
     jaws = StaticJaws(scene, loading_arc, lateral)
     scene.net = jaw_network(scene.net, scene.specimen.tessellation, jaws.cells)
-    set_equilibrium(scene, JawEquilibrium(scene.net, lateral == "fixed", getattr(scene, "rotation_blocked", False)))
+    set_equilibrium(scene, JawEquilibrium(scene.net, lateral == "fixed", getattr(scene, "rotation_blocked", False),
+                                          **solver_options(scene.params)))
     jaws.bind()
     scene.drivers = [d for d in scene.drivers if not isinstance(d, StaticPlatens)] + [jaws]
     bz = scene.params.brazilian
@@ -258,7 +260,7 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         scene.rotation_blocked = True
         eq = scene.eq
         if isinstance(eq, JawEquilibrium):
-            set_equilibrium(scene, JawEquilibrium(scene.net, eq.lateral_fixed, True))
+            set_equilibrium(scene, JawEquilibrium(scene.net, eq.lateral_fixed, True, **solver_options(scene.params)))
         else:
-            set_equilibrium(scene, JawEquilibrium(scene.net, False, True))
+            set_equilibrium(scene, JawEquilibrium(scene.net, False, True, **solver_options(scene.params)))
     return done

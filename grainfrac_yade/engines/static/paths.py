@@ -11,15 +11,15 @@ from __future__ import annotations
 from .cascade import Path
 from . import damped
 from .inertial import InertialPath, InertialRelaxation
-from .solver import Equilibrium
+from .solver import Equilibrium, solver_options
 
 #: (equilibrium, parameters, lateral traction [Pa], masses: () -> (ndof,) array) -> path, per value of
 #: ``numerics.static_relaxation``.
 PATHS = {
     "none": lambda eq, params, confinement, masses: Path(eq),
     "overdamped": lambda eq, params, confinement, masses: damped.RelaxingPath(
-        eq, damped.AnchoredEquilibrium(eq.net, confinement=confinement), damped.REST_TOLERANCE,
-        max_steps=params.numerics.static_relaxation_steps),
+        eq, damped.AnchoredEquilibrium(eq.net, confinement=confinement, **solver_options(params)),
+        damped.REST_TOLERANCE, max_steps=params.numerics.static_relaxation_steps),
     "inertial": lambda eq, params, confinement, masses: InertialPath(eq, InertialRelaxation(eq, masses(), params)),
 }
 

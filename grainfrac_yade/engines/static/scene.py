@@ -57,7 +57,7 @@ from .failure import FailureRule
 from .network import build_static_network
 from .scene_state import SceneStateExchange
 from .settings import summary_keys
-from .solver import Equilibrium, State
+from .solver import Equilibrium, State, solver_options
 from .strategy import RelaxationHooks, SceneRelaxation
 
 #: Fields of the core's converged state that a save keeps (arrays over bonds in canonical order, or scalars).
@@ -109,7 +109,7 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         self.canon = np.empty(m, np.int64)
         self.canon[self.net.order] = np.arange(m)
         self.confinement_stress = 0.0
-        self.eq = Equilibrium(self.net)
+        self.eq = Equilibrium(self.net, **solver_options(params))
         self.path = path_for(self.eq, params, 0.0, self.masses, self.strategy.path_relaxation)
         self.drivers = []
         self._dt = load_increment(params)
@@ -372,7 +372,7 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         """Rebuild the equilibrium with a constant lateral traction ``stress`` [Pa] and re-solve where the scene is."""
         self.confinement_stress = float(stress)
         counters = self.eq.counters
-        self.eq = Equilibrium(self.net, confinement=self.confinement_stress)
+        self.eq = Equilibrium(self.net, confinement=self.confinement_stress, **solver_options(self.params))
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
         self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.strategy.path_relaxation)

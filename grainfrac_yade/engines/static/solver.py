@@ -34,7 +34,7 @@ from . import contacts as cl
 from .factoring import (DIRECT_FACTOR_OPTIONS, FAST_FACTOR_OPTIONS, ILL_CONDITIONED_RESIDUAL,  # noqa: F401
                         PIVOT_RATIO, KeptFactor)
 from .network import StaticNetwork
-from .tangent import MAX_LOW_RANK_CONTACTS, TangentPattern
+from .tangent import MAX_LOW_RANK_CONTACTS, UPDATE_COLUMNS, TangentPattern
 from .ties import ranked
 
 #: Active-set iterations per equilibrium before giving up [1]: each is one factorisation; a consistent set is
@@ -119,11 +119,13 @@ class Equilibrium(KeptFactor):
     def __init__(self, net: StaticNetwork, confinement: float = 0.0,
                  max_iterations: int = MAX_ACTIVE_SET_ITERATIONS,
                  changes_per_iteration: int = STATUS_CHANGES_PER_ITERATION, direction: float = 1.0,
-                 reuse_factor: bool = True, max_low_rank_contacts: int = MAX_LOW_RANK_CONTACTS):
+                 reuse_factor: bool = True, max_low_rank_contacts: int = MAX_LOW_RANK_CONTACTS,
+                 update_columns: str = "changes"):
         """``direction`` +1: the platens close as the closure grows (compression); -1: they open (a pull).
         ``reuse_factor`` False: every tangent assembled by sparse products and factorised by SuperLU (the plain
         direct path, the fast path's reference); True: the cached assembly and low-rank updates of a kept factor
-        (:mod:`.tangent`), at most ``max_low_rank_contacts`` changed contacts from it."""
+        (:mod:`.tangent`), at most ``max_low_rank_contacts`` changed contacts from it, their K^-1 U columns made as
+        ``update_columns`` says (:data:`.tangent.UPDATE_COLUMNS`)."""
         if max_iterations < 1 or changes_per_iteration < 1:
             raise ValueError("max_iterations and changes_per_iteration must be >= 1")
         self.net, self.max_iterations, self.changes_per_iteration = net, int(max_iterations), int(changes_per_iteration)
@@ -138,7 +140,7 @@ class Equilibrium(KeptFactor):
         self.platen_fixed = fixed
         self.platen_nodes = net.top | net.bottom
         self.counters = Counters()
-        self._ground = None
+        self._ground, self._platen_y = None, None
         self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
         self._plain = None      # (status, sign) of the kept plain factor (_factor_now)
         ea, eb = net_tri_edges(net)
@@ -150,6 +152,9 @@ class Equilibrium(KeptFactor):
         self._rows_kinematic = all(g is c or (g.shape == c.shape and (g != c).nnz == 0)
                                    for g, c in ((net.gn, net.cn), (net.gt, net.ct)))
         self.reuse_factor, self.max_low_rank_contacts = bool(reuse_factor), int(max_low_rank_contacts)
+        if max_low_rank_contacts < 1 or update_columns not in UPDATE_COLUMNS:
+            raise ValueError(f"max_low_rank_contacts must be >= 1 and update_columns one of {UPDATE_COLUMNS}")
+        self.update_columns = update_columns
         self._pattern = TangentPattern(net) if self.reuse_factor else None
         self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
         #: halvings of a step whose active set cycles before NumericalFailure (a caller with another way past a
@@ -277,7 +282,10 @@ class Equilibrium(KeptFactor):
         """Platen stress [Pa, compression positive] of the force ``r`` (ndof,) [N] on the platen nodes: half the
         bottom's y sum less the top's, over width x thickness."""
         n = self.net
-        return 0.5 * (r[n.dofs[n.bottom, 1]].sum() - r[n.dofs[n.top, 1]].sum()) / (n.width * n.thickness)
+        if self._platen_y is None:      # the platen nodes' axial dofs, in node order (the same sums every time)
+            self._platen_y = (n.dofs[n.bottom, 1], n.dofs[n.top, 1])
+        bottom, top = self._platen_y
+        return 0.5 * (r[bottom].sum() - r[top].sum()) / (n.width * n.thickness)
 
     # ------------------------------------------------------------------ the active-set iteration
     def solve(self, closure: float, base: State, release=None) -> State:
@@ -363,6 +371,13 @@ class Equilibrium(KeptFactor):
         base = State(closure, np.zeros(self.net.ndof), np.zeros(m, bool), np.full(m, cl.INTACT), np.ones(m), z,
                      z, z, 0.0, np.zeros(m, int))
         return self.solve(closure, base)
+
+
+def solver_options(params) -> dict:
+    """The keyword arguments of :class:`Equilibrium` that the run's parameters set: the low-rank updates' contact limit
+    (``numerics.static_low_rank_contacts``) and how their columns are made (``numerics.static_update_columns``)."""
+    return {"max_low_rank_contacts": params.numerics.static_low_rank_contacts,
+            "update_columns": params.numerics.static_update_columns}
 
 
 def own_stiffness(k, dofs) -> np.ndarray:

@@ -58,6 +58,12 @@ INCREMENTAL_CONTACTS = 500
 #: cells, UCS and creep at 160 MPa, 1,174 low-rank tangents): singular tangents (their own factor's pivot ratio
 #: <= 7.6e-15) had capacitance pivot ratios <= 6.6e-10, regular ones (>= 2.6e-11) >= 1.5e-7.
 CAPACITANCE_PIVOT_RATIO = 1e-8
+#: How the K^-1 U columns of a changed contact are made (``numerics.static_update_columns``): "changes" back-substitutes
+#: its two U columns (the change of its force rows times its coefficients) for each status it takes; "rows"
+#: back-substitutes each of its rows (c_n, c_t, and g_n, g_t where they differ from them) once per reference factor and
+#: combines them with the change of its coefficients, skipping rows the change does not touch (a stick/slip change moves
+#: the shear coefficients alone: one column).  The same solution to round-off (1e-16 relative per column).
+UPDATE_COLUMNS = ("changes", "rows")
 
 
 def _outer_triplets(g: sp.csr_matrix, c: sp.csr_matrix):
@@ -82,6 +88,13 @@ def _outer_triplets(g: sp.csr_matrix, c: sp.csr_matrix):
         z = np.zeros(0, int)
         return z, z, np.zeros(0), z
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), np.concatenate(who)
+
+
+def _index_array(a: np.ndarray) -> np.ndarray:
+    """``a`` (indices of a compressed sparse matrix) as 32-bit integers where they fit, as scipy would store them:
+    a matrix built from them then skips scipy's scan of every index for the narrower type (the values and every
+    product are the same)."""
+    return a.astype(np.int32) if len(a) and a.max() < np.iinfo(np.int32).max else a
 
 
 class TangentPattern:
@@ -176,7 +189,7 @@ class TangentPattern:
             take = np.flatnonzero(free[self.row] & free[self.col])
             nf = int(free.sum())
             indptr = np.searchsorted(fmap[self.col[take]], np.arange(nf + 1))
-            sel = (take, fmap[self.row[take]], indptr, nf)
+            sel = (take, _index_array(fmap[self.row[take]]), _index_array(indptr), nf)
             if len(self._free_cache) > 64:
                 self._free_cache.clear()
             self._free_cache[key] = sel
@@ -193,7 +206,7 @@ class TangentPattern:
             take = np.flatnonzero(free[self.row] & fixed[self.col])
             nx = int(fixed.sum())
             indptr = np.searchsorted(xmap[self.col[take]], np.arange(nx + 1))
-            sel = (take, fmap[self.row[take]], indptr, (int(free.sum()), nx))
+            sel = (take, _index_array(fmap[self.row[take]]), _index_array(indptr), (int(free.sum()), nx))
             self._free_cache[key] = sel
         take, rows, indptr, shape = sel
         return sp.csc_matrix((data[take], rows, indptr), shape=shape)
@@ -208,9 +221,15 @@ class LowRankSolver:
     solve is a sum over the blocks.  The columns of the contacts met for the first time in a :meth:`prepare` are
     computed by one back-substitution of all their U columns together."""
 
-    def __init__(self, net, lu, coef, free, max_contacts=MAX_LOW_RANK_CONTACTS):
+    def __init__(self, net, lu, coef, free, max_contacts=MAX_LOW_RANK_CONTACTS, columns="changes",
+                 rows_kinematic=False):
         self.net, self.lu, self.coef, self.free, self.max_contacts = net, lu, coef, free, max_contacts
+        if columns not in UPDATE_COLUMNS:
+            raise ValueError(f"update columns must be one of {UPDATE_COLUMNS}, got {columns!r}")
+        #: :data:`UPDATE_COLUMNS`; ``rows_kinematic``: the force rows equal the kinematic rows (fem cells)
+        self.columns, self.rows_kinematic = columns, bool(rows_kinematic)
         self._z = {}            # (contact, coefficients) -> K^-1 U columns (n x 2, free dofs)
+        self._y = {}            # columns "rows": (contact, row kind 0 c_n, 1 c_t, 2 g_n, 3 g_t) -> K^-1 of that row
         #: the keys of every back-substitution of U columns, in the order and blocks they were computed (what
         #: :meth:`replay` repeats to rebuild :attr:`_z` bit for bit: a block's columns are solved together)
         self.blocks = []
@@ -247,7 +266,9 @@ class LowRankSolver:
         by one back-substitution of all their U columns (n x 2k) on the reference factor, then cached."""
         keys = [self._key(i, c) for i, c in zip(contacts, coefs)]
         miss = [j for j, k in enumerate(keys) if k not in self._z]
-        if miss:
+        if miss and self.columns == "rows":
+            self._columns_from_rows([contacts[j] for j in miss], [coefs[j] for j in miss], [keys[j] for j in miss])
+        elif miss:
             u = np.empty((self.lu.shape[0], 2 * len(miss)), order="F")
             for q, j in enumerate(miss):
                 u[:, 2 * q], u[:, 2 * q + 1] = self._u(contacts[j], coefs[j])
@@ -255,8 +276,52 @@ class LowRankSolver:
             self.back_substitutions += u.shape[1]
             for q, j in enumerate(miss):
                 self._z[keys[j]] = z[:, 2 * q:2 * q + 2]
+        if miss:
             self.blocks.append([keys[j] for j in miss])
         return [self._z[k] for k in keys]
+
+    def _row_terms(self, i, new):
+        """{row kind: (coefficient in w_n, coefficient in w_t)} of contact i going from its reference coefficients to
+        ``new`` (:meth:`_u` by rows: w_n = a_nn' g_n' + a_sn' g_t' - a_nn g_n - a_sn g_t, w_t = a_ss' g_t' - a_ss g_t,
+        g the kinematic rows once broken); rows with both coefficients zero left out."""
+        old = tuple(c[i] for c in self.coef)
+        terms = {}
+
+        def add(kind, cn, ct):
+            if self.rows_kinematic:
+                kind %= 2
+            a, b = terms.get(kind, (0.0, 0.0))
+            terms[kind] = (a + cn, b + ct)
+        for sign, (a_nn, a_sn, a_ss, broken) in ((1.0, new), (-1.0, old)):
+            n_kind, t_kind = (0, 1) if broken else (2, 3)
+            add(n_kind, sign * a_nn, 0.0)
+            add(t_kind, sign * a_sn, sign * a_ss)
+        return {k: v for k, v in sorted(terms.items()) if v[0] != 0.0 or v[1] != 0.0}
+
+    def _columns_from_rows(self, contacts, coefs, keys):
+        """The K^-1 U blocks of these contacts (columns "rows", :data:`UPDATE_COLUMNS`): the rows not yet solved on
+        this factor by one back-substitution together, then each block combined from its contact's rows."""
+        terms = [self._row_terms(i, c) for i, c in zip(contacts, coefs)]
+        need = list(dict.fromkeys((int(i), kind) for i, t in zip(contacts, terms) for kind in t
+                                  if (int(i), kind) not in self._y))
+        if need:
+            m, n = self._m, self.lu.shape[0]
+            u = np.empty((n, len(need)), order="F")
+            for q, (i, kind) in enumerate(need):
+                u[:, q] = self._rows[kind * m + i].toarray().ravel()
+            y = self.lu.solve(u)
+            self.back_substitutions += len(need)
+            for q, key in enumerate(need):
+                self._y[key] = y[:, q]
+        for i, t, key in zip(contacts, terms, keys):
+            z = np.zeros((self.lu.shape[0], 2), order="F")
+            for kind, (cn, ct) in t.items():
+                y = self._y[(int(i), kind)]
+                if cn != 0.0:
+                    z[:, 0] += cn * y
+                if ct != 0.0:
+                    z[:, 1] += ct * y
+            self._z[key] = z
 
     def column_table(self) -> np.ndarray:
         """(k, 6) the keys of :attr:`blocks` as rows (block, contact, a_nn, a_sn, a_ss, broken): exact doubles."""
