@@ -534,3 +534,17 @@ def test_first_creep_crack_is_the_earliest_bond_broken_at_the_held_load(tmp_path
     (tmp_path / "b").mkdir()
     (tmp_path / "b" / "cracks.csv").write_text(cols + "0,,ramp,tensile,inter,0,0,0\n")
     assert np.isnan(first_creep_crack(tmp_path / "b")) and np.isnan(first_creep_crack(tmp_path / "c"))
+
+
+def test_an_integer_key_older_runs_lack_is_filled_as_the_newer_runs_read_it():
+    """A key added with an integer default (a newer params.json has it, an older one not): the newer runs' column
+    has gaps, so pandas reads it as floats; the filled default must read the same, or one model looks like two."""
+    import pandas as pd
+    from grainfrac_yade.analysis.study_runs import fill_missing_params, variant_labels
+    runs = pd.DataFrame({"outcome": ["failed", "failed"], "specimen.width": [0.01, 0.01],
+                         "numerics.static_low_rank_contacts": [None, 128]})
+    runs["numerics.static_low_rank_contacts"] = runs["numerics.static_low_rank_contacts"].astype(float)
+    filled, counts = fill_missing_params(runs)
+    assert counts == {"numerics.static_low_rank_contacts": 1}
+    assert filled["numerics.static_low_rank_contacts"].astype(str).nunique() == 1
+    assert list(variant_labels(filled)) == ["model", "model"]

@@ -85,7 +85,11 @@ def fill_missing_params(runs: pd.DataFrame) -> tuple:
         if key not in runs or key.split(".")[0] in ("sources", "composition", "grains", "contacts"):
             continue   # no run has the key (all alike), or a material table (never assumed)
         missing = has_params & runs[key].isna()
-        if missing.any() and (has_params & runs[key].notna()).any():
+        present = has_params & runs[key].notna()
+        if missing.any() and present.any():
+            if (isinstance(value, int) and not isinstance(value, bool)
+                    and pd.api.types.is_float_dtype(runs.loc[present, key])):
+                value = float(value)    # a column with gaps reads its integers as floats: 128 is written 128.0
             runs[key] = runs[key].astype(object)
             for i in runs.index[missing]:
                 runs.at[i, key] = value
