@@ -38,6 +38,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ...params.schema import field_spec
+from .factoring import FAST_FACTOR_OPTIONS
 
 #: ``numerics.static_condensation`` (the schema's choices): "none" = the full free system (every run before the key);
 #: "cell_interiors" = the fem cells' interior nodes condensed out of it (module doc).
@@ -81,7 +82,10 @@ class CellInteriors:
         if not len(i):
             self.network = net
             return
-        self._lu_ii = spla.splu(k[i][:, i].tocsc())      # block-diagonal by cell: no fill between cells
+        # block-diagonal by cell (no fill between cells), symmetric positive definite: the fast path's ordering
+        # (minimum degree on A^T + A, diagonal pivots) leaves half COLAMD's fill (5 x 10 mm: 0.35 M against 0.69 M
+        # entries, one solve 0.9 against 1.2 ms)
+        self._lu_ii = spla.splu(k[i][:, i].tocsc(), **FAST_FACTOR_OPTIONS)
         self.network = replace(net, k_grain=self._condensed_grain_stiffness(k))
 
     def _condensed_grain_stiffness(self, k) -> sp.csr_matrix:

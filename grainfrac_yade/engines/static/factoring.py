@@ -142,8 +142,8 @@ class KeptFactor:
         coef = (a_nn, a_sn, a_ss, status != cl.INTACT)
         fixed, held, _ = self.fixed_dofs(status)
         interior = None
-        if self._cells is not None:         # the interiors condensed out: counted as fixed, recovered after a solve
-            fixed, interior = self._cells.split(fixed)
+        if self._interiors is not None:         # the interiors condensed out: counted as fixed, recovered after a solve
+            fixed, interior = self._interiors.split(fixed)
         data = self._pattern.data(*coef)
         kff = self._pattern.free_block(data, fixed)
         self._kfc = self._pattern.coupling(data, fixed)

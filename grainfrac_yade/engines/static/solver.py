@@ -162,9 +162,12 @@ class Equilibrium(KeptFactor):
         if max_low_rank_contacts < 1 or update_columns not in UPDATE_COLUMNS:
             raise ValueError(f"max_low_rank_contacts must be >= 1 and update_columns one of {UPDATE_COLUMNS}")
         self.update_columns = update_columns
-        self._cells = cell_interiors(net, condensation) if self.reuse_factor and self.condensable else None
+        self._interiors = cell_interiors(net, condensation) if self.reuse_factor and self.condensable else None
         self._interior_free = None      # the interior dofs the kept factor's solves recover (None: not condensed)
-        self._pattern = (TangentPattern(net if self._cells is None else self._cells.network) if self.reuse_factor
+        #: inside the active-set iteration the interior of a condensed solve is recovered only for the converged
+        #: answer (the statuses read the boundary alone): (u, load, interior dofs) of the last solve, else None
+        self._deferred, self._defer = None, False
+        self._pattern = (TangentPattern(net if self._interiors is None else self._interiors.network) if self.reuse_factor
                          else None)
         self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
         #: halvings of a step whose active set cycles before NumericalFailure (a caller with another way past a
@@ -254,7 +257,7 @@ class Equilibrium(KeptFactor):
         for attempt in range(2):
             lu, k, b, fixed = self._factor(status, sign, s_p)
             u, load = start_of(b, fixed)
-            cells, interior = self._cells, self._interior_free
+            cells, interior = self._interiors, self._interior_free
             f = load if interior is None or load is None else cells.load(load)
             rhs = -(self._kfc @ u[fixed]) if f is None else f[~fixed] - self._kfc @ u[fixed]
             try:
@@ -265,7 +268,9 @@ class Equilibrium(KeptFactor):
                 key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
                 self._factor_now(key, status, sign, s_p, True)
                 continue
-            if interior is not None:
+            if interior is not None and self._defer:
+                self._deferred = (u, load, interior)
+            elif interior is not None:
                 cells.recover(u, load, interior)
             if self._grounded:
                 pull = np.abs(self._ground.diagonal() * u).max()
@@ -343,6 +348,9 @@ class Equilibrium(KeptFactor):
 
     def _converged(self, closure, base, status, sign, u, it) -> State:
         n = self.net
+        if self._deferred is not None and self._deferred[0] is u:     # the interior of a condensed solve
+            self._interiors.recover(*self._deferred)
+        self._deferred = None
         dn, ds = n.cn @ u, n.ct @ u
         fn, fs = cl.forces(dn, ds, status, sign, base.s_p, n.kn, n.ks, n.tan_residual)
         s_p = np.where(base.broken, cl.converged_slip(ds, status, fs, n.ks), base.s_p)
@@ -351,6 +359,14 @@ class Equilibrium(KeptFactor):
                      self.platen_stress(u, fn, fs, base.broken), base.break_mode.copy(), self._held, it)
 
     def _active_set(self, closure, base, extra) -> State:
+        self._defer = self._interiors is not None
+        try:
+            return self._iterate(closure, base, extra)
+        finally:
+            self._defer, self._deferred = False, None
+
+    def _iterate(self, closure, base, extra) -> State:
+        """The active-set iteration (module doc); a condensed solve's interior recovered for its answer alone."""
         n = self.net
         status, sign = base.status.copy(), base.sign.copy()
         cap, best, seen, last = self.changes_per_iteration, None, set(), np.zeros(0, int)
