@@ -128,16 +128,25 @@ def test_condensed_ucs_is_the_full_one():
 def test_condensed_creep_killed_and_resumed_is_the_run_without_a_stop(tmp_path, monkeypatch):
     """A fem creep (4 x 8 mm, K = 4, 2 graded rings, 160 MPa, the inertial relaxation) with the interiors condensed
     out, killed at its fifth checkpoint and resumed: the same history (wall times aside), events, break times and
-    broken set, bit for bit, as the run without a stop (the kept factor is rebuilt on the condensed system)."""
-    p = load_parameters(extra_files=["params/presets/fem.toml"],
-                        overrides=["numerics.engine=static", "numerics.static_relaxation=inertial", CONDENSED,
-                                   "specimen.width=4e-3", "specimen.height=8e-3", "resolution.nodes_per_face=4",
-                                   "resolution.cell_rings=2", "numerics.checkpoint_interval=1e-9"])
-    whole, resumed = run_killed_and_resumed(tmp_path, monkeypatch, p, 1, 160e6, lambda run, written: written == 5)
+    broken set, bit for bit, as the run without a stop, with checkpoints at every safe point and with none (the kept
+    factor is rebuilt on the condensed system)."""
+    from grainfrac_yade.protocols.creep import run_creep
+
+    def params(interval):
+        return load_parameters(extra_files=["params/presets/fem.toml"],
+                               overrides=["numerics.engine=static", "numerics.static_relaxation=inertial", CONDENSED,
+                                          "specimen.width=4e-3", "specimen.height=8e-3", "resolution.nodes_per_face=4",
+                                          "resolution.cell_rings=2", f"numerics.checkpoint_interval={interval}"])
+    p0 = params(0)
+    plain = run_creep(build_specimen(p0, 1), p0, 160e6, checkpoint_folder=tmp_path / "plain", run_values={"seed": 1})
+    whole, resumed = run_killed_and_resumed(tmp_path, monkeypatch, params(1e-9), 1, 160e6,
+                                            lambda run, written: written == 5)
     assert whole.n_events > 1 and len(whole.checkpointer.write_s) > 5
     assert resumed.scene.eq._interiors is not None
     assert_resumed_as_whole(resumed, whole)
+    assert_resumed_as_whole(resumed, plain)
     assert np.array_equal(resumed.scene.broken, whole.scene.broken)
+    assert np.array_equal(resumed.scene.broken, plain.scene.broken)
 
 
 def test_factor_state_rebuilds_the_condensed_factor_bit_for_bit():

@@ -18,15 +18,16 @@ last bit), and added to the grain stiffness of a condensed network (:attr:`CellI
 rows and columns empty).  The solver's fast path (:mod:`.tangent`: the assembled tangent, its kept SuperLU factor,
 the low-rank updates of changed contacts, the refinement) then works on that network with the interior dofs
 counted as fixed (:meth:`CellInteriors.split`): every factor and back-substitution is on the boundary dofs alone.
-After each solve the interior displacements are recovered (:meth:`CellInteriors.recover`), so every reader of
+After each converged equilibrium and tangent response (not after each active-set iteration: the statuses read the
+boundary alone) the interior displacements are recovered (:meth:`CellInteriors.recover`), so every reader of
 the displacement vector (forces, the platen stress, outputs, the inertial relaxation, checkpoints) sees the full
 one.  The answers equal the uncondensed ones to round-off (another elimination order; tests/test_static_condensation.py).
 
 A cell cut loose is held whole (:meth:`.solver.Equilibrium.fixed_dofs`): its interior is fixed with it and its Schur
-part couples only its own (fixed) boundary dofs, so it changes nothing.  A prescribed dof inside a cell's interior
-(none but the platen nodes' own, which are boundary) would break the condensation: :meth:`CellInteriors.split`
-refuses a fixed set that fixes part of a cell's interior.  Rigid cells have no interior node (every node is a bond
-node): the parameter check refuses the option with them (:func:`grainfrac_yade.params.loading`).
+part couples only its own (fixed) boundary dofs, so it changes nothing.  Every prescribed dof (platens, jaws, lateral
+pins) is on a boundary node; a fixed set that holds part of a cell's interior cannot be condensed and is refused
+(:meth:`CellInteriors.split`).  Rigid cells have no interior node (every node is a bond
+node): the parameter check refuses the option with them (:func:`grainfrac_yade.params.fem_only.check_fem_only`).
 """
 from __future__ import annotations
 

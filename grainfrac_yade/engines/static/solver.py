@@ -19,7 +19,9 @@ back-substitution each.  Cells cut loose (their node group has no closed contact
 carry no load: their dofs are held where they are and counted; a group held by the platens but free to slide
 sideways gets one lateral dof pinned, as the intact specimen does (``elastic.solve_uniaxial``).  A singular
 or ill-conditioned system (a mechanism in the loading path) raises :class:`NumericalFailure`, one line.  The kept
-factor is :mod:`.factoring`'s (a mixin of :class:`Equilibrium`).
+factor is :mod:`.factoring`'s (a mixin of :class:`Equilibrium`).  With ``numerics.static_condensation =
+"cell_interiors"`` the fast path solves the system with the fem cells' interior nodes condensed out
+(:mod:`.condensation`), the interiors recovered for each answer.
 """
 from __future__ import annotations
 
