@@ -2,7 +2,8 @@
 back-substitution of the intact free block, in full and as the exact Schur complement on the nodes that bonds and
 platens touch (each cell's interior is linear elastic and coupled only to its own boundary, so its complement is
 made once, cell by cell).  One thread; prints what docs/studies/model_convergence.md ("Cost at the converged
-discretisation") tabulates.
+discretisation") tabulates.  Built since as ``numerics.static_condensation = "cell_interiors"``
+(grainfrac_yade/engines/static/condensation.py).
 
     OMP_NUM_THREADS=1 /usr/bin/python3 -m studies.fem_condensation --width 10e-3 --height 20e-3 [--set KEY=VALUE ...]
 

@@ -26,7 +26,7 @@ PATH_AGREEMENT = 1e-8
 
 
 def _params(fem, *overrides):
-    return load_parameters(extra_files=["params/presets/fem.toml"] if fem else [],
+    return load_parameters(extra_files=["params/presets/fem_coarse.toml"] if fem else [],
                            overrides=["specimen.width=3e-3", "specimen.height=6e-3", *overrides])
 
 

@@ -18,6 +18,7 @@ from ..arrhenius import betas_from_physical
 from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
 from .cells import cell_count
+from .fem_only import check_fem_only
 from .files import read_toml
 from .schema import (DEFAULT_FILES, FRACTION_SUM_TOLERANCE, PARAMS_DIR, SECTION_CLASSES, ContactParams, GrainParams,
                      Parameters, SpecimenParams, StressCorrosionParams, _check_value, average_contact, field_spec,
@@ -49,7 +50,7 @@ ADDED_KEYS = {"numerics.engine": "yade", "specimen.min_edge_fraction": 0.0, "num
               "creep.servo_response_crossings": 0.0, "creep.max_relaxation_crossings": 0.0,
               "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
               "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0,
-              "resolution.cell_rings": 1, "resolution.cell_ring_growth": 1.0}
+              "resolution.cell_rings": 1, "resolution.cell_ring_growth": 1.0, "numerics.static_condensation": "none"}
 
 
 def migrate_tree(tree: dict) -> list:
@@ -346,7 +347,7 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
     _check_law(sc, origins)
     _check_grain_size(typed["specimen"], origins)
     _check_weibull_modulus(typed["calibration"], origins)
-    _check_cell_rings(typed["resolution"], origins)
+    check_fem_only(typed["resolution"], typed["numerics"], origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
 
 
@@ -404,21 +405,6 @@ def _check_weibull_modulus(cal, origins: Mapping):
                              f"{m:g} is below {MIN_WEIBULL_MODULUS:g} (the exponential distribution, CV 1): most faces "
                              "would be all but unbonded", f"give 0 (no scatter) or a modulus >= {MIN_WEIBULL_MODULUS:g} "
                              "(e.g. 3: CV 0.36)")
-
-
-def _check_cell_rings(res, origins: Mapping):
-    """Radial rings refine the triangle mesh of fem cells; a rigid cell has no mesh to refine."""
-    if res.cell_rings > 1 and res.grain_model != "fem":
-        raise ParameterError(origins.get("resolution.cell_rings", "parameters"), "resolution.cell_rings",
-                             f"{res.cell_rings} with resolution.grain_model = {res.grain_model!r}: rings refine the "
-                             "triangle mesh of fem cells, a rigid cell has none",
-                             "set resolution.cell_rings = 1, or resolution.grain_model = \"fem\" "
-                             "(params/presets/fem.toml)")
-    if res.cell_ring_growth != 1.0 and res.cell_rings == 1:
-        raise ParameterError(origins.get("resolution.cell_ring_growth", "parameters"), "resolution.cell_ring_growth",
-                             f"{res.cell_ring_growth:g} with resolution.cell_rings = 1: the grading spaces the rings "
-                             "of a cell, one ring (the fan of triangles) has none to space",
-                             "set resolution.cell_rings >= 2, or resolution.cell_ring_growth = 1")
 
 
 def require_plane(params: Parameters, command: str):

@@ -143,6 +143,12 @@ class NumericsParams:
                                        "changes = both U columns of a changed contact for each status it takes; rows "
                                        "= each of its rows once per factor, combined with the change (fewer "
                                        "back-substitutions; results change at round-off)", ("changes", "rows"))
+    static_condensation: str = _spec("", "choice", "static engine, fem cells: none = the full free system; "
+                                     "cell_interiors = each cell's interior nodes (no bond, no platen) condensed out "
+                                     "exactly once, the factors, back-substitutions and low-rank updates on the "
+                                     "cells' boundary dofs alone (grainfrac_yade.engines.static.condensation; results "
+                                     "change at round-off); refused with rigid cells (no interior)",
+                                     ("none", "cell_interiors"))
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")

@@ -97,7 +97,11 @@ def intact_diagonal(eq: Equilibrium) -> np.ndarray:
 
 class AnchoredEquilibrium(Equilibrium):
     """The equilibrium of :class:`.solver.Equilibrium` with a spring ``alpha`` D on every dof anchored at
-    :attr:`u_ref` (module doc): one backward-Euler step of the overdamped motion.  ``alpha`` > 0 [1]."""
+    :attr:`u_ref` (module doc): one backward-Euler step of the overdamped motion.  ``alpha`` > 0 [1].  The anchor
+    stiffens every dof, interiors too, by a ratio that changes step by step: the full system is solved
+    (``numerics.static_condensation`` does not reach the anchored steps)."""
+
+    condensable = False
 
     def __init__(self, net, alpha: float = ANCHOR_RATIO, confinement: float = 0.0, **kw):
         if not alpha > 0:

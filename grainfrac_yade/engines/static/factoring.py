@@ -141,6 +141,9 @@ class KeptFactor:
         a_nn, _, a_sn, a_ss, _, _ = cl.affine_law(status, sign, s_p, n.kn, n.ks, n.tan_residual)
         coef = (a_nn, a_sn, a_ss, status != cl.INTACT)
         fixed, held, _ = self.fixed_dofs(status)
+        interior = None
+        if self._interiors is not None:         # the interiors condensed out: counted as fixed, recovered after a solve
+            fixed, interior = self._interiors.split(fixed)
         data = self._pattern.data(*coef)
         kff = self._pattern.free_block(data, fixed)
         self._kfc = self._pattern.coupling(data, fixed)
@@ -150,6 +153,7 @@ class KeptFactor:
         if self._lr is not None and np.array_equal(fixed, self._lr_fixed):
             op = self._lr.prepare(coef)
         self._fixed, self._held, self._kff, self._coef = fixed, held, kff, coef
+        self._interior_free = interior
         if not kff.shape[0]:        # nothing free: nothing to solve
             self._op, self._key, self._k, self._lu, self._lr = _PlainOp(None), key, None, None, None
             return
@@ -200,6 +204,7 @@ class KeptFactor:
         self.counters.factor_seconds += time.process_time() - t0
         self.counters.factorisations += 1
         self._key, self._lu, self._k, self._fixed, self._held, self._kff = key, lu, k, fixed, held, kff
+        self._interior_free = None          # the direct path solves the full system
         self._kfc = k[free][:, fixed].tocsr()
         self._op, self._lr, self._plain = _PlainOp(lu), None, (status.copy(), np.asarray(sign, float).copy())
         if lu is not None and not ground:     # a near-singular factor shows in its pivots' spread

@@ -19,7 +19,9 @@ back-substitution each.  Cells cut loose (their node group has no closed contact
 carry no load: their dofs are held where they are and counted; a group held by the platens but free to slide
 sideways gets one lateral dof pinned, as the intact specimen does (``elastic.solve_uniaxial``).  A singular
 or ill-conditioned system (a mechanism in the loading path) raises :class:`NumericalFailure`, one line.  The kept
-factor is :mod:`.factoring`'s (a mixin of :class:`Equilibrium`).
+factor is :mod:`.factoring`'s (a mixin of :class:`Equilibrium`).  With ``numerics.static_condensation =
+"cell_interiors"`` the fast path solves the system with the fem cells' interior nodes condensed out
+(:mod:`.condensation`), the interiors recovered for each answer.
 """
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ...errors import NumericalFailure
 from . import contacts as cl
+from .condensation import cell_interiors
 from .factoring import (DIRECT_FACTOR_OPTIONS, FAST_FACTOR_OPTIONS, ILL_CONDITIONED_RESIDUAL,  # noqa: F401
                         PIVOT_RATIO, KeptFactor)
 from .network import StaticNetwork
@@ -116,16 +119,22 @@ class Counters:
 class Equilibrium(KeptFactor):
     """Equilibria of one network under a constant lateral traction ``confinement`` [Pa] (module doc)."""
 
+    #: Whether the fast path may condense the cells' interiors out (:mod:`.condensation`): a subclass whose tangent
+    #: adds stiffness on interior dofs (:class:`.damped.AnchoredEquilibrium`'s anchor) solves the full system.
+    condensable = True
+
     def __init__(self, net: StaticNetwork, confinement: float = 0.0,
                  max_iterations: int = MAX_ACTIVE_SET_ITERATIONS,
                  changes_per_iteration: int = STATUS_CHANGES_PER_ITERATION, direction: float = 1.0,
                  reuse_factor: bool = True, max_low_rank_contacts: int = MAX_LOW_RANK_CONTACTS,
-                 update_columns: str = "changes"):
+                 update_columns: str = "changes", condensation: str = "none"):
         """``direction`` +1: the platens close as the closure grows (compression); -1: they open (a pull).
         ``reuse_factor`` False: every tangent assembled by sparse products and factorised by SuperLU (the plain
         direct path, the fast path's reference); True: the cached assembly and low-rank updates of a kept factor
         (:mod:`.tangent`), at most ``max_low_rank_contacts`` changed contacts from it, their K^-1 U columns made as
-        ``update_columns`` says (:data:`.tangent.UPDATE_COLUMNS`)."""
+        ``update_columns`` says (:data:`.tangent.UPDATE_COLUMNS`), on the system with the cells' interiors condensed
+        out where ``condensation`` says so (:data:`.condensation.MODES`; the fast path of a :attr:`condensable`
+        equilibrium only: the direct path is the reference)."""
         if max_iterations < 1 or changes_per_iteration < 1:
             raise ValueError("max_iterations and changes_per_iteration must be >= 1")
         self.net, self.max_iterations, self.changes_per_iteration = net, int(max_iterations), int(changes_per_iteration)
@@ -155,7 +164,13 @@ class Equilibrium(KeptFactor):
         if max_low_rank_contacts < 1 or update_columns not in UPDATE_COLUMNS:
             raise ValueError(f"max_low_rank_contacts must be >= 1 and update_columns one of {UPDATE_COLUMNS}")
         self.update_columns = update_columns
-        self._pattern = TangentPattern(net) if self.reuse_factor else None
+        self._interiors = cell_interiors(net, condensation) if self.reuse_factor and self.condensable else None
+        self._interior_free = None      # the interior dofs the kept factor's solves recover (None: not condensed)
+        #: inside the active-set iteration the interior of a condensed solve is recovered only for the converged
+        #: answer (the statuses read the boundary alone): (u, load, interior dofs) of the last solve, else None
+        self._deferred, self._defer = None, False
+        self._pattern = (TangentPattern(net if self._interiors is None else self._interiors.network) if self.reuse_factor
+                         else None)
         self._lr, self._op, self._fixed_cache, self._rows_cache = None, None, {}, {}
         #: halvings of a step whose active set cycles before NumericalFailure (a caller with another way past a
         #: status cycle, :class:`.damped.RelaxingPath`, gives up sooner)
@@ -228,20 +243,25 @@ class Equilibrium(KeptFactor):
 
     def displacements(self, closure, status, sign, s_p, held_u, extra=None):
         """u at ``closure`` under fixed statuses (held dofs at ``held_u``; ``extra``: a further dead load)."""
-        def rhs_of(k, b, fixed):
+        def start_of(b, fixed):
             u = np.where(fixed, held_u, 0.0)
             plat = self.platen_fixed
             u[plat] = closure * self.e[plat]
             f = self.f_ext if extra is None else self.f_ext + extra
-            return u, f[~fixed] - b[~fixed] - self._kfc @ u[fixed]
-        return self._solve_state(status, sign, s_p, rhs_of)
+            return u, f - b
+        return self._solve_state(status, sign, s_p, start_of)
 
-    def _solve_state(self, status, sign, s_p, rhs_of):
+    def _solve_state(self, status, sign, s_p, start_of):
         """Factor (or reuse), solve, and where the plain factor fails retry once with the ground springs; a
-        mechanism the ground springs hold against a load is NumericalFailure."""
+        mechanism the ground springs hold against a load is NumericalFailure.  ``start_of(b, fixed)``: (u with the
+        fixed dofs' values, the load f_ext - b or None); the free dofs solve K_ff u_f = load_f - K_fc u_c, on the
+        condensed system where the kept factor is (:mod:`.condensation`), its interior then recovered."""
         for attempt in range(2):
             lu, k, b, fixed = self._factor(status, sign, s_p)
-            u, rhs = rhs_of(k, b, fixed)
+            u, load = start_of(b, fixed)
+            cells, interior = self._interiors, self._interior_free
+            f = load if interior is None or load is None else cells.load(load)
+            rhs = -(self._kfc @ u[fixed]) if f is None else f[~fixed] - self._kfc @ u[fixed]
             try:
                 u[~fixed] = self._solve(lu, self._kff, rhs)
             except NumericalFailure:
@@ -250,6 +270,10 @@ class Equilibrium(KeptFactor):
                 key = (status.tobytes(), np.where(status == cl.SLIP, sign, 0.0).tobytes())
                 self._factor_now(key, status, sign, s_p, True)
                 continue
+            if interior is not None and self._defer:
+                self._deferred = (u, load, interior)
+            elif interior is not None:
+                cells.recover(u, load, interior)
             if self._grounded:
                 pull = np.abs(self._ground.diagonal() * u).max()
                 if pull > LOADED_MECHANISM * max(np.abs(rhs).max(), 1e-300):
@@ -260,11 +284,11 @@ class Equilibrium(KeptFactor):
 
     def response(self, state: State):
         """du/dd at ``state``'s statuses (the tangent response to the closure): (v, dF_n, dF_s, dstress)."""
-        def rhs_of(k, b, fixed):
+        def start_of(b, fixed):
             v = np.zeros(self.net.ndof)
             v[self.platen_fixed] = self.e[self.platen_fixed]
-            return v, -(self._kfc @ v[fixed])
-        v = self._solve_state(state.status, state.sign, state.s_p, rhs_of)
+            return v, None
+        v = self._solve_state(state.status, state.sign, state.s_p, start_of)
         n = self.net
         a_nn, a_ns, a_sn, a_ss, _, _ = cl.affine_law(state.status, state.sign, state.s_p, n.kn, n.ks, n.tan_residual)
         dn, ds = n.cn @ v, n.ct @ v
@@ -326,6 +350,9 @@ class Equilibrium(KeptFactor):
 
     def _converged(self, closure, base, status, sign, u, it) -> State:
         n = self.net
+        if self._deferred is not None and self._deferred[0] is u:     # the interior of a condensed solve
+            self._interiors.recover(*self._deferred)
+        self._deferred = None
         dn, ds = n.cn @ u, n.ct @ u
         fn, fs = cl.forces(dn, ds, status, sign, base.s_p, n.kn, n.ks, n.tan_residual)
         s_p = np.where(base.broken, cl.converged_slip(ds, status, fs, n.ks), base.s_p)
@@ -334,6 +361,14 @@ class Equilibrium(KeptFactor):
                      self.platen_stress(u, fn, fs, base.broken), base.break_mode.copy(), self._held, it)
 
     def _active_set(self, closure, base, extra) -> State:
+        self._defer = self._interiors is not None
+        try:
+            return self._iterate(closure, base, extra)
+        finally:
+            self._defer, self._deferred = False, None
+
+    def _iterate(self, closure, base, extra) -> State:
+        """The active-set iteration (module doc); a condensed solve's interior recovered for its answer alone."""
         n = self.net
         status, sign = base.status.copy(), base.sign.copy()
         cap, best, seen, last = self.changes_per_iteration, None, set(), np.zeros(0, int)
@@ -375,9 +410,11 @@ class Equilibrium(KeptFactor):
 
 def solver_options(params) -> dict:
     """The keyword arguments of :class:`Equilibrium` that the run's parameters set: the low-rank updates' contact limit
-    (``numerics.static_low_rank_contacts``) and how their columns are made (``numerics.static_update_columns``)."""
+    (``numerics.static_low_rank_contacts``), how their columns are made (``numerics.static_update_columns``) and
+    whether the cells' interiors are condensed out (``numerics.static_condensation``)."""
     return {"max_low_rank_contacts": params.numerics.static_low_rank_contacts,
-            "update_columns": params.numerics.static_update_columns}
+            "update_columns": params.numerics.static_update_columns,
+            "condensation": params.numerics.static_condensation}
 
 
 def own_stiffness(k, dofs) -> np.ndarray:
