@@ -192,8 +192,13 @@ class StaticJaws(StaticPlatens):
         scene = self.scene
         if state.get("rotation_blocked") and not getattr(scene, "rotation_blocked", False):
             scene.rotation_blocked = True
-            set_equilibrium(scene, JawEquilibrium(scene.net, self.lateral == "fixed", True,
-                                                  **solver_options(scene.params)), solve=False)
+            set_equilibrium(scene, jaw_equilibrium(scene, self.lateral == "fixed", True), solve=False)
+
+
+def jaw_equilibrium(scene, lateral_fixed: bool, block_rotation: bool) -> JawEquilibrium:
+    """The scene's :class:`JawEquilibrium` on its network, with the solver options its parameters set
+    (:func:`.solver.solver_options`)."""
+    return JawEquilibrium(scene.net, lateral_fixed, block_rotation, **solver_options(scene.params))
 
 
 def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws:
@@ -207,8 +212,7 @@ def attach_jaws(scene, loading_arc: float, lateral: str = "fixed") -> StaticJaws
                              "confinement yet); fix: attach_jaws right after build_scene and the levers")
     jaws = StaticJaws(scene, loading_arc, lateral)
     scene.net = jaw_network(scene.net, scene.specimen.tessellation, jaws.cells)
-    set_equilibrium(scene, JawEquilibrium(scene.net, lateral == "fixed", getattr(scene, "rotation_blocked", False),
-                                          **solver_options(scene.params)))
+    set_equilibrium(scene, jaw_equilibrium(scene, lateral == "fixed", getattr(scene, "rotation_blocked", False)))
     jaws.bind()
     scene.drivers = [d for d in scene.drivers if not isinstance(d, StaticPlatens)] + [jaws]
     bz = scene.params.brazilian
@@ -260,7 +264,7 @@ def apply_levers(scene, levers: Levers, seed: int) -> dict:
         scene.rotation_blocked = True
         eq = scene.eq
         if isinstance(eq, JawEquilibrium):
-            set_equilibrium(scene, JawEquilibrium(scene.net, eq.lateral_fixed, True, **solver_options(scene.params)))
+            set_equilibrium(scene, jaw_equilibrium(scene, eq.lateral_fixed, True))
         else:
-            set_equilibrium(scene, JawEquilibrium(scene.net, False, True, **solver_options(scene.params)))
+            set_equilibrium(scene, jaw_equilibrium(scene, False, True))
     return done

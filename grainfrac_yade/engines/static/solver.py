@@ -149,7 +149,9 @@ class Equilibrium(KeptFactor):
         self.platen_fixed = fixed
         self.platen_nodes = net.top | net.bottom
         self.counters = Counters()
-        self._ground, self._platen_y = None, None
+        self._ground = None
+        #: the platen nodes' axial dofs, in node order (what :meth:`reaction_stress` sums)
+        self._platen_y = (net.dofs[net.bottom, 1], net.dofs[net.top, 1])
         self._key, self._lu, self._k, self._b, self._fixed = None, None, None, None, None
         self._plain = None      # (status, sign) of the kept plain factor (_factor_now)
         ea, eb = net_tri_edges(net)
@@ -306,8 +308,6 @@ class Equilibrium(KeptFactor):
         """Platen stress [Pa, compression positive] of the force ``r`` (ndof,) [N] on the platen nodes: half the
         bottom's y sum less the top's, over width x thickness."""
         n = self.net
-        if self._platen_y is None:      # the platen nodes' axial dofs, in node order (the same sums every time)
-            self._platen_y = (n.dofs[n.bottom, 1], n.dofs[n.top, 1])
         bottom, top = self._platen_y
         return 0.5 * (r[bottom].sum() - r[top].sum()) / (n.width * n.thickness)
 

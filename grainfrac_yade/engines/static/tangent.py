@@ -23,6 +23,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from ...params.schema import field_spec
+
 #: A low-rank (Woodbury) solve is accepted when its relative residual max|K x - b| / max|b| on the assembled new
 #: tangent is below RESIDUAL_MARGIN times the largest residual the direct solves on its reference factor left,
 #: or below FAST_RESIDUAL, whichever is larger [1].  Direct SuperLU solves leave 6e-16 (median) to 1.2e-15 (max)
@@ -63,7 +65,7 @@ CAPACITANCE_PIVOT_RATIO = 1e-8
 #: back-substitutes each of its rows (c_n, c_t, and g_n, g_t where they differ from them) once per reference factor and
 #: combines them with the change of its coefficients, skipping rows the change does not touch (a stick/slip change moves
 #: the shear coefficients alone: one column).  The same solution to round-off (1e-16 relative per column).
-UPDATE_COLUMNS = ("changes", "rows")
+UPDATE_COLUMNS = field_spec("numerics.static_update_columns")["choices"]
 
 
 def _outer_triplets(g: sp.csr_matrix, c: sp.csr_matrix):
@@ -224,8 +226,6 @@ class LowRankSolver:
     def __init__(self, net, lu, coef, free, max_contacts=MAX_LOW_RANK_CONTACTS, columns="changes",
                  rows_kinematic=False):
         self.net, self.lu, self.coef, self.free, self.max_contacts = net, lu, coef, free, max_contacts
-        if columns not in UPDATE_COLUMNS:
-            raise ValueError(f"update columns must be one of {UPDATE_COLUMNS}, got {columns!r}")
         #: :data:`UPDATE_COLUMNS`; ``rows_kinematic``: the force rows equal the kinematic rows (fem cells)
         self.columns, self.rows_kinematic = columns, bool(rows_kinematic)
         self._z = {}            # (contact, coefficients) -> K^-1 U columns (n x 2, free dofs)
