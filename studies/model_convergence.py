@@ -5,16 +5,25 @@ with ``--elastic``, one line per ``elastic --grains fem`` folder: the moduli and
 
     /usr/bin/python3 -m studies.model_convergence results/model_convergence/* --out docs/studies/model_convergence/ucs_runs.csv
     /usr/bin/python3 -m studies.model_convergence --elastic results/model_convergence_elastic/* --out docs/studies/model_convergence/elastic_tails.csv
+    /usr/bin/python3 -m studies.model_convergence --k-series docs/studies/model_convergence/*ucs_runs.csv --out docs/studies/model_convergence/k_series.md
+
+``--k-series`` reads such CSVs back: for each specimen (size, seed) and grain interior (rings, grading), the UCS
+against K with the paired change from the next coarser K and the three-point extrapolation in the node spacing
+h ~ 1 / K (`grainfrac_yade/analysis/mesh_convergence.py`), as a markdown table.
 
 A pure reader of run folders (summary.json, params.json; no YADE).
 """
 import argparse
 import csv
 import json
+import math
 import sys
 from pathlib import Path
 
-from grainfrac_yade.api import ADDED_KEYS
+from grainfrac_yade.api import ADDED_KEYS, extrapolate, paired_changes
+
+#: The study's criterion: the paired UCS change between the two finest discretisations below this [1].
+CONVERGED_CHANGE = 0.05
 
 #: (column, summary key, factor) of every row: the units are those of the column name.
 COLUMNS = (("ucs_mpa", "ucs_pa", 1e-6), ("peak_axial_strain_percent", "peak_axial_strain", 100.0),
@@ -78,12 +87,52 @@ def row(folder: Path) -> dict | None:
     return out
 
 
+def k_series(rows: list[dict]) -> str:
+    """Markdown: per specimen and interior, the UCS against K (bonds per face), the paired changes, and the
+    three-point extrapolation in h = 1 / K with the K it puts within the criterion of its limit."""
+    groups = {}
+    for r in rows:
+        key = (float(r["width_mm"]), float(r["height_mm"]), int(r["seed"]), int(r["cell_rings_1"]),
+               float(r["cell_ring_growth_1"]))
+        groups.setdefault(key, {})[int(r["bonds_per_face_1"])] = float(r["ucs_mpa"])
+    lines = ["| specimen [mm] | seed | rings (grading) | K: UCS [MPa] (change) | extrapolation over the three finest |",
+             "|---|---|---|---|---|"]
+    for (w, h, seed, rings, growth), by_k in sorted(groups.items()):
+        ks = sorted(by_k)
+        ucs = [by_k[k] for k in ks]
+        changes = paired_changes(ucs)
+        cells = ", ".join(f"{k}: {u:.1f}" + ("" if i == 0 else f" ({100 * changes[i]:+.1f} %)")
+                          for i, (k, u) in enumerate(zip(ks, ucs)))
+        fit, why = extrapolate([1.0 / k for k in ks], ucs)
+        if fit is None:
+            note = why
+        else:
+            k_needed = 1.0 / fit.spacing_within(CONVERGED_CHANGE)
+            note = (f"limit {fit.limit:.1f} MPa, order {fit.order:.2f}; within {100 * CONVERGED_CHANGE:.0f} % "
+                    f"of the limit from K = {math.ceil(k_needed)}")
+        lines.append(f"| {w:g} x {h:g} | {seed} | {rings} ({growth:g}) | {cells} | {note} |")
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folders", nargs="+", type=Path)
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--elastic", action="store_true", help="the folders are elastic --grains fem runs")
+    ap.add_argument("--k-series", action="store_true", help="the arguments are ucs_runs CSVs of this script: "
+                    "write the UCS against K as a markdown table")
     a = ap.parse_args(argv)
+    if a.k_series:
+        try:
+            rows = [r for path in a.folders for r in csv.DictReader(open(path, newline=""))]
+        except OSError as e:
+            print(f"error: {e.filename}: cannot read ({e.strerror}); fix: give ucs_runs CSVs of this script",
+                  file=sys.stderr)
+            return 2
+        a.out.parent.mkdir(parents=True, exist_ok=True)
+        a.out.write_text(k_series(rows))
+        print(f"{len(rows)} rows -> {a.out}")
+        return 0
     rows = sorted((r for r in map(elastic_row if a.elastic else row, a.folders) if r),
                   key=lambda r: (r["cell_ring_growth_1"], r["cell_rings_1"], r["bonds_per_face_1"], r["run"]))
     if not rows:

@@ -1,0 +1,68 @@
+"""The convergence arithmetic of the discretisation study against closed forms (pure core, no YADE)."""
+import math
+
+import numpy as np
+import pytest
+
+from grainfrac_yade.analysis.mesh_convergence import extrapolate, finest_within, paired_changes
+
+
+def test_extrapolation_recovers_a_power_law_at_unequal_refinement_ratios():
+    # U = 120 + 900 h^1.5 at h = 1/8, 1/12, 1/16 (ratios 1.5 and 1.33): the exact order and limit come back
+    k = np.array([8.0, 12.0, 16.0])
+    u = 120.0 + 900.0 * (1.0 / k) ** 1.5
+    fit, why = extrapolate(1.0 / k, u)
+    assert fit is not None, why
+    # bisection to the interval's round-off: the order to 1e-9, the limit to 1e-9 relative
+    assert fit.order == pytest.approx(1.5, abs=1e-9)
+    assert fit.limit == pytest.approx(120.0, rel=1e-9)
+    assert fit.coefficient == pytest.approx(900.0, rel=1e-8)
+    np.testing.assert_allclose(fit.value(1.0 / k), u, rtol=1e-12)
+    # |U - limit| = 0.05 x 120 at h = (6 / 900)^(1 / 1.5)
+    assert fit.spacing_within(0.05) == pytest.approx((6.0 / 900.0) ** (1.0 / 1.5), rel=1e-8)
+
+
+def test_extrapolation_uses_the_three_finest_and_falls_from_above_too():
+    h = np.array([1 / 4, 1 / 8, 1 / 12, 1 / 24])
+    u = 200.0 - 50.0 * h ** 2.0
+    u[0] = 999.0   # a coarse result outside the asymptotic range is not used
+    fit, _ = extrapolate(h, u)
+    assert fit.order == pytest.approx(2.0, abs=1e-9) and fit.limit == pytest.approx(200.0, rel=1e-9)
+
+
+def test_no_extrapolation_where_the_changes_change_sign_or_do_not_shrink():
+    h = [1 / 8, 1 / 12, 1 / 16]
+    fit, why = extrapolate(h, [200.0, 160.0, 170.0])
+    assert fit is None and "not monotone" in why
+    # changes growing (-40 then -60): no order in the searched range gives a ratio below 1
+    fit, why = extrapolate(h, [200.0, 160.0, 100.0])
+    assert fit is None and "asymptotic range" in why
+    fit, why = extrapolate(h[:2], [200.0, 160.0])
+    assert fit is None and "fewer than three" in why
+    with pytest.raises(ValueError):
+        extrapolate([1 / 8, 1 / 8, 1 / 16], [1.0, 2.0, 3.0])
+
+
+def test_paired_changes_and_the_studys_criterion():
+    c = paired_changes([200.0, 160.0, 156.0])
+    assert math.isnan(c[0])
+    np.testing.assert_allclose(c[1:], [-0.2, -0.025], rtol=1e-12)
+    assert finest_within([200.0, 160.0, 156.0], 0.05)
+    assert not finest_within([200.0, 160.0], 0.05)
+    assert not finest_within([200.0], 0.05)
+
+
+def test_the_studys_k_series_table_groups_by_specimen_and_interior():
+    from studies.model_convergence import k_series
+
+    def r(k, u, seed=1, rings=4):
+        return {"width_mm": "5.0", "height_mm": "10.0", "seed": str(seed), "cell_rings_1": str(rings),
+                "cell_ring_growth_1": "2.0", "bonds_per_face_1": str(k), "ucs_mpa": str(u)}
+    law = {k: 120.0 + 900.0 * (1.0 / k) ** 1.5 for k in (8, 12, 16)}
+    rows = [r(k, u) for k, u in law.items()] + [r(8, 200.0, seed=2), r(12, 160.0, seed=2)]
+    text = k_series(rows).splitlines()
+    assert len(text) == 4
+    seed1, seed2 = text[2], text[3]
+    # within 5 % of 120 MPa: 900 h^1.5 <= 6, h <= (1/150)^(2/3), K >= 150^(2/3) = 28.2
+    assert "| 5 x 10 | 1 | 4 (2) |" in seed1 and "limit 120.0 MPa, order 1.50" in seed1 and "from K = 29" in seed1
+    assert "12: 160.0 (-20.0 %)" in seed2 and "fewer than three results" in seed2
