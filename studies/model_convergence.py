@@ -7,7 +7,8 @@ with ``--elastic``, one line per ``elastic --grains fem`` folder: the moduli and
     /usr/bin/python3 -m studies.model_convergence --elastic results/model_convergence_elastic/* --out docs/studies/model_convergence/elastic_tails.csv
     /usr/bin/python3 -m studies.model_convergence --k-series docs/studies/model_convergence/*ucs_runs.csv --out docs/studies/model_convergence/k_series.md
 
-``--k-series`` reads such CSVs back: for each specimen (size, seed) and grain interior (rings, grading), the UCS
+``--k-series`` reads such CSVs back: for each specimen (size, seed), grain interior (rings, grading) and bond
+stiffness factor (``calibration.stiffness_scale``; 1 where a CSV lacks the column), the UCS
 against K with the paired change from the next coarser K and the three-point extrapolation in the node spacing
 h ~ 1 / K (`grainfrac_yade/analysis/mesh_convergence.py`), as a markdown table.
 
@@ -80,29 +81,38 @@ def row(folder: Path) -> dict | None:
         return None
     res = s["params"]["resolution"]
     out = {"run": folder.name, "seed": s["seed"], "width_mm": 1e3 * s["params"]["specimen"]["width"],
-           "height_mm": 1e3 * s["params"]["specimen"]["height"], **_discretisation(res)}
+           "height_mm": 1e3 * s["params"]["specimen"]["height"], **_discretisation(res),
+           "stiffness_scale_1": s["params"]["calibration"]["stiffness_scale"]}
     for name, key, factor in COLUMNS:
         out[name] = _value(s.get(key), factor)
-    out.update(end_reason=s.get("end_reason"), code_version=s.get("code_version"))
+    out.update(peak_reached=s.get("peak_reached"), end_reason=s.get("end_reason"), code_version=s.get("code_version"))
     return out
 
 
 def k_series(rows: list[dict]) -> str:
     """Markdown: per specimen and interior, the UCS against K (bonds per face), the paired changes, and the
-    three-point extrapolation in h = 1 / K with the K it puts within the criterion of its limit."""
-    groups = {}
+    three-point extrapolation in h = 1 / K with the K it puts within the criterion of its limit. Runs that
+    ended without a peak (``peak_reached`` False) are shown with their stress at the end and left out of the
+    changes and the extrapolation."""
+    groups, no_peak = {}, {}
     for r in rows:
         key = (float(r["width_mm"]), float(r["height_mm"]), int(r["seed"]), int(r["cell_rings_1"]),
-               float(r["cell_ring_growth_1"]))
-        groups.setdefault(key, {})[int(r["bonds_per_face_1"])] = float(r["ucs_mpa"])
-    lines = ["| specimen [mm] | seed | rings (grading) | K: UCS [MPa] (change) | extrapolation over the three finest |",
-             "|---|---|---|---|---|"]
-    for (w, h, seed, rings, growth), by_k in sorted(groups.items()):
+               float(r["cell_ring_growth_1"]), float(r.get("stiffness_scale_1", 1.0)))
+        groups.setdefault(key, {})
+        if r.get("peak_reached", "True") == "False":
+            no_peak.setdefault(key, {})[int(r["bonds_per_face_1"])] = float(r["ucs_mpa"])
+        else:
+            groups[key][int(r["bonds_per_face_1"])] = float(r["ucs_mpa"])
+    lines = ["| specimen [mm] | seed | rings (grading) | bond stiffness x | K: UCS [MPa] (change) | extrapolation over the three finest |",
+             "|---|---|---|---|---|---|"]
+    for key, by_k in sorted(groups.items()):
+        w, h, seed, rings, growth, stiffness = key
         ks = sorted(by_k)
         ucs = [by_k[k] for k in ks]
         changes = paired_changes(ucs)
-        cells = ", ".join(f"{k}: {u:.1f}" + ("" if i == 0 else f" ({100 * changes[i]:+.1f} %)")
-                          for i, (k, u) in enumerate(zip(ks, ucs)))
+        cells = ", ".join([f"{k}: no peak ({u:.1f} at the end)" for k, u in sorted(no_peak.get(key, {}).items())]
+                          + [f"{k}: {u:.1f}" + ("" if i == 0 else f" ({100 * changes[i]:+.1f} %)")
+                             for i, (k, u) in enumerate(zip(ks, ucs))])
         fit, why = extrapolate([1.0 / k for k in ks], ucs)
         if fit is None:
             note = why
@@ -110,7 +120,7 @@ def k_series(rows: list[dict]) -> str:
             k_needed = 1.0 / fit.spacing_within(CONVERGED_CHANGE)
             note = (f"limit {fit.limit:.1f} MPa, order {fit.order:.2f}; within {100 * CONVERGED_CHANGE:.0f} % "
                     f"of the limit from K = {math.ceil(k_needed)}")
-        lines.append(f"| {w:g} x {h:g} | {seed} | {rings} ({growth:g}) | {cells} | {note} |")
+        lines.append(f"| {w:g} x {h:g} | {seed} | {rings} ({growth:g}) | {stiffness:g} | {cells} | {note} |")
     return "\n".join(lines) + "\n"
 
 
