@@ -25,6 +25,10 @@ from grainfrac_yade.api import ADDED_KEYS, extrapolate, paired_changes
 
 #: The study's criterion: the paired UCS change between the two finest discretisations below this [1].
 CONVERGED_CHANGE = 0.05
+#: A lateral over axial strain ratio ("nu" of the summary, 10-50 % of the peak) above this [1] is no elastic solid's
+#: (plane strain allows at most 0.5): the specimen split into columns before its peak, which then is not a brittle
+#: strength but the columns' (small-displacement statics: no buckling).
+SPLIT_POISSON = 0.5
 
 #: (column, summary key, factor) of every row: the units are those of the column name.
 COLUMNS = (("ucs_mpa", "ucs_pa", 1e-6), ("peak_axial_strain_percent", "peak_axial_strain", 100.0),
@@ -92,15 +96,19 @@ def row(folder: Path) -> dict | None:
 def k_series(rows: list[dict]) -> str:
     """Markdown: per specimen and interior, the UCS against K (bonds per face), the paired changes, and the
     three-point extrapolation in h = 1 / K with the K it puts within the criterion of its limit. Runs that
-    ended without a peak (``peak_reached`` False) are shown with their stress at the end and left out of the
-    changes and the extrapolation."""
+    ended without a peak (``peak_reached`` False) or split before it (nu above :data:`SPLIT_POISSON`) are shown
+    with their stress and left out of the changes and the extrapolation."""
     groups, no_peak = {}, {}
     for r in rows:
         key = (float(r["width_mm"]), float(r["height_mm"]), int(r["seed"]), int(r["cell_rings_1"]),
                float(r["cell_ring_growth_1"]), float(r.get("stiffness_scale_1", 1.0)))
         groups.setdefault(key, {})
         if r.get("peak_reached", "True") == "False":
-            no_peak.setdefault(key, {})[int(r["bonds_per_face_1"])] = float(r["ucs_mpa"])
+            no_peak.setdefault(key, {})[int(r["bonds_per_face_1"])] = f"no peak ({float(r['ucs_mpa']):.1f} at the end)"
+        elif r.get("poisson_1") not in (None, "") and float(r["poisson_1"]) > SPLIT_POISSON:
+            no_peak.setdefault(key, {})[int(r["bonds_per_face_1"])] = (
+                f"split ({float(r['ucs_mpa']):.1f} at {float(r['peak_axial_strain_percent']):.3g} %, "
+                f"nu {float(r['poisson_1']):.2f})")
         else:
             groups[key][int(r["bonds_per_face_1"])] = float(r["ucs_mpa"])
     lines = ["| specimen [mm] | seed | rings (grading) | bond stiffness x | K: UCS [MPa] (change) | extrapolation over the three finest |",
@@ -110,9 +118,10 @@ def k_series(rows: list[dict]) -> str:
         ks = sorted(by_k)
         ucs = [by_k[k] for k in ks]
         changes = paired_changes(ucs)
-        cells = ", ".join([f"{k}: no peak ({u:.1f} at the end)" for k, u in sorted(no_peak.get(key, {}).items())]
-                          + [f"{k}: {u:.1f}" + ("" if i == 0 else f" ({100 * changes[i]:+.1f} %)")
-                             for i, (k, u) in enumerate(zip(ks, ucs))])
+        shown = {**no_peak.get(key, {}),
+                 **{k: f"{u:.1f}" + ("" if i == 0 else f" ({100 * changes[i]:+.1f} %)")
+                    for i, (k, u) in enumerate(zip(ks, ucs))}}
+        cells = ", ".join(f"{k}: {text}" for k, text in sorted(shown.items()))
         fit, why = extrapolate([1.0 / k for k in ks], ucs)
         if fit is None:
             note = why

@@ -61,11 +61,12 @@ def test_the_studys_k_series_table_groups_by_specimen_and_interior():
     law = {k: 120.0 + 900.0 * (1.0 / k) ** 1.5 for k in (8, 12, 16)}
     stiff = [dict(r(8, 300.0), stiffness_scale_1="4.0")]     # another bond stiffness: a series of its own
     stiff.append(dict(r(6, 900.0), peak_reached="False"))     # no peak: shown, not a point of the series
+    stiff.append(dict(r(4, 600.0), peak_axial_strain_percent="1.2", poisson_1="3.4"))   # split: shown, not a point
     rows = [r(k, u) for k, u in law.items()] + [r(8, 200.0, seed=2), r(12, 160.0, seed=2)] + stiff
     text = k_series(rows).splitlines()
     assert len(text) == 5 and "| 5 x 10 | 1 | 4 (2) | 4 | 8: 300.0 |" in text[3]
     del text[3]
     seed1, seed2 = text[2], text[3]
     # within 5 % of 120 MPa: 900 h^1.5 <= 6, h <= (1/150)^(2/3), K >= 150^(2/3) = 28.2
-    assert "| 5 x 10 | 1 | 4 (2) | 1 | 6: no peak (900.0 at the end), 8: 159.8, 12: 141.7 (-11.3 %)" in seed1 and "limit 120.0 MPa, order 1.50" in seed1 and "from K = 29" in seed1
+    assert "| 5 x 10 | 1 | 4 (2) | 1 | 4: split (600.0 at 1.2 %, nu 3.40), 6: no peak (900.0 at the end), 8: 159.8, 12: 141.7 (-11.3 %)" in seed1 and "limit 120.0 MPa, order 1.50" in seed1 and "from K = 29" in seed1
     assert "12: 160.0 (-20.0 %)" in seed2 and "fewer than three results" in seed2
