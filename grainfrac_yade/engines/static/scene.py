@@ -438,9 +438,9 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         for k in ("held", "iterations"):
             values[k] = int(values[k])
         self.state = State(**values)
-        self.eq.restore_factor_state({k[len(FACTOR_PREFIX):]: v for k, v in a.items() if k.startswith(FACTOR_PREFIX)})
         self.path.jt, self.path.jc = a["jt"].copy(), a["jc"].copy()
-        self.path.restore_arrays(a)
+        self.path.restore_arrays(a)         # before the factor: the bonds' softened stiffness is in its tangent
+        self.eq.restore_factor_state({k[len(FACTOR_PREFIX):]: v for k, v in a.items() if k.startswith(FACTOR_PREFIX)})
         self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()
         self._time = float(a["time"])
         self._steps_offset = int(a["steps"]) - self.eq.counters.equilibria
