@@ -375,7 +375,8 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress, **solver_options(self.params))
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
-        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.strategy.path_relaxation)
+        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.strategy.path_relaxation,
+                             self.path.teeth)
         self.path.load_loss_ratio = self.load_loss_ratio
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)

@@ -32,6 +32,9 @@ class BondTeeth:
         self.tooth = np.zeros(net.n_bonds, np.int64)
         self.events = 0
         self.equilibria = []
+        #: called with (bonds, f_{i+1} / f_i) after each tooth: what keeps its own copy of the strengths (a creep
+        #: test's degradation law, :class:`.engine.StaticCorrosion`) scales it alike
+        self.strength_listeners = []
 
     def softens(self, bond: int) -> bool:
         """Whether ``bond`` takes another tooth (rather than breaking) when it meets its strength."""
@@ -53,6 +56,8 @@ class BondTeeth:
         self.events += len(b)
         for eq in self.equilibria:
             eq.stiffness_changed()
+        for follow in self.strength_listeners:
+            follow(b, f_ratio)
 
     def summary_keys(self) -> dict:
         return {EVENTS_KEY: int(self.events)}
@@ -73,9 +78,13 @@ class BondTeeth:
             eq.stiffness_changed()
 
 
-def teeth_for(params, net) -> BondTeeth | None:
+def teeth_for(params, net, kept: BondTeeth | None = None) -> BondTeeth | None:
     """The run's :class:`BondTeeth` on ``net``, or None for the brittle bond (:func:`grainfrac_yade.softening.
-    softening_of`)."""
+    softening_of`); ``kept``: a path's teeth to go on with (a path rebuilt on the same network), its equilibria
+    forgotten (the new path's are told from then on)."""
+    if kept is not None:
+        kept.equilibria = []
+        return kept
     factors = softening_of(params.numerics)
     return None if factors is None else BondTeeth(net, factors)
 
