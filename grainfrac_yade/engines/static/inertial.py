@@ -261,9 +261,10 @@ class InertialMotion(HeldRelaxing):
             hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
             if hit.any() and teeth is not None:     # saw-tooth softening: the next tooth, the force dropping
                 soft = np.flatnonzero(hit)[teeth.tooth[hit] < len(teeth.stiffness) - 1]
-                teeth.advance(soft, jt, jc)
-                fn[soft], fs[soft] = net.kn[soft] * dn[soft], net.ks[soft] * ds[soft]
-                hit[soft] = False
+                if len(soft):
+                    teeth.advance(soft, jt, jc)
+                    fn[soft], fs[soft] = net.kn[soft] * dn[soft], net.ks[soft] * ds[soft]
+                    hit[soft] = False
             if hit.any():
                 idx = np.flatnonzero(hit)
                 _, md = cl.overstress(fn[idx], fs[idx], net.area[idx], jt[idx], jc[idx], net.tan_friction[idx])
