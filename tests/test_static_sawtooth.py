@@ -1,5 +1,5 @@
 """Saw-tooth softening on the static engine (grainfrac_yade/engines/static/teeth.py): one bond through its teeth against
-the closed form, checkpoints, the brittle settings as the default law, and the refusal on the other engines."""
+the closed form (the static path and the inertial relaxation), checkpoints, the brittle settings as the default law, and the refusal on the other engines."""
 import json
 
 import numpy as np
@@ -139,3 +139,36 @@ def test_softening_refused_on_the_dynamic_engines_in_one_line(capsys, tmp_path, 
     p = load_parameters(overrides=[f"numerics.engine={engine}", "numerics.static_softening=sawtooth"])
     with pytest.raises(GrainfracError, match="static_softening"):
         engine_for(p).build_scene(None, p)
+
+
+def test_inertial_relaxation_takes_one_tooth_per_step_and_breaks_at_the_last():
+    """The inertial relaxation's contact law with teeth (engines/static/inertial.py): a bond pulled beyond every tooth
+    at once (platens held open) takes one tooth per explicit step, its stiffness and strength as the closed form says,
+    and breaks at the step after its last tooth; pulled just past its strength it takes one tooth and stays intact."""
+    from grainfrac_yade.engines.static.inertial import FixedPlatens, InertialMotion, InertialRelaxation
+    n, mu = 4, 3.0
+    net = tension_pair()
+    eq = Equilibrium(net, direction=-1.0)
+    teeth = BondTeeth(net, sawtooth_teeth(n, mu))
+    d0 = JT * net.area[0] / KN
+
+    class Dynamics:         # what InertialMotion reads of an InertialRelaxation, with unit masses and no damping
+        _rows, _state = InertialRelaxation._rows, InertialRelaxation._state
+
+        def __init__(self):
+            self.net, self.eq, self.masses, self.teeth = net, eq, np.ones(net.ndof), teeth
+            self.dt, self.damping = 1e-9, 0.0
+
+    path = Path(eq)
+    motion = InertialMotion(Dynamics(), eq.solve(1.0001 * d0, eq.initial(0.0)), FixedPlatens(None), path.jt, path.jc,
+                            None)
+    motion.advance(2)
+    assert teeth.tooth[0] == 1 and not motion.broken[0] and teeth.events == 1
+    motion.closure = 2 * mu * d0
+    k, f = sawtooth_teeth(n, mu)
+    for i in range(2, n):
+        motion.advance(1)
+        assert teeth.tooth[0] == i and not motion.broken[0]
+        assert net.kn[0] == pytest.approx(KN * k[i], rel=1e-14) and path.jt[0] == pytest.approx(JT * f[i], rel=1e-14)
+    motion.advance(1)
+    assert motion.broken[0] and teeth.events == n - 1 and motion.fn[0] == 0.0
