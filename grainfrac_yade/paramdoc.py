@@ -22,6 +22,7 @@ CHECK_MEANING = {
     "nonnegative": ">= 0",
     "fraction": "in [0, 1]",
     "fraction_below_one": "in [0, 1)",
+    "at_least_one": ">= 1",
     "unit_interval": "in (0, 1]",
     "unit_interval_open": "in (0, 1)",
     "poisson": "in (-1, 0.5)",

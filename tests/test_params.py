@@ -163,6 +163,9 @@ def test_dt_min_above_dt_max():
     ("stress_corrosion.beta1=-1", "must be > 0"),
     ("beta1", "not of the form"),
     ("resolution.spheres_per_cell=1.5", "not an integer"),
+    ("numerics.static_softening=linear", "not one of"),
+    ("numerics.static_softening_teeth=0", "must be >= 1"),
+    ("numerics.static_softening_ductility=0.5", "must be >= 1"),
 ])
 def test_bad_override(override, words):
     with pytest.raises(ParameterError, match=words) as err:

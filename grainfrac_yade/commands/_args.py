@@ -71,18 +71,18 @@ def load_params_from_args(args):
 def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
     """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
     without dynamics, a test the engine does not have yet, a VTK series ``vtk`` it does not write), and warn
-    once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  Nothing for
-    a dynamic engine (YADE); an engine without dynamics says what it refuses in its
-    :class:`~grainfrac_yade.engines.EngineModule` (``unsupported``, ``vtk_refused``, ``warn_dynamic_only``:
+    once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  A dynamic engine
+    (YADE) refuses only settings it has no model of; an engine says what it refuses in its
+    :class:`~grainfrac_yade.engines.EngineModule` (``unsupported``, ``refused_settings``, ``vtk_refused``, ``warn_dynamic_only``:
     docs/maintainers.md, adding an engine)."""
     module = engine_for(params)
+    refusal = module.refusal(command, params)
+    if refusal:
+        raise GrainfracError(refusal)
     if module.dynamic:
         return
     if command == "creep" and params.stress_corrosion.clock == "paper":
         require_dynamic(params, "the paper clock (its unbalanced force, Eq. 8)")
-    refusal = module.refusal(command)
-    if refusal:
-        raise GrainfracError(refusal)
     if vtk and module.vtk_refused:
         raise GrainfracError(module.vtk_refused)
     for line in module.warn_dynamic_only([o for o in overrides if override_origin(o) == "--set"], params):

@@ -280,6 +280,10 @@ def _no_warnings(overrides, params) -> list:
     return []
 
 
+def _no_refused_settings(params) -> str:
+    return ""
+
+
 @dataclass(frozen=True)
 class EngineModule:
     """What one engine offers the test protocols and the commands: the ``ENGINE`` of its sub-package's
@@ -298,7 +302,8 @@ class EngineModule:
     state from a checkpoint).
 
     What the command line refuses before a run folder is made: ``unsupported`` (command -> the one line that
-    says so and the fix), ``vtk_refused`` (the line refusing a VTK series, "" if it writes them), and
+    says so and the fix), ``refused_settings(params)`` (the one line refusing a setting it has no model of, "" if
+    none: the saw-tooth softening on the dynamic engines), ``vtk_refused`` (the line refusing a VTK series, "" if it writes them), and
     ``warn_dynamic_only(overrides, params)`` (one warning line per setting given that the engine does not read).
     Engine-specific tools, None where an engine has none: ``timings`` (the module of ``bench``'s timings) and
     ``batch_rows`` (the module that reads a yade-batch row: ``read_table``, ``row_errors``, ``row_plan``,
@@ -316,12 +321,13 @@ class EngineModule:
     unsupported: dict = field(default_factory=dict)
     vtk_refused: str = ""
     warn_dynamic_only: Callable[[list, object], list] = _no_warnings
+    refused_settings: Callable[[object], str] = _no_refused_settings
     timings: object = None
     batch_rows: object = None
 
-    def refusal(self, command: str) -> str:
-        """The one line that refuses ``command`` on this engine, "" if it runs it."""
-        return self.unsupported.get(command, "")
+    def refusal(self, command: str, params=None) -> str:
+        """The one line that refuses ``command`` (with ``params``, if given) on this engine, "" if it runs it."""
+        return self.unsupported.get(command, "") or ("" if params is None else self.refused_settings(params))
 
 
 __all__ = ["EngineModule", "PlatenDrive", "Scene", "SceneState"]

@@ -149,6 +149,10 @@ class NumericsParams:
                                      "cells' boundary dofs alone (grainfrac_yade.engines.static.condensation; results "
                                      "change at round-off); refused with rigid cells (no interior)",
                                      ("none", "cell_interiors"))
+    static_softening: str = _spec("", "choice", "static engine: none = an intact bond breaks at paper Eq. 4-5; sawtooth = it softens by "
+                                  "saw-tooth teeth first (grainfrac_yade.softening); refused by the yade and hybrid engines", ("none", "sawtooth"))
+    static_softening_teeth: int = _spec("1", "positive_int", "static_softening = sawtooth: teeth N of a bond; 1 = brittle")
+    static_softening_ductility: float = _spec("1", "at_least_one", "static_softening = sawtooth: ultimate over peak separation mu; 1 = brittle")
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")
@@ -450,6 +454,7 @@ def _check_value(value: Any, spec: Mapping, source: str, key: str):
     rules = {
         "positive": (value > 0, f"must be > 0 (got {value:g})", f"give a positive value{unit_txt}"),
         "nonnegative": (value >= 0, f"must be >= 0 (got {value:g})", f"give a value >= 0{unit_txt}"),
+        "at_least_one": (value >= 1, f"must be >= 1 (got {value:g})", f"give a value >= 1{unit_txt}"),
         "fraction": (0 <= value <= 1, f"must lie in [0, 1] (got {value:g})", "give a fraction between 0 and 1"),
         "fraction_below_half": (0 <= value < 0.5, f"must lie in [0, 0.5) (got {value:g})",
                                 "give a fraction in [0, 0.5) (an edge of half the grain size or more is no sliver)"),

@@ -13,6 +13,8 @@ Importing this module does not import YADE: the first stint does.
 from __future__ import annotations
 
 from .._interface import EngineModule
+from ...errors import GrainfracError
+from ...softening import engine_refusal
 from ..dynamic import dynamic_engine
 from ..static.engine import ENGINE as STATIC
 from ..static.scene import StaticScene
@@ -44,9 +46,17 @@ def warn_dynamic_only(overrides, params) -> list:
     return warn_not_used(overrides)
 
 
+def refused_settings(params) -> str:
+    """The one line refusing the saw-tooth softening (``numerics.static_softening``): its teeth are events of the
+    static path, which the dynamic stints do not have ("" where the run asks for none)."""
+    return engine_refusal(params, NAME)
+
+
 def build_scene(specimen, params, layout=None) -> StaticScene:
     """The hybrid scene of ``specimen`` (rigid or fem cells): a static scene with the strategy of dynamic stints on
-    :data:`DYNAMIC_ENGINE`."""
+    :data:`DYNAMIC_ENGINE` (a setting it has no model of refused in one line first)."""
+    if refused_settings(params):
+        raise GrainfracError(refused_settings(params))
     return StaticScene(specimen, params, layout, DynamicStints(lambda: dynamic_engine(DYNAMIC_ENGINE)))
 
 
@@ -63,4 +73,5 @@ def scene_from_state(specimen, params, state, layout=None) -> StaticScene:
 ENGINE = EngineModule(name=NAME, dynamic=DYNAMIC, scene_file=STATIC.scene_file, version=version,
                       build_scene=build_scene, scene_from_state=scene_from_state, consolidate=STATIC.consolidate,
                       apply_levers=STATIC.apply_levers, stress_corrosion=STATIC.stress_corrosion,
-                      unsupported=UNSUPPORTED, vtk_refused=STATIC.vtk_refused, warn_dynamic_only=warn_dynamic_only)
+                      unsupported=UNSUPPORTED, vtk_refused=STATIC.vtk_refused, warn_dynamic_only=warn_dynamic_only,
+                      refused_settings=refused_settings)

@@ -29,6 +29,7 @@ from ...errors import NumericalFailure
 from . import contacts as cl
 from .failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
 from .solver import Equilibrium, State
+from .teeth import tooth_release
 from .ties import DECISION_REL_TOL, first_of_largest
 
 #: A bond whose ratio is within this of 1 has reached its strength [1]: the tie rule's tolerance
@@ -81,6 +82,8 @@ class Path:
         #: (:meth:`.strategy.RelaxationHooks.lose_load_below`): a relaxation with the platens held loses the load
         #: below this ratio of the stress it started from; None: never (a path that does not relax ignores it)
         self.load_loss_ratio = None
+        #: the bonds' saw-tooth softening (:class:`.teeth.BondTeeth`); None: a bond at its strength breaks
+        self.teeth = None
 
     # ------------------------------------------------------------------ ratios and the tie rule
     def ratios(self, state: State):
@@ -115,9 +118,19 @@ class Path:
         base.break_mode[bond] = mode
         return self.eq.solve(state.closure, base, self.eq.release_force(state, base))
 
+    def soften_bond(self, state: State, bond: int) -> State:
+        """``state`` with ``bond`` on its next saw-tooth (:mod:`.teeth`: lower stiffness and strengths, still intact),
+        re-solved at its closure (the force it no longer carries released as for a break)."""
+        n = self.net
+        self.teeth.advance(bond, self.jt, self.jc)
+        dn, ds = (rows[bond] @ state.u for rows in (n.cn, n.ct))
+        release = tooth_release(self.eq, state, bond, n.kn[bond] * dn[0], n.ks[bond] * ds[0])
+        return self.eq.solve(state.closure, state.copy(), release)
+
     def cascade(self, state: State, first: int | None = None, record: Record | None = None) -> State:
-        """Break ``first`` (if given), then every bond at its strength, one at a time, the most overstressed first;
-        :class:`LargeCascade` after :attr:`max_cascade` bonds if that is set."""
+        """Break ``first`` (if given), then every bond at its strength, one at a time, the most overstressed first (a
+        bond with a saw-tooth left takes it instead, :attr:`teeth`); :class:`LargeCascade` after :attr:`max_cascade`
+        broken bonds if that is set."""
         broken = 0
         while True:
             self.last_converged = state
@@ -132,6 +145,9 @@ class Path:
                 if not len(hit):
                     return state
                 bond = self.pick(ratio, hit)
+            if self.teeth is not None and self.teeth.softens(bond):
+                state = self.soften_bond(state, bond)
+                continue
             state = self.break_bond(state, bond, int(mode[bond]))
             broken += 1
             if record is not None:
@@ -225,15 +241,19 @@ class Path:
         return state
 
     def summary_keys(self) -> dict:
-        """What a run's summary records of the path beyond the engine's counters: nothing for the plain path."""
-        return {}
+        """What a run's summary records of the path beyond the engine's counters: the tooth events of saw-tooth
+        softening (nothing for the plain path without it)."""
+        return {} if self.teeth is None else self.teeth.summary_keys()
 
     def saved_arrays(self) -> dict:
-        """Arrays a scene's save keeps of the path's own bookkeeping (none for the plain path)."""
-        return {}
+        """Arrays a scene's save keeps of the path's own bookkeeping: the bonds' teeth (none for the plain path
+        without softening)."""
+        return {} if self.teeth is None else self.teeth.saved_arrays()
 
     def restore_arrays(self, arrays: dict) -> None:
-        """Take back what :meth:`saved_arrays` gave (nothing for the plain path)."""
+        """Take back what :meth:`saved_arrays` gave."""
+        if self.teeth is not None:
+            self.teeth.restore_arrays(arrays)
 
     def hold(self, state: State, target: float, rule: FailureRule):
         """Regain the platen stress ``target`` [Pa] from ``state`` along the path: (state, failure reason or None)."""

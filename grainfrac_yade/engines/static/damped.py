@@ -178,6 +178,7 @@ def relax_held(path: Path, anchored: AnchoredEquilibrium, state: State, target: 
     network; ``start_closure``: where the regain began [m] (the collapse rule's origin; default ``state``'s)."""
     damped = Path(anchored, path.bracket_tol)
     damped.jt, damped.jc = path.jt, path.jc         # the same strengths, not copies
+    damped.teeth = path.teeth                       # and the same teeth
     start = state.closure if start_closure is None else float(start_closure)
     broken0 = int(state.broken.sum())
     out = Relaxation(state, None, start)
@@ -237,12 +238,13 @@ class RelaxingPath(Path):
 
     def summary_keys(self) -> dict:
         """The relaxations of the whole run (a resumed run's included, :meth:`saved_arrays`)."""
-        return {k: int(v) for k, v in zip(self.TALLY, self.tally)}
+        return {**super().summary_keys(), **{k: int(v) for k, v in zip(self.TALLY, self.tally)}}
 
     def saved_arrays(self) -> dict:
-        return {"relaxation_tally": self.tally.copy()}
+        return {**super().saved_arrays(), "relaxation_tally": self.tally.copy()}
 
     def restore_arrays(self, arrays: dict) -> None:
+        super().restore_arrays(arrays)
         self.tally = np.asarray(arrays.get("relaxation_tally", np.zeros(len(self.TALLY))), np.int64).copy()
 
     def cascade(self, state, first=None, record=None):

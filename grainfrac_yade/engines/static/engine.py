@@ -65,6 +65,15 @@ class StaticCorrosion(BondCorrosion):
         super().__init__(scene, sc_params)
         if not self.law.exact_jump:
             raise GrainfracError(STIFFNESS_LAW_REFUSED)
+        if scene.path.teeth is not None:        # a saw-tooth lowers the law's strengths as the path's
+            scene.path.teeth.strength_listeners.append(self.follow_tooth)
+
+    def follow_tooth(self, bonds, ratio):
+        """Bonds ``bonds`` (canonical numbers) took their next saw-tooth (:mod:`.teeth`): the law's current,
+        corroded strengths x ``ratio`` (f_{i+1} / f_i), as the path's, so that corrosion goes on from them."""
+        lay = self.scene.net.order[np.atleast_1d(bonds)]
+        self.state = self.state.replaced(lay, {k: self.state[k][lay] * ratio for k in ("tensile_strength",
+                                                                                      "cohesion")})
 
     def write(self, idx):
         """The law's strengths of bonds ``idx`` into the scene (no solve: the next one follows them)."""

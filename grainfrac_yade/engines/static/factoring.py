@@ -74,6 +74,13 @@ class KeptFactor:
         round-off (1e-12 relative), so a run that drops it goes on along another rounding than one that does not."""
         self._key, self._lr, self._op, self._lu, self._k, self._plain = None, None, None, None, None, None
 
+    def stiffness_changed(self):
+        """A bond's stiffness changed in place (a saw-tooth, :mod:`.teeth`): the tangent at the same statuses is
+        another one, so the kept tangent's key is dropped and the next solve assembles it again; on the fast path
+        that is a low-rank update of the kept reference factor (its K^-1 U columns are keyed by the coefficients),
+        on the direct path a new factor."""
+        self._key = None
+
     def factor_state(self) -> dict:
         """What rebuilds the solver's kept state bit for bit (:meth:`restore_factor_state`), as arrays: the ground
         springs (made from the first tangent that needed them); the fast path's reference factor as the statuses

@@ -10,7 +10,8 @@ M lumped (each body's mass and, for rigid cells, its inertia about its node: the
 ``masses_and_step``, with ``numerics.density_scale``), the step ``numerics.timestep_safety`` x 2 / omega_max
 (omega_max^2 bounded by the largest row sum of M^-1 |K| of the intact tangent, Gershgorin).  Every step evaluates
 the contact law of :mod:`.contacts` at the current displacements: intact bonds linear, broken at paper Eq. 4-5 as
-soon as they reach it (JCFpm's broken state, :func:`.contacts.break_state`); broken contacts compression only,
+soon as they reach it (JCFpm's broken state, :func:`.contacts.break_state`; with saw-tooth softening a bond takes
+its next tooth there first, :mod:`.teeth`); broken contacts compression only,
 with the residual friction by the return mapping from the last step (:func:`.contacts.trial_status`).
 
 The platens hold the target stress through the creep protocol's servo (closing speed (target - stress) x H /
@@ -153,6 +154,8 @@ class InertialRelaxation:
         self.damping = cp.relaxation_damping if cp.relaxation_damping > 0 else params.numerics.damping
         self.density = scene_density(params)
         self._intact_modulus = None
+        #: the path's saw-tooth softening (:class:`.teeth.BondTeeth`, set by :func:`.paths.path_for`); None: brittle
+        self.teeth = None
 
     def budget(self, state: State):
         """The creep protocol's :class:`~grainfrac_yade.wave.HoldBudget` of a relaxation from ``state`` (in this
@@ -247,7 +250,7 @@ class InertialMotion(HeldRelaxing):
         jt, jc, inv_m = self.jt, self.jc, self.inv_m
         plat = np.flatnonzero(eq.platen_fixed)     # the driven dofs by index (the same values as by the mask)
         e_plat = eq.e[plat]
-        dt, damping = self.dyn.dt, self.dyn.damping
+        dt, damping, teeth = self.dyn.dt, self.dyn.damping, self.dyn.teeth
         u, v, broken, s_p, mode = self.u, self.v, self.broken, self.s_p, self.mode
         status, sign, rows, closure = self.status, self.sign, self.rows, self.closure
         for _ in range(steps):
@@ -256,6 +259,12 @@ class InertialMotion(HeldRelaxing):
             status, sign = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual, status, sign)[:2]
             fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)
             hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
+            if hit.any() and teeth is not None:     # saw-tooth softening: the next tooth, the force dropping
+                soft = np.flatnonzero(hit)[teeth.tooth[hit] < len(teeth.stiffness) - 1]
+                if len(soft):
+                    teeth.advance(soft, jt, jc)
+                    fn[soft], fs[soft] = net.kn[soft] * dn[soft], net.ks[soft] * ds[soft]
+                    hit[soft] = False
             if hit.any():
                 idx = np.flatnonzero(hit)
                 _, md = cl.overstress(fn[idx], fs[idx], net.area[idx], jt[idx], jc[idx], net.tan_friction[idx])

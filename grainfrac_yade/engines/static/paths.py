@@ -12,6 +12,7 @@ from .cascade import Path
 from . import damped
 from .inertial import InertialPath, InertialRelaxation
 from .solver import Equilibrium, solver_options
+from .teeth import teeth_for
 
 #: (equilibrium, parameters, lateral traction [Pa], masses: () -> (ndof,) array) -> path, per value of
 #: ``numerics.static_relaxation``.
@@ -24,9 +25,17 @@ PATHS = {
 }
 
 
-def path_for(eq: Equilibrium, params, confinement: float = 0.0, masses=None, relaxation: str | None = None) -> Path:
+def path_for(eq: Equilibrium, params, confinement: float = 0.0, masses=None, relaxation: str | None = None,
+             teeth=None) -> Path:
     """The static path on ``eq`` for ``params`` (``numerics.static_relaxation`` picks it from :data:`PATHS`, or
     ``relaxation`` where a scene relaxes its own way) under the lateral traction ``confinement`` [Pa]; ``masses``: a
     callable giving the network's (ndof,) masses (:func:`.inertial.dof_masses`), called only by a path that moves
-    with inertia."""
-    return PATHS[relaxation or params.numerics.static_relaxation](eq, params, confinement, masses)
+    with inertia.  The path's saw-tooth softening (:func:`.teeth.teeth_for`; ``teeth``: a former path's, kept) tells
+    its equilibria when a bond's stiffness changes."""
+    path = PATHS[relaxation or params.numerics.static_relaxation](eq, params, confinement, masses)
+    path.teeth = teeth_for(params, eq.net, teeth)
+    if path.teeth is not None:
+        path.teeth.equilibria += [e for e in (eq, getattr(path, "anchored", None)) if e is not None]
+        if hasattr(path, "dynamics"):
+            path.dynamics.teeth = path.teeth
+    return path

@@ -375,7 +375,8 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         self.eq = Equilibrium(self.net, confinement=self.confinement_stress, **solver_options(self.params))
         self.eq.counters = counters
         jt, jc, kept = self.path.jt, self.path.jc, self.path.saved_arrays()
-        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.strategy.path_relaxation)
+        self.path = path_for(self.eq, self.params, self.confinement_stress, self.masses, self.strategy.path_relaxation,
+                             self.path.teeth)
         self.path.load_loss_ratio = self.load_loss_ratio
         self.path.jt, self.path.jc = jt, jc
         self.path.restore_arrays(kept)
@@ -438,9 +439,9 @@ class StaticScene(SceneStateExchange, RelaxationHooks):
         for k in ("held", "iterations"):
             values[k] = int(values[k])
         self.state = State(**values)
-        self.eq.restore_factor_state({k[len(FACTOR_PREFIX):]: v for k, v in a.items() if k.startswith(FACTOR_PREFIX)})
         self.path.jt, self.path.jc = a["jt"].copy(), a["jc"].copy()
-        self.path.restore_arrays(a)
+        self.path.restore_arrays(a)         # before the factor: the bonds' softened stiffness is in its tangent
+        self.eq.restore_factor_state({k[len(FACTOR_PREFIX):]: v for k, v in a.items() if k.startswith(FACTOR_PREFIX)})
         self.broken, self.break_mode, self.break_step = a["broken"].copy(), a["break_mode"].copy(), a["break_step"].copy()
         self._time = float(a["time"])
         self._steps_offset = int(a["steps"]) - self.eq.counters.equilibria

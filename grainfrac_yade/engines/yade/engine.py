@@ -17,11 +17,13 @@ package.
 from __future__ import annotations
 
 from .._interface import EngineModule
+from ...errors import GrainfracError
+from ...softening import engine_refusal
 from . import batch, bench_timing, load_yade
 from .confinement import consolidate
 from .corrosion_engine import stress_corrosion
 from .levers import apply_levers
-from .scene import build_scene, scene_from_state
+from . import scene as _scene
 
 #: The value of ``numerics.engine`` that selects this engine.
 NAME = "yade"
@@ -36,7 +38,24 @@ def version() -> str:
     return load_yade().config.version
 
 
+def refused_settings(params) -> str:
+    """The one line refusing the static engine's saw-tooth softening (``numerics.static_softening``): YADE's JCFpm
+    bonds break at their strength ("" where the run asks for no softening)."""
+    return engine_refusal(params, NAME)
+
+
+def build_scene(specimen, params, layout=None):
+    """:func:`.scene.build_scene`, a setting this engine has no model of refused in one line first."""
+    if refused_settings(params):
+        raise GrainfracError(refused_settings(params))
+    return _scene.build_scene(specimen, params, layout)
+
+
+scene_from_state = _scene.scene_from_state
+
+
 #: What the registry returns for ``numerics.engine = "yade"``.
 ENGINE = EngineModule(name=NAME, dynamic=DYNAMIC, scene_file=SCENE_FILE, version=version, build_scene=build_scene,
                       scene_from_state=scene_from_state, consolidate=consolidate, apply_levers=apply_levers,
-                      stress_corrosion=stress_corrosion, timings=bench_timing, batch_rows=batch)
+                      stress_corrosion=stress_corrosion, timings=bench_timing, batch_rows=batch,
+                      refused_settings=refused_settings)
