@@ -148,8 +148,14 @@ def main(argv=None) -> int:
             print(f"error: {e.filename}: cannot read ({e.strerror}); fix: give ucs_runs CSVs of this script",
                   file=sys.stderr)
             return 2
+        try:
+            table = k_series(rows)
+        except (KeyError, ValueError) as e:
+            print(f"error: {', '.join(map(str, a.folders))}: a row lacks or mangles column {e}; fix: give ucs_runs "
+                  "CSVs written by this script", file=sys.stderr)
+            return 2
         a.out.parent.mkdir(parents=True, exist_ok=True)
-        a.out.write_text(k_series(rows))
+        a.out.write_text(table)
         print(f"{len(rows)} rows -> {a.out}")
         return 0
     rows = sorted((r for r in map(elastic_row if a.elastic else row, a.folders) if r),

@@ -70,3 +70,13 @@ def test_the_studys_k_series_table_groups_by_specimen_and_interior():
     # within 5 % of 120 MPa: 900 h^1.5 <= 6, h <= (1/150)^(2/3), K >= 150^(2/3) = 28.2
     assert "| 5 x 10 | 1 | 4 (2) | 1 | 4: split (600.0 at 1.2 %, nu 3.40), 6: no peak (900.0 at the end), 8: 159.8, 12: 141.7 (-11.3 %)" in seed1 and "limit 120.0 MPa, order 1.50" in seed1 and "from K = 29" in seed1
     assert "12: 160.0 (-20.0 %)" in seed2 and "fewer than three results" in seed2
+
+
+def test_the_k_series_refuses_a_foreign_csv_in_one_line(tmp_path, capsys):
+    from studies.model_convergence import main
+    bad = tmp_path / "other.csv"
+    bad.write_text("run,ucs_mpa\nx,100\n")
+    assert main(["--k-series", str(bad), "--out", str(tmp_path / "k.md")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "other.csv" in err[0] and "fix:" in err[0]
+    assert not (tmp_path / "k.md").exists()
