@@ -36,6 +36,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import GrainfracError
+
 #: The softening choices of ``numerics.static_softening`` (the schema's), with none = the brittle bond.
 SOFTENING_NONE, SOFTENING_SAWTOOTH = "none", "sawtooth"
 
@@ -101,3 +103,11 @@ def engine_refusal(params, engine: str) -> str:
     return (f"numerics.static_softening = {params.numerics.static_softening!r}: the saw-tooth teeth are events of the "
             f"static engine's path, the {engine} engine has none; fix: --engine static, or numerics.static_softening "
             "= \"none\"")
+
+
+def refuse_on(params, engine: str) -> None:
+    """Raise :class:`~grainfrac_yade.errors.GrainfracError` with :func:`engine_refusal`'s line where ``params`` ask
+    ``engine`` for softening it has no model of (a scene built without the command line's check)."""
+    line = engine_refusal(params, engine)
+    if line:
+        raise GrainfracError(line)

@@ -13,8 +13,7 @@ Importing this module does not import YADE: the first stint does.
 from __future__ import annotations
 
 from .._interface import EngineModule
-from ...errors import GrainfracError
-from ...softening import engine_refusal
+from ...softening import engine_refusal, refuse_on
 from ..dynamic import dynamic_engine
 from ..static.engine import ENGINE as STATIC
 from ..static.scene import StaticScene
@@ -55,8 +54,7 @@ def refused_settings(params) -> str:
 def build_scene(specimen, params, layout=None) -> StaticScene:
     """The hybrid scene of ``specimen`` (rigid or fem cells): a static scene with the strategy of dynamic stints on
     :data:`DYNAMIC_ENGINE` (a setting it has no model of refused in one line first)."""
-    if refused_settings(params):
-        raise GrainfracError(refused_settings(params))
+    refuse_on(params, NAME)
     return StaticScene(specimen, params, layout, DynamicStints(lambda: dynamic_engine(DYNAMIC_ENGINE)))
 
 

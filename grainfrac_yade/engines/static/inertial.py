@@ -260,7 +260,7 @@ class InertialMotion(HeldRelaxing):
             fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)
             hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
             if hit.any() and teeth is not None:     # saw-tooth softening: the next tooth, the force dropping
-                soft = np.flatnonzero(hit)[teeth.tooth[hit] < len(teeth.stiffness) - 1]
+                soft = np.flatnonzero(hit)[teeth.softens(hit)]
                 if len(soft):
                     teeth.advance(soft, jt, jc)
                     fn[soft], fs[soft] = net.kn[soft] * dn[soft], net.ks[soft] * ds[soft]

@@ -36,9 +36,10 @@ class BondTeeth:
         #: test's degradation law, :class:`.engine.StaticCorrosion`) scales it alike
         self.strength_listeners = []
 
-    def softens(self, bond: int) -> bool:
-        """Whether ``bond`` takes another tooth (rather than breaking) when it meets its strength."""
-        return bool(self.tooth[bond] < len(self.stiffness) - 1)
+    def softens(self, bonds):
+        """Whether each of ``bonds`` (a canonical number or an array of them) takes another tooth (rather than
+        breaking) when it meets its strength."""
+        return self.tooth[bonds] < len(self.stiffness) - 1
 
     def advance(self, bonds, jt: np.ndarray, jc: np.ndarray) -> None:
         """Move ``bonds`` (canonical numbers, each on a tooth before its last) to their next tooth: k_n, k_s of the

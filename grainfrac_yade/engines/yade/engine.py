@@ -17,8 +17,7 @@ package.
 from __future__ import annotations
 
 from .._interface import EngineModule
-from ...errors import GrainfracError
-from ...softening import engine_refusal
+from ...softening import engine_refusal, refuse_on
 from . import batch, bench_timing, load_yade
 from .confinement import consolidate
 from .corrosion_engine import stress_corrosion
@@ -46,8 +45,7 @@ def refused_settings(params) -> str:
 
 def build_scene(specimen, params, layout=None):
     """:func:`.scene.build_scene`, a setting this engine has no model of refused in one line first."""
-    if refused_settings(params):
-        raise GrainfracError(refused_settings(params))
+    refuse_on(params, NAME)
     return _scene.build_scene(specimen, params, layout)
 
 
