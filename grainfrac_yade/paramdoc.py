@@ -16,7 +16,7 @@ from pathlib import Path
 
 from . import params as schema
 
-#: What each check name of the schema accepts (the rules of ``params.schema._check_value``).
+#: What each check name of the schema accepts (the rules of ``params.values._check_value``).
 CHECK_MEANING = {
     "positive": "> 0",
     "nonnegative": ">= 0",
