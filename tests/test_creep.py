@@ -136,3 +136,12 @@ def test_hold_budget_in_wave_crossings(small_ucs):
     assert run.hold_budget.max_relaxation_steps == math.ceil(400 * run.hold_budget.crossing_steps) > 30000
     assert run.hold_budget.servo_response_steps == max(200, math.ceil(0.5 * run.hold_budget.crossing_steps))
     assert not run.failed, run.failure_reason
+
+
+def test_with_a_bond_per_face_the_face_reading_is_the_node_reading_on_yade(creep_at_08, small_ucs):
+    """Rigid cells have one bond per face: the face's F / L is the bond's own stress to the bit (one run against
+    another on this machine, same arithmetic), so the face reading repeats every event of the default."""
+    face = _creep(0.8, small_ucs, ["stress_corrosion.reading=face"])
+    assert face.failed and face.n_events == creep_at_08.n_events
+    assert face.clock.creep_time == creep_at_08.clock.creep_time
+    assert np.array_equal(face.break_time, creep_at_08.break_time, equal_nan=True)

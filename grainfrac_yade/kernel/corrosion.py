@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..law import Stresses, build_law, check_finite, degrade_step
+from ..law.readings import build_reading
 
 #: Names of the law's state arrays in checkpoints (state_dict), with the value of an intact bond.
 STATE_KEYS = {"tensile_strength": "tensile_strength_pa", "cohesion": "cohesion_pa", "area_fraction": "area_fraction"}
@@ -28,6 +29,7 @@ class BondCorrosion:
         self.scene = scene
         self.p = sc_params
         self.law = build_law(sc_params)
+        self.reading = build_reading(sc_params.reading, layout)
         self.area0 = layout.bond_area.copy()
         self.tensile0 = props.tensile_strength.copy()
         self.cohesion0 = props.cohesion.copy()
@@ -40,14 +42,19 @@ class BondCorrosion:
         self.restored = np.zeros(layout.n_bonds, bool)
 
     def stresses(self, idx) -> Stresses:
-        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``, from the scene's bond forces.
+        """sigma (tension positive) and tau [Pa] per intact area A0 of bonds ``idx``, from the scene's bond forces,
+        and the stresses that drive their corrosion (the reading's, :mod:`grainfrac_yade.law.readings`).
 
         NumericalFailure if a force is NaN or infinite."""
         idx = np.asarray(idx, dtype=np.int64)
         fn, fs = self.scene.bond_forces(idx)
         check_finite("bond normal force", fn, idx)
         check_finite("bond shear force", fs, idx)
-        return Stresses(idx, fn / self.area0[idx], fs / self.area0[idx])
+        normal, shear = fn / self.area0[idx], fs / self.area0[idx]
+        rate_normal, rate_shear = self.reading.driving(idx, normal, shear, self.scene)
+        check_finite("driving normal stress", rate_normal, idx)
+        check_finite("driving shear stress", rate_shear, idx)
+        return Stresses(idx, normal, shear, rate_normal, rate_shear)
 
     def intact(self) -> np.ndarray:
         """The scene's intact bonds."""

@@ -24,19 +24,32 @@ class Stresses:
     """Stresses of the bonds ``index`` (numbers into the scene's bond list) at frozen forces.
 
     ``normal``: sigma = F_n / A0, tension positive [Pa]; ``shear``: tau = |F_s| / A0 >= 0 [Pa];
-    A0 is the bond's intact area (the area law divides by its remaining fraction itself).
+    A0 is the bond's intact area (the area law divides by its remaining fraction itself).  The failure
+    criteria (paper Eq. 4-5) read these.  ``rate_normal``, ``rate_shear``: the stresses that drive the rate of
+    paper Eq. 7 (:mod:`grainfrac_yade.law.readings`); the bonds' own (``normal``, ``shear``) unless given.
     """
     index: np.ndarray
     normal: np.ndarray
     shear: np.ndarray
+    rate_normal: np.ndarray = None
+    rate_shear: np.ndarray = None
+
+    def __post_init__(self):
+        if self.rate_normal is None:
+            object.__setattr__(self, "rate_normal", self.normal)
+        if self.rate_shear is None:
+            object.__setattr__(self, "rate_shear", self.shear)
 
     @classmethod
-    def of(cls, index, normal, shear) -> "Stresses":
-        return cls(np.asarray(index, dtype=np.int64), np.asarray(normal, float), np.asarray(shear, float))
+    def of(cls, index, normal, shear, rate_normal=None, rate_shear=None) -> "Stresses":
+        as_float = (lambda x: None if x is None else np.asarray(x, float))
+        return cls(np.asarray(index, dtype=np.int64), np.asarray(normal, float), np.asarray(shear, float),
+                   as_float(rate_normal), as_float(rate_shear))
 
     def take(self, positions) -> "Stresses":
         """The stresses at ``positions`` (into these arrays)."""
-        return Stresses(self.index[positions], self.normal[positions], self.shear[positions])
+        return Stresses(self.index[positions], self.normal[positions], self.shear[positions],
+                        self.rate_normal[positions], self.rate_shear[positions])
 
 
 @dataclass(frozen=True)

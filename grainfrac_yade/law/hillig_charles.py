@@ -4,7 +4,9 @@ activation threshold (Potyondy 2007).
     dJ^T/dt = -beta1 exp(beta2 sigma),   dJ^C/dt = -beta1 exp(beta2 tau),   J >= 0,
 
 sigma = F_n/A0 (tension positive), tau = |F_s|/A0, beta1 [Pa/s], beta2 [1/Pa] (paper section 4.1:
-1e-3 Pa/s and 1e-7 1/Pa).  Failure (paper Eq. 4-5): sigma >= J^T, or tau >= J^C + s_n tan(phi).
+1e-3 Pa/s and 1e-7 1/Pa).  Failure (paper Eq. 4-5): sigma >= J^T, or tau >= J^C + s_n tan(phi).  The
+stresses in the rate are the bond's own or its face's (``stress_corrosion.reading``, :mod:`.readings`); the
+criteria read the bond's own.
 Stiffness does not change, so under frozen stresses each rate is constant: the time to failure is a
 closed form (computed in log space, no overflow for any finite input) and the event clock jumps
 exactly from failure to failure.  beta1 is then an exact time scale: every time is proportional to
@@ -59,26 +61,32 @@ def degrade(tensile_strength, cohesion, normal_stress, shear_stress, dt, beta1, 
     return np.maximum(jt, 0.0), np.maximum(jc, 0.0)
 
 
-def channel_times(tensile_strength, cohesion, normal_stress, shear_stress, tan_friction, beta1, beta2):
+def channel_times(tensile_strength, cohesion, normal_stress, shear_stress, tan_friction, beta1, beta2,
+                  rate_normal=None, rate_shear=None):
     """Closed-form creep times to tensile and to shear failure under frozen stresses (paper Eq. 5, 7).
 
-    Tension: t_T = (J^T - sigma) / (beta1 exp(beta2 sigma)); 0 if sigma >= J^T; inf ('never') if
+    Tension: t_T = (J^T - sigma) / (beta1 exp(beta2 sigma_r)); 0 if sigma >= J^T; inf ('never') if
     sigma < 0, because J^T cannot fall below 0.  Shear: the cohesion must fall to J^C* = tau - s_n
-    tan(phi), so t_S = (J^C - J^C*) / (beta1 exp(beta2 tau)); 0 if already failed; inf ('never') if
-    J^C* < 0 (friction alone carries tau).  Finite times are in [0, TIME_CAP] (log space, clipped).
+    tan(phi), so t_S = (J^C - J^C*) / (beta1 exp(beta2 tau_r)); 0 if already failed; inf ('never') if
+    J^C* < 0 (friction alone carries tau).  sigma_r, tau_r: the stresses that drive the rate
+    (``rate_normal``, ``rate_shear``; :mod:`.readings`), sigma and tau unless given.  Finite times are in
+    [0, TIME_CAP] (log space, clipped).
     """
     b1, b2 = check_rate_constants(beta1, beta2)
     jt, jc, sigma, tau, tphi = np.broadcast_arrays(*finite(
         tensile_strength=tensile_strength, cohesion=cohesion, normal_stress=normal_stress,
         shear_stress=shear_stress, tan_friction=tan_friction))
     check_shear(tau)
+    sigma_r = sigma if rate_normal is None else np.broadcast_to(finite(rate_normal=rate_normal)[0], sigma.shape)
+    tau_r = tau if rate_shear is None else np.broadcast_to(finite(rate_shear=rate_shear)[0], tau.shape)
+    check_shear(tau_r, "rate_shear")
     with np.errstate(over="ignore"):  # inf only where sigma < 0 ('never' anyway)
         gap_t = jt - sigma
         gap_s = shear_strength(jc, sigma, tphi) - tau  # cohesion still to lose; +inf: never
     t_t = np.where(gap_t <= 0, 0.0, np.where(
-        sigma >= 0, quotient(gap_t, log_rate(sigma, b1, b2)), np.inf))
+        sigma >= 0, quotient(gap_t, log_rate(sigma_r, b1, b2)), np.inf))
     t_s = np.where(gap_s <= 0, 0.0, np.where(
-        gap_s > jc, np.inf, quotient(gap_s, log_rate(tau, b1, b2))))
+        gap_s > jc, np.inf, quotient(gap_s, log_rate(tau_r, b1, b2))))
     return t_t, t_s
 
 
@@ -180,7 +188,7 @@ class StrengthLaw(DegradationLaw):
 
     def active(self, state, stresses):
         """(tension, shear) channels that corrode now (all, without a threshold)."""
-        return active_channels(state["tensile_strength"], state["cohesion"], stresses.normal, stresses.shear,
+        return active_channels(state["tensile_strength"], state["cohesion"], stresses.rate_normal, stresses.rate_shear,
                                state.tan_friction, self.threshold_ratio, self.threshold_stress)
 
     def channel_times(self, state, stresses):
@@ -214,8 +222,8 @@ class HilligCharles(StrengthLaw):
                 + self._threshold_text())
 
     def rate(self, state, stresses):
-        r_t = degradation_rate(stresses.normal, self.beta1, self.beta2)
-        r_s = degradation_rate(stresses.shear, self.beta1, self.beta2)
+        r_t = degradation_rate(stresses.rate_normal, self.beta1, self.beta2)
+        r_s = degradation_rate(stresses.rate_shear, self.beta1, self.beta2)
         if self.has_threshold:
             ten, sh = self.active(state, stresses)
             r_t, r_s = np.where(ten, r_t, 0.0), np.where(sh, r_s, 0.0)
@@ -223,13 +231,13 @@ class HilligCharles(StrengthLaw):
 
     def degrade(self, state, stresses, dt):
         active = self.active(state, stresses) if self.has_threshold else None
-        jt, jc = degrade(state["tensile_strength"], state["cohesion"], stresses.normal, stresses.shear, dt,
+        jt, jc = degrade(state["tensile_strength"], state["cohesion"], stresses.rate_normal, stresses.rate_shear, dt,
                          self.beta1, self.beta2, active)
         return {"tensile_strength": jt, "cohesion": jc}
 
     def channel_times(self, state, stresses):
         return channel_times(state["tensile_strength"], state["cohesion"], stresses.normal, stresses.shear,
-                             state.tan_friction, self.beta1, self.beta2)
+                             state.tan_friction, self.beta1, self.beta2, stresses.rate_normal, stresses.rate_shear)
 
 
 #: The law this module builds (its class attributes, e.g. ``time_scales_with_beta1``, are the law's own).

@@ -17,6 +17,7 @@ from typing import Mapping
 from ..arrhenius import betas_from_physical
 from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
+from ..law.readings import FACE_READING_LAWS
 from .cells import cell_count
 from .fem_only import check_fem_only
 from .files import read_toml
@@ -417,7 +418,13 @@ def require_plane(params: Parameters, command: str):
 
 
 def _check_law(sc: StressCorrosionParams, origins: Mapping):
-    """The activation threshold belongs to the strength laws: the area law has none."""
+    """The activation threshold belongs to the strength laws: the area law has none.  A reading other than the
+    bond's own needs a law that keeps the driving stress apart from the one its criteria read."""
+    if sc.reading != "node" and sc.law not in FACE_READING_LAWS:
+        raise ParameterError(origins.get("stress_corrosion.reading", "parameters"), "stress_corrosion.reading",
+                             f"{sc.reading!r} with law = {sc.law!r} (that law fails a bond where its driving stress "
+                             "meets its strength: one stress for both)",
+                             f"set stress_corrosion.reading = \"node\", or law = {' or '.join(FACE_READING_LAWS)}")
     if sc.law == "area":
         for key in ("threshold_ratio", "threshold_stress"):
             if getattr(sc, key) > 0:

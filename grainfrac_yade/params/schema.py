@@ -14,6 +14,7 @@ from typing import Mapping
 
 from ..errors import ParameterError
 from ..law import LAW_NAMES
+from ..law.readings import READING_NAMES
 from .values import NEAREST_KEY_CUTOFF, RETIRED_VALUES, _check_value, nearest_key
 
 PARAMS_DIR = Path(__file__).resolve().parents[2] / "params"
@@ -186,6 +187,9 @@ class StressCorrosionParams:
     law: str = _spec("", "choice", "degradation law: hillig_charles = paper Eq. 7 on strength; normalised = "
                      "exponent on stress/strength (Potyondy 2007); area = corrosion shrinks the bond area",
                      LAW_NAMES)
+    reading: str = _spec("", "choice", "the stress that drives Eq. 7's rate: node = each bond's own F/A (UDEC's "
+                         "sub-contacts); face = the face's F/L over its whole area (failure stays per bond)",
+                         READING_NAMES)
     beta1: float = _spec("Pa/s", "positive", "rate constant beta1 (paper Eq. 7)")
     beta2: float = _spec("1/Pa", "positive", "stress sensitivity beta2 (paper Eq. 7; laws hillig_charles, area)")
     beta2_normalised: float = _spec("1", "positive", "stress sensitivity on stress/strength (law normalised)")

@@ -281,7 +281,8 @@ class GrainScene(GrainSceneState):
         """Normal force (tension positive) and shear force magnitude [N] of bonds.
 
         Reads the law's normal force (along the line of centres, or along the face normal for
-        bonds on their face's plane) and ``|shearForce|``; about 2-3 us per bond.
+        bonds on their face's plane) and ``|shearForce|``; about 2-3 us per bond.  A broken bond whose
+        contact YADE has erased (its cells apart) carries none: 0, 0.
         """
         idx = np.arange(self.n_bonds) if indices is None else np.asarray(indices)
         fn = np.empty(len(idx))
@@ -290,6 +291,9 @@ class GrainScene(GrainSceneState):
         on_face = self.model.bonds_on_faces
         for n, k in enumerate(idx):
             i = inter[k]
+            if not i.isReal:
+                fn[n] = fs[n] = 0.0
+                continue
             phys = i.phys
             fn[n] = -phys.normalForce.dot(phys.jointNormal if on_face else i.geom.normal)
             fs[n] = phys.shearForce.norm()
