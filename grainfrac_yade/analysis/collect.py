@@ -22,7 +22,7 @@ PARAM_COLUMNS = ("resolution.spheres_per_cell", "resolution.grain_model", "resol
                  "calibration.strength_scale", "calibration.stiffness_scale", "calibration.shear_stiffness_ratio_scale",
                  "calibration.tensile_cohesion_ratio_scale", "calibration.inter_mineral_strength_ratio",
                  "calibration.strength_weibull_modulus", "stress_corrosion.clock",
-                 "stress_corrosion.law", "stress_corrosion.beta1", "stress_corrosion.beta2",
+                 "stress_corrosion.law", "stress_corrosion.reading", "stress_corrosion.beta1", "stress_corrosion.beta2",
                  "stress_corrosion.beta2_normalised", "stress_corrosion.threshold_ratio",
                  "stress_corrosion.threshold_stress", "confinement.stress", "ucs.strain_rate", "creep.ramp_strain_rate",
                  "numerics.density_scale", "specimen.min_edge_fraction", "numerics.keep_intact_joints")

@@ -34,7 +34,8 @@ RUN_TABLE = ("run", "folder", "command", "engine", "seed", "variant", "status", 
              "broken_ramp", "broken_creep", "broken_total", "macrocracks", "n_bonds", "primary_end_s",
              "tertiary_start_s", "steps", "steps_counted", "wall_s", "cpu_s", "specimen.width", "specimen.height", "specimen.grain_size",
              "resolution.grain_model", "resolution.nodes_per_face", "calibration.strength_scale", "calibration.stiffness_scale",
-             "stress_corrosion.beta1", "stress_corrosion.beta2", "specimen.min_edge_fraction", "creep.ramp_strain_rate",
+             "stress_corrosion.reading", "stress_corrosion.beta1", "stress_corrosion.beta2",
+             "specimen.min_edge_fraction", "creep.ramp_strain_rate",
              "numerics.density_scale", "study", "beta1_run", "time_factor", "code_version", "problem")
 
 

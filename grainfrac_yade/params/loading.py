@@ -52,7 +52,8 @@ ADDED_KEYS = {"numerics.engine": "yade", "specimen.min_edge_fraction": 0.0, "num
               "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
               "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0,
               "resolution.cell_rings": 1, "resolution.cell_ring_growth": 1.0, "numerics.static_condensation": "none",
-              "numerics.static_softening": "none", "numerics.static_softening_teeth": 1, "numerics.static_softening_ductility": 1.0}
+              "numerics.static_softening": "none", "numerics.static_softening_teeth": 1, "numerics.static_softening_ductility": 1.0,
+              "stress_corrosion.reading": "node"}
 
 
 def migrate_tree(tree: dict) -> list:
