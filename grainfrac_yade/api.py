@@ -18,7 +18,7 @@ What is here, by layer:
   :func:`scene_density`; the engines: :func:`engine`, :func:`engine_for`;
 * static solves without a protocol: :func:`elastic_summary`;
 * analysis: :func:`ucs_summary`, :func:`crack_initiation_volumetric_stress`, :func:`split_peak_index`, the lab
-  fit module :mod:`lab_fit`, the discretisation study's :func:`paired_changes` and :func:`extrapolate`;
+  fit module :mod:`lab_fit`, the discretisation study's :func:`paired_changes`, :func:`log_changes` and :func:`extrapolate`;
 * runs and commands: :func:`prepare_run_dir`, :func:`summary_header`, :func:`write_json`, :func:`code_version`,
   :func:`tensile_scale_overrides` (the Brazilian command's ``--tensile-scale``), :func:`static_hold` (``bench
   --static``'s timed creep test on the static engine);
@@ -49,6 +49,7 @@ EXPORTS = {
     "split_peak_index": "grainfrac_yade.analysis.brazilian_analysis",
     "lab_fit": "grainfrac_yade.analysis.lab_fit",
     "paired_changes": "grainfrac_yade.analysis.mesh_convergence",
+    "log_changes": "grainfrac_yade.analysis.mesh_convergence",
     "extrapolate": "grainfrac_yade.analysis.mesh_convergence",
     "prepare_run_dir": "grainfrac_yade.runs.runio", "summary_header": "grainfrac_yade.runs.runio",
     "write_json": "grainfrac_yade.runs.runio", "code_version": "grainfrac_yade.runs.runio",

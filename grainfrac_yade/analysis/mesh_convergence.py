@@ -49,6 +49,15 @@ def paired_changes(values) -> np.ndarray:
     return out
 
 
+def log_changes(values) -> np.ndarray:
+    """Change of each result's logarithm from the previous (coarser) one: ln(U_i / U_(i-1)); NaN for the first.
+    For results that span decades (lifetimes), the study's criterion reads its magnitude |d ln U|."""
+    u = np.asarray(values, dtype=float)
+    out = np.full(u.shape, np.nan)
+    out[1:] = np.log(u[1:] / u[:-1])
+    return out
+
+
 def _ratio(p: float, h1: float, h2: float, h3: float) -> float:
     return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p)
 
