@@ -1,5 +1,5 @@
 """The creep rows of the model convergence study (docs/studies/model_convergence.md): one CSV line per finished creep
-run folder (the discretisation, the reading of the driving stress, the held stress, the lifetime, the events, the
+run folder (the discretisation, the degradation law and the reading of the driving stress, the held stress, the lifetime, the events, the
 cost), and from such CSVs the lifetime against bonds per face K as a markdown table, units in the column names.
 
     /usr/bin/python3 -m studies.model_convergence_lifetimes results/model_convergence_creep/* --out docs/studies/model_convergence/lifetime_runs.csv
@@ -15,7 +15,7 @@ cost), and from such CSVs the lifetime against bonds per face K as a markdown ta
   :data:`HELD_STRESS_DIGITS` decimals of a MPa) at two or more K.
 
 Rows that repeat one discretisation and load (the cells' interiors condensed out or not: the same lifetime to
-round-off) show the last of the CSV's order (reading, held stress, K, run name).
+round-off) show the last of the CSV's order (law, reading, held stress, K, run name).
 
 A pure reader of run folders (summary.json); no YADE.
 """
@@ -50,7 +50,7 @@ def row(folder: Path) -> dict | None:
             "height_mm": 1e3 * p["specimen"]["height"], "bonds_per_face_1": res["nodes_per_face"],
             "cell_rings_1": res.get("cell_rings", ADDED_KEYS["resolution.cell_rings"]),
             "cell_ring_growth_1": res.get("cell_ring_growth", ADDED_KEYS["resolution.cell_ring_growth"]),
-            "reading": sc.get("reading", ADDED_KEYS["stress_corrosion.reading"]),
+            "law": sc["law"], "reading": sc.get("reading", ADDED_KEYS["stress_corrosion.reading"]),
             "driving_stress_ratio_1": s["driving_stress_ratio"], "given_ucs_mpa": round(1e-6 * s["ucs_pa"], 6),
             "held_mpa": round(1e-6 * s["stress_pa"], 6), "failed": s["failed"],
             "lifetime_s": s["lifetime_s"] if s["failed"] else None, "creep_time_end_s": s["creep_time_end_s"],
@@ -93,18 +93,18 @@ def series(rows, ucs_rows) -> str:
         value = (float(r["lifetime_s"]), int(r["n_events_1"]))
         ucs, given = own.get((*spec, k)), float(r["given_ucs_mpa"])
         if ucs is not None and abs(given / ucs - 1.0) <= OWN_UCS_TOLERANCE:
-            at_ratio.setdefault((*spec, r["reading"], float(r["driving_stress_ratio_1"])), {})[k] = value
+            at_ratio.setdefault((*spec, r["law"], r["reading"], float(r["driving_stress_ratio_1"])), {})[k] = value
         held = round(float(r["held_mpa"]), HELD_STRESS_DIGITS)
-        at_stress.setdefault((*spec, r["reading"], held), {})[k] = value
-    head = ("| specimen [mm], seed, rings (grading), reading, {} | K: lifetime (events) [d ln t_f from the coarser K] "
+        at_stress.setdefault((*spec, r["law"], r["reading"], held), {})[k] = value
+    head = ("| specimen [mm], seed, rings (grading), law, reading, {} | K: lifetime (events) [d ln t_f from the coarser K] "
             f"| finest change against {CONVERGED_LOG_CHANGE:g} |\n|---|---|---|")
     out = ["At a ratio r of each discretisation's own UCS:", "", head.format("r")]
-    for (w, h, seed, rings, growth, reading, ratio), by_k in sorted(at_ratio.items()):
-        out.append(_line(f"{w:g} x {h:g}, {seed}, {rings} ({growth:g}), {reading}, {ratio:g}", by_k))
+    for (w, h, seed, rings, growth, law, reading, ratio), by_k in sorted(at_ratio.items()):
+        out.append(_line(f"{w:g} x {h:g}, {seed}, {rings} ({growth:g}), {law}, {reading}, {ratio:g}", by_k))
     out += ["", "At one held stress:", "", head.format("held [MPa]")]
-    for (w, h, seed, rings, growth, reading, held), by_k in sorted(at_stress.items()):
+    for (w, h, seed, rings, growth, law, reading, held), by_k in sorted(at_stress.items()):
         if len(by_k) > 1:
-            out.append(_line(f"{w:g} x {h:g}, {seed}, {rings} ({growth:g}), {reading}, {held:.2f}", by_k))
+            out.append(_line(f"{w:g} x {h:g}, {seed}, {rings} ({growth:g}), {law}, {reading}, {held:.2f}", by_k))
     return "\n".join(out) + "\n"
 
 
@@ -138,7 +138,7 @@ def main(argv=None) -> int:
         print(f"{len(rows)} rows -> {a.out}")
         return 0
     rows = sorted((r for r in map(row, a.folders) if r),
-                  key=lambda r: (r["reading"], r["held_mpa"], r["bonds_per_face_1"], r["run"]))
+                  key=lambda r: (r["law"], r["reading"], r["held_mpa"], r["bonds_per_face_1"], r["run"]))
     if not rows:
         print("error: no finished creep run among the folders; fix: give creep run folders that hold a summary.json",
               file=sys.stderr)

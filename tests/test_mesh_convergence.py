@@ -91,9 +91,9 @@ def test_log_changes_are_the_logarithms_of_the_ratios():
 def test_the_lifetime_series_lays_rows_out_at_a_ratio_of_the_own_ucs_and_at_one_stress():
     from studies.model_convergence_lifetimes import series
 
-    def r(k, reading, ucs, lifetime, ratio=0.8, events=10, failed="True"):
+    def r(k, reading, ucs, lifetime, ratio=0.8, events=10, failed="True", law="hillig_charles"):
         return {"width_mm": "10.0", "height_mm": "20.0", "seed": "1", "cell_rings_1": "4", "cell_ring_growth_1": "2.0",
-                "bonds_per_face_1": str(k), "reading": reading, "driving_stress_ratio_1": str(ratio),
+                "bonds_per_face_1": str(k), "law": law, "reading": reading, "driving_stress_ratio_1": str(ratio),
                 "given_ucs_mpa": str(ucs), "held_mpa": str(ratio * ucs), "failed": failed,
                 "lifetime_s": "" if failed != "True" else str(lifetime), "n_events_1": str(events)}
     own = [{"width_mm": "10.0", "height_mm": "20.0", "seed": "1", "cell_rings_1": "4", "cell_ring_growth_1": "2.0",
@@ -101,13 +101,15 @@ def test_the_lifetime_series_lays_rows_out_at_a_ratio_of_the_own_ucs_and_at_one_
     rows = [r(8, "node", 200.0, 1e5), r(12, "node", 160.0, 1e6), r(16, "node", 150.0, 1.5e6),
             r(8, "face", 150.0, 4e5), r(12, "face", 150.0, 6e5),          # one stress (120 MPa), not own ratios
             r(16, "face", 150.0, 8e5),                                    # K = 16's own ratio and 120 MPa alike
-            r(12, "face", 160.0, 1e9, failed="False")]                    # unfailed: not a point
+            r(12, "face", 160.0, 1e9, failed="False"),                    # unfailed: not a point
+            r(8, "node", 200.0, 3e3, law="normalised")]                  # another law: a series of its own
     text = series(rows, own)
     ratio_part, stress_part = text.split("At one held stress:")
-    node = [line for line in ratio_part.splitlines() if ", node, 0.8 |" in line]
+    node = [line for line in ratio_part.splitlines() if ", hillig_charles, node, 0.8 |" in line]
     assert len(node) == 1 and "[+2.30]" in node[0] and "16: 1.5e+06 s (10 events) [+0.41] | within 0.5 |" in node[0]
     face_ratio = [line for line in ratio_part.splitlines() if ", face, 0.8 |" in line]
     assert len(face_ratio) == 1 and "16: 8e+05 s" in face_ratio[0] and "| one K |" in face_ratio[0]
     face_stress = [line for line in stress_part.splitlines() if ", face, 120.00 |" in line]
     assert len(face_stress) == 1 and "8: 4e+05 s" in face_stress[0] and "[+0.29] | within 0.5 |" in face_stress[0]
     assert not any(", node, " in line for line in stress_part.splitlines())   # node rows: one K per held stress
+    assert "| 10 x 20, 1, 4 (2), normalised, node, 0.8 | 8: 3000 s (10 events) | one K |" in ratio_part
