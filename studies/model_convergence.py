@@ -133,6 +133,40 @@ def k_series(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def read_csvs(paths, what: str) -> list[dict] | None:
+    """The rows of the CSVs ``paths``; None, after one line naming the file and ``what`` to give, if one is unreadable."""
+    try:
+        return [r for path in paths for r in csv.DictReader(open(path, newline=""))]
+    except OSError as e:
+        print(f"error: {e.filename}: cannot read ({e.strerror}); fix: give {what}", file=sys.stderr)
+        return None
+
+
+def write_markdown(make, n_rows: int, out: Path, sources, what: str) -> int:
+    """Write the markdown ``make()`` returns at ``out`` (exit status 0), or say in one line that the CSVs
+    ``sources`` lack or mangle a column and name ``what`` to give (2; nothing written)."""
+    try:
+        text = make()
+    except (KeyError, ValueError) as e:
+        print(f"error: {', '.join(map(str, sources))}: a row lacks or mangles column {e}; fix: give {what}",
+              file=sys.stderr)
+        return 2
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    print(f"{n_rows} rows -> {out}")
+    return 0
+
+
+def write_rows(rows: list[dict], out: Path) -> None:
+    """``rows`` (dicts with the same keys) as a CSV at ``out``, its folder made; says how many."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with open(out, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"{len(rows)} rows -> {out}")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folders", nargs="+", type=Path)
@@ -142,33 +176,15 @@ def main(argv=None) -> int:
                     "write the UCS against K as a markdown table")
     a = ap.parse_args(argv)
     if a.k_series:
-        try:
-            rows = [r for path in a.folders for r in csv.DictReader(open(path, newline=""))]
-        except OSError as e:
-            print(f"error: {e.filename}: cannot read ({e.strerror}); fix: give ucs_runs CSVs of this script",
-                  file=sys.stderr)
-            return 2
-        try:
-            table = k_series(rows)
-        except (KeyError, ValueError) as e:
-            print(f"error: {', '.join(map(str, a.folders))}: a row lacks or mangles column {e}; fix: give ucs_runs "
-                  "CSVs written by this script", file=sys.stderr)
-            return 2
-        a.out.parent.mkdir(parents=True, exist_ok=True)
-        a.out.write_text(table)
-        print(f"{len(rows)} rows -> {a.out}")
-        return 0
+        rows = read_csvs(a.folders, "ucs_runs CSVs of this script")
+        return 2 if rows is None else write_markdown(lambda: k_series(rows), len(rows), a.out, a.folders,
+                                                     "ucs_runs CSVs written by this script")
     rows = sorted((r for r in map(elastic_row if a.elastic else row, a.folders) if r),
                   key=lambda r: (r["cell_ring_growth_1"], r["cell_rings_1"], r["bonds_per_face_1"], r["run"]))
     if not rows:
         print("error: no finished run among the folders; fix: give run folders that hold a summary.json", file=sys.stderr)
         return 2
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(a.out, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"{len(rows)} rows -> {a.out}")
+    write_rows(rows, a.out)
     return 0
 
 

@@ -20,12 +20,12 @@ round-off) show the last of the CSV's order (law, reading, held stress, K, run n
 A pure reader of run folders (summary.json); no YADE.
 """
 import argparse
-import csv
 import json
 import sys
 from pathlib import Path
 
 from grainfrac_yade.api import ADDED_KEYS, log_changes
+from studies.model_convergence import read_csvs, write_markdown, write_rows
 
 #: The study's criterion on the lifetime: |d ln t_f| between the two finest discretisations below this [1].
 CONVERGED_LOG_CHANGE = 0.5
@@ -108,13 +108,6 @@ def series(rows, ucs_rows) -> str:
     return "\n".join(out) + "\n"
 
 
-def _read_csvs(paths, what):
-    try:
-        return [r for path in paths for r in csv.DictReader(open(path, newline=""))]
-    except OSError as e:
-        raise SystemExit(f"error: {e.filename}: cannot read ({e.strerror}); fix: give {what}")
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folders", nargs="+", type=Path, help="creep run folders (or, with --series, CSVs of this script)")
@@ -125,30 +118,19 @@ def main(argv=None) -> int:
                     "studies.model_convergence (the own UCS of each discretisation)")
     a = ap.parse_args(argv)
     if a.series:
-        rows = _read_csvs(a.folders, "lifetime CSVs of this script")
-        ucs_rows = _read_csvs(a.ucs, "ucs_runs CSVs of studies.model_convergence")
-        try:
-            table = series(rows, ucs_rows)
-        except (KeyError, ValueError) as e:
-            print(f"error: {', '.join(map(str, a.folders + a.ucs))}: a row lacks or mangles column {e}; fix: give "
-                  "the CSVs these scripts write", file=sys.stderr)
+        rows = read_csvs(a.folders, "lifetime CSVs of this script")
+        ucs_rows = read_csvs(a.ucs, "ucs_runs CSVs of studies.model_convergence")
+        if rows is None or ucs_rows is None:
             return 2
-        a.out.parent.mkdir(parents=True, exist_ok=True)
-        a.out.write_text(table)
-        print(f"{len(rows)} rows -> {a.out}")
-        return 0
+        return write_markdown(lambda: series(rows, ucs_rows), len(rows), a.out, a.folders + a.ucs,
+                              "the CSVs of this script and of studies.model_convergence")
     rows = sorted((r for r in map(row, a.folders) if r),
                   key=lambda r: (r["law"], r["reading"], r["held_mpa"], r["bonds_per_face_1"], r["run"]))
     if not rows:
         print("error: no finished creep run among the folders; fix: give creep run folders that hold a summary.json",
               file=sys.stderr)
         return 2
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(a.out, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"{len(rows)} rows -> {a.out}")
+    write_rows(rows, a.out)
     return 0
 
 
