@@ -113,3 +113,16 @@ def test_the_lifetime_series_lays_rows_out_at_a_ratio_of_the_own_ucs_and_at_one_
     assert len(face_stress) == 1 and "8: 4e+05 s" in face_stress[0] and "[+0.29] | within 0.5 |" in face_stress[0]
     assert not any(", node, " in line for line in stress_part.splitlines())   # node rows: one K per held stress
     assert "| 10 x 20, 1, 4 (2), normalised, node, 0.8 | 8: 3000 s (10 events) | one K |" in ratio_part
+
+
+def test_the_lifetime_series_refuses_a_foreign_csv_in_one_line(tmp_path, capsys):
+    from studies.model_convergence_lifetimes import main
+    bad = tmp_path / "other.csv"
+    bad.write_text("run,ucs_mpa\nx,100\n")
+    assert main(["--series", str(bad), "--ucs", str(bad), "--out", str(tmp_path / "t.md")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "other.csv" in err[0] and "fix:" in err[0]
+    assert main(["--series", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "t.md")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "missing.csv: cannot read" in err[0]
+    assert not (tmp_path / "t.md").exists()
