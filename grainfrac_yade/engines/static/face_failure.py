@@ -77,6 +77,10 @@ class FaceFailure(BondFailure):
         self.of_bond[self.order] = np.repeat(np.arange(len(self.starts)), self.counts)
         #: one bond of each face (the face's first in canonical order)
         self.first = self.order[self.starts]
+        self._face_index = np.repeat(np.arange(len(self.starts)), self.counts)
+        #: (broken mask, members) and (J^T, J^C, members, face strengths) of the last call: a relaxation's steps
+        #: call with the same ones many times
+        self._members_cache, self._strength_cache = None, None
         tphi = net.tan_friction
         if np.any(tphi != tphi[self.first][self.of_bond]):
             raise GrainfracError("numerics.static_failure = \"face\": the bonds of a face have different friction "
@@ -85,38 +89,56 @@ class FaceFailure(BondFailure):
 
     # ------------------------------------------------------------------ face resultants
     def _members(self, broken):
-        """(sorted mask, single) of the bonds each face's resultant sums: its intact ones (all of them where none
-        is intact), in face order; ``single``: faces with one such bond (evaluated on its own numbers)."""
-        intact = ~np.asarray(broken, bool)[self.order]
+        """(sorted mask, single, one, area) of the bonds each face's resultant sums: its intact ones (all of them
+        where none is intact), in face order; ``single``: faces with one such bond (evaluated on its own numbers),
+        ``one``: where a single face's bond lies in face order; ``area``: each face's summed area."""
+        broken = np.asarray(broken, bool)
+        cached = self._members_cache
+        if cached is not None and np.array_equal(cached[0], broken):
+            return cached[1]
+        intact = ~broken[self.order]
         n_intact = np.add.reduceat(intact.astype(np.int64), self.starts)
-        use = intact | (n_intact == 0)[np.repeat(np.arange(len(self.starts)), self.counts)]
+        use = intact | (n_intact == 0)[self._face_index]
         n_use = np.add.reduceat(use.astype(np.int64), self.starts)
-        return use, n_use == 1
+        one = np.maximum.reduceat(np.where(use, np.arange(len(use)), -1), self.starts)
+        members = (use, n_use == 1, one)
+        members += (self._sum(self.net.area, members),)
+        self._members_cache = (broken.copy(), members)
+        return members
 
     def _sum(self, x, members):
         """Per face, the sum of ``x`` over its member bonds (one member: its value, exactly)."""
-        use, single = members
+        use, single, one = members[:3]
         xs = np.asarray(x, float)[self.order]
         total = np.add.reduceat(np.where(use, xs, 0.0), self.starts)
-        one = np.maximum.reduceat(np.where(use, np.arange(len(xs)), -1), self.starts)
         return np.where(single, xs[one], total)
+
+    def _strengths(self, jt, jc, members):
+        """Per face (J^T, J^C) of :meth:`_strength` (kept while the strengths and members stay)."""
+        cached = self._strength_cache
+        if (cached is not None and cached[2] is members and np.array_equal(cached[0], jt)
+                and np.array_equal(cached[1], jc)):
+            return cached[3]
+        out = (self._strength(jt, members), self._strength(jc, members))
+        self._strength_cache = (np.array(jt, float), np.array(jc, float), members, out)
+        return out
 
     def _strength(self, j, members):
         """Per face, its member bonds' common strength, or their area-weighted mean where they differ."""
-        use, _ = members
+        use = members[0]
         js = np.asarray(j, float)[self.order]
         lo = np.minimum.reduceat(np.where(use, js, np.inf), self.starts)
         hi = np.maximum.reduceat(np.where(use, js, -np.inf), self.starts)
         if np.array_equal(lo, hi):
             return lo
-        mean = self._sum(j * self.net.area, members) / self._sum(self.net.area, members)
+        mean = self._sum(j * self.net.area, members) / members[3]
         return np.where(lo == hi, lo, mean)
 
     def resultants(self, fn, fs, jt, jc, broken):
         """Per face (F_n, F_s signed, A, J^T, J^C, tan(phi)) of its intact bonds."""
         m = self._members(broken)
-        return (self._sum(fn, m), self._sum(fs, m), self._sum(self.net.area, m), self._strength(jt, m),
-                self._strength(jc, m), self.net.tan_friction[self.first])
+        return (self._sum(fn, m), self._sum(fs, m), m[3], *self._strengths(jt, jc, m),
+                self.net.tan_friction[self.first])
 
     def overstress(self, fn, fs, jt, jc, broken):
         r, mode = cl.overstress(*self.resultants(fn, fs, jt, jc, broken))
@@ -137,8 +159,7 @@ class FaceFailure(BondFailure):
     def stresses(self, fn, fs, broken):
         """(sigma, tau) [Pa] per bond: its face's resultant stresses (what the criterion reads)."""
         m = self._members(broken)
-        area = self._sum(self.net.area, m)
-        return (self._sum(fn, m) / area)[self.of_bond], (np.abs(self._sum(fs, m)) / area)[self.of_bond]
+        return (self._sum(fn, m) / m[3])[self.of_bond], (np.abs(self._sum(fs, m)) / m[3])[self.of_bond]
 
     def group(self, bond: int, broken) -> np.ndarray:
         """The intact bonds of ``bond``'s face (with ``bond``), in canonical order: they break together."""
