@@ -228,3 +228,4 @@ def test_face_failure_creep_without_the_face_reading_refused_in_one_line(capsys,
     rc, out = _cli(capsys, "creep", "--engine", "static", "--width", "3e-3", "--height", "6e-3", "--stress", "100",
                    "--set", "numerics.static_failure=face", "--out", str(tmp_path / "x"))
     assert rc == 2 and out.err.count("\n") == 1 and "stress_corrosion.reading" in out.err and "fix:" in out.err
+    assert not (tmp_path / "x").exists()
