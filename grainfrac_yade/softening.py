@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import GrainfracError
 
 #: The softening choices of ``numerics.static_softening`` (the schema's), with none = the brittle bond.
 SOFTENING_NONE, SOFTENING_SAWTOOTH = "none", "sawtooth"
@@ -104,10 +103,3 @@ def engine_refusal(params, engine: str) -> str:
             f"static engine's path, the {engine} engine has none; fix: --engine static, or numerics.static_softening "
             "= \"none\"")
 
-
-def refuse_on(params, engine: str) -> None:
-    """Raise :class:`~grainfrac_yade.errors.GrainfracError` with :func:`engine_refusal`'s line where ``params`` ask
-    ``engine`` for softening it has no model of (a scene built without the command line's check)."""
-    line = engine_refusal(params, engine)
-    if line:
-        raise GrainfracError(line)

@@ -13,16 +13,18 @@ PHI, PHI_R = np.radians(40.0), np.radians(25.0)
 
 
 def network(pos, springs, normals, *, top, bottom, left=(), right=(), area=1e-6, kn=KN, ks=KS, jt=JT, jc=JC,
-            phi=PHI, phi_r=PHI_R, width=1e-3, height=1e-3, thickness=1e-3):
+            phi=PHI, phi_r=PHI_R, width=1e-3, height=1e-3, thickness=1e-3, face=None):
     """Translating nodes at ``pos`` joined by springs (pairs) with the given unit normals; every spring a bond of
-    ``area`` [m^2]; per-spring arrays or scalars for stiffness and strengths."""
+    ``area`` [m^2]; per-spring arrays or scalars for stiffness and strengths; ``face``: each spring's face (default:
+    a face of its own)."""
     pos = np.asarray(pos, float)
     springs = np.asarray(springs, np.int64)
     m, n = len(springs), len(pos)
     full = lambda v: np.broadcast_to(np.asarray(v, float), (m,)).copy()  # noqa: E731
     net = Network(node_pos=pos, node_rotates=np.zeros(n, bool), node_cell=np.arange(n), spring_nodes=springs,
                   spring_normal=np.asarray(normals, float), spring_arm=np.zeros((m, 2, 2)), spring_kn=full(kn),
-                  spring_ks=full(ks), spring_area=full(area), spring_face=np.arange(m),
+                  spring_ks=full(ks), spring_area=full(area),
+                  spring_face=np.arange(m) if face is None else np.asarray(face, np.int64),
                   tri_nodes=np.zeros((0, 3), np.int64), tri_stiffness=np.zeros((0, 3, 3)))
     mask = lambda idx: np.isin(np.arange(n), idx)  # noqa: E731
     return from_network(net, top=mask(top), bottom=mask(bottom), left=mask(left), right=mask(right), width=width,

@@ -7,6 +7,7 @@ import pytest
 
 from grainfrac_yade.engines.registry import engine_for
 from grainfrac_yade.engines.static.cascade import Path
+from grainfrac_yade.engines.static.face_failure import BondFailure
 from grainfrac_yade.engines.static.solver import Equilibrium
 from grainfrac_yade.engines.static.teeth import EVENTS_KEY, BondTeeth
 from grainfrac_yade.errors import GrainfracError
@@ -157,7 +158,7 @@ def test_inertial_relaxation_takes_one_tooth_per_step_and_breaks_at_the_last():
 
         def __init__(self):
             self.net, self.eq, self.masses, self.teeth = net, eq, np.ones(net.ndof), teeth
-            self.dt, self.damping = 1e-9, 0.0
+            self.dt, self.damping, self.failure = 1e-9, 0.0, BondFailure(net)
 
     path = Path(eq)
     motion = InertialMotion(Dynamics(), eq.solve(1.0001 * d0, eq.initial(0.0)), FixedPlatens(None), path.jt, path.jc,

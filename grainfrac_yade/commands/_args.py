@@ -8,6 +8,7 @@ import sys
 
 from ..engines.registry import engine_for, require_dynamic
 from ..errors import GrainfracError
+from ..failure_criterion import reading_refusal
 from ..params import FlagOverride, check_conflicting_overrides, load_parameters, override_origin
 from ..geometry.specimen import MAX_SEED, check_cell_count
 from ..geometry.tessellation import n_cells_for
@@ -71,12 +72,13 @@ def load_params_from_args(args):
 def check_engine(command: str, params, overrides=(), vtk: bool = False) -> None:
     """Before a run folder is made: refuse what the engine of ``params`` cannot run (one line: the paper clock
     without dynamics, a test the engine does not have yet, a VTK series ``vtk`` it does not write), and warn
-    once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics.  A dynamic engine
+    once per line of a dynamic-only setting given in ``overrides`` to an engine without dynamics; a creep test with face
+    failure whose corrosion does not read the face (:func:`grainfrac_yade.failure_criterion.reading_refusal`).  A dynamic engine
     (YADE) refuses only settings it has no model of; an engine says what it refuses in its
     :class:`~grainfrac_yade.engines.EngineModule` (``unsupported``, ``refused_settings``, ``vtk_refused``, ``warn_dynamic_only``:
     docs/maintainers.md, adding an engine)."""
     module = engine_for(params)
-    refusal = module.refusal(command, params)
+    refusal = module.refusal(command, params) or (reading_refusal(params) if command == "creep" else "")
     if refusal:
         raise GrainfracError(refusal)
     if module.dynamic:

@@ -17,6 +17,7 @@ from typing import Mapping
 from ..arrhenius import betas_from_physical
 from ..contact_strength import MIN_WEIBULL_MODULUS
 from ..errors import GrainfracError, ParameterError
+from ..failure_criterion import check_combination
 from ..law.readings import FACE_READING_LAWS
 from .cells import cell_count
 from .fem_only import check_fem_only
@@ -52,7 +53,7 @@ ADDED_KEYS = {"numerics.engine": "yade", "specimen.min_edge_fraction": 0.0, "num
               "calibration.shear_stiffness_ratio_scale": 1.0, "calibration.tensile_cohesion_ratio_scale": 1.0,
               "calibration.inter_mineral_strength_ratio": 1.0, "calibration.strength_weibull_modulus": 0.0,
               "resolution.cell_rings": 1, "resolution.cell_ring_growth": 1.0, "numerics.static_condensation": "none",
-              "numerics.static_softening": "none", "numerics.static_softening_teeth": 1, "numerics.static_softening_ductility": 1.0,
+              "numerics.static_softening": "none", "numerics.static_softening_teeth": 1, "numerics.static_softening_ductility": 1.0, "numerics.static_failure": "bond",
               "stress_corrosion.reading": "node"}
 
 
@@ -351,6 +352,7 @@ def build_parameters(merged: Mapping, origins: Mapping, sources=()) -> Parameter
     _check_grain_size(typed["specimen"], origins)
     _check_weibull_modulus(typed["calibration"], origins)
     check_fem_only(typed["resolution"], typed["numerics"], origins)
+    check_combination(typed["numerics"], origins)
     return Parameters(composition=composition, grains=grains, sources=tuple(sources), **typed)
 
 

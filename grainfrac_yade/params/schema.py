@@ -150,6 +150,7 @@ class NumericsParams:
                                   "saw-tooth teeth first (grainfrac_yade.softening); refused by the yade and hybrid engines", ("none", "sawtooth"))
     static_softening_teeth: int = _spec("1", "positive_int", "static_softening = sawtooth: teeth N of a bond; 1 = brittle")
     static_softening_ductility: float = _spec("1", "at_least_one", "static_softening = sawtooth: ultimate over peak separation mu; 1 = brittle")
+    static_failure: str = _spec("", "choice", "static engine: bond = paper Eq. 4-5 on each bond's own stress (a face with several bonds fails bond by bond); face = on each face's resultant (summed bond forces over the face's area), the face failing as a whole (grainfrac_yade.failure_criterion; a prototype, untested at scale); refused by the yade and hybrid engines, with static_softening = sawtooth, and in a creep test unless stress_corrosion.reading = face", ("bond", "face"))
     handover_cascade_bonds: int = _spec("1", "nonnegative_int", "hybrid engine: bonds one static cascade may break "
                                         "before YADE's dynamics take over from its state; 0 = only where the static "
                                         "equilibrium gives out")

@@ -13,7 +13,7 @@ Importing this module does not import YADE: the first stint does.
 from __future__ import annotations
 
 from .._interface import EngineModule
-from ...softening import engine_refusal, refuse_on
+from ...failure_criterion import refuse_static_path_settings, static_path_refusal
 from ..dynamic import dynamic_engine
 from ..static.engine import ENGINE as STATIC
 from ..static.scene import StaticScene
@@ -46,15 +46,16 @@ def warn_dynamic_only(overrides, params) -> list:
 
 
 def refused_settings(params) -> str:
-    """The one line refusing the saw-tooth softening (``numerics.static_softening``): its teeth are events of the
-    static path, which the dynamic stints do not have ("" where the run asks for none)."""
-    return engine_refusal(params, NAME)
+    """The one line refusing the saw-tooth softening (``numerics.static_softening``) and face failure
+    (``numerics.static_failure``): both are events of the static path, which the dynamic stints do not have ("" where
+    the run asks for neither)."""
+    return static_path_refusal(params, NAME)
 
 
 def build_scene(specimen, params, layout=None) -> StaticScene:
     """The hybrid scene of ``specimen`` (rigid or fem cells): a static scene with the strategy of dynamic stints on
     :data:`DYNAMIC_ENGINE` (a setting it has no model of refused in one line first)."""
-    refuse_on(params, NAME)
+    refuse_static_path_settings(params, NAME)
     return StaticScene(specimen, params, layout, DynamicStints(lambda: dynamic_engine(DYNAMIC_ENGINE)))
 
 

@@ -16,6 +16,8 @@ explicit dynamic relaxation (docs/engines.md).  One module per job:
   low-rank (Woodbury) updates;
 * :mod:`.cascade`: bonds broken one at a time, the most overstressed first; the sequentially linear path in the
   platen closure and the return to a held load;
+* :mod:`.face_failure`: the path's failure criterion, each bond's own stress (the default) or each face's resultant
+  with the face breaking as a whole (``numerics.static_failure``);
 * :mod:`.failure`: the physical failure rule under a held load (no equilibrium ahead, or too much strain to regain);
 * :mod:`.paths`: the registry that turns ``numerics.static_relaxation`` into the scene's path;
 * :mod:`.strategy`: the scene's relaxation strategy (what it does where the plain solve gives out: the plain one

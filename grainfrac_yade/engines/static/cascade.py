@@ -27,6 +27,7 @@ import numpy as np
 
 from ...errors import NumericalFailure
 from . import contacts as cl
+from .face_failure import BondFailure
 from .failure import COLLAPSE, NO_EQUILIBRIUM, FailureRule
 from .solver import Equilibrium, State
 from .teeth import tooth_release
@@ -84,19 +85,19 @@ class Path:
         self.load_loss_ratio = None
         #: the bonds' saw-tooth softening (:class:`.teeth.BondTeeth`); None: a bond at its strength breaks
         self.teeth = None
+        #: the failure criterion (:mod:`.face_failure`): each bond's own (the default) or each face's, whole
+        self.failure = BondFailure(eq.net)
 
     # ------------------------------------------------------------------ ratios and the tie rule
     def ratios(self, state: State):
         """(ratio, mode) of every bond; -inf for broken ones."""
-        n = self.net
-        r, mode = cl.overstress(state.fn, state.fs, n.area, self.jt, self.jc, n.tan_friction)
+        r, mode = self.failure.overstress(state.fn, state.fs, self.jt, self.jc, state.broken)
         return np.where(state.broken, -np.inf, r), mode
 
     def over(self, state: State) -> np.ndarray:
         """Intact bonds at their strength (exact paper Eq. 4-5, or a ratio within BREAK_RATIO_TOL of 1)."""
-        n = self.net
         r, _ = self.ratios(state)
-        hit = cl.failing(state.fn, state.fs, n.area, self.jt, self.jc, n.tan_friction) | (r >= 1 - BREAK_RATIO_TOL)
+        hit = self.failure.failing(state.fn, state.fs, self.jt, self.jc, state.broken) | (r >= 1 - BREAK_RATIO_TOL)
         return hit & ~state.broken
 
     @staticmethod
@@ -107,15 +108,19 @@ class Path:
 
     # ------------------------------------------------------------------ breaking
     def break_bond(self, state: State, bond: int, mode: int) -> State:
-        """``state`` with ``bond`` broken (JCFpm's broken contact, :func:`.contacts.break_state`), re-solved at its
-        closure (the bond's intact force released through :meth:`.solver.Equilibrium.release_force`)."""
+        """``state`` with ``bond`` broken, and with it the bonds its failure criterion breaks together
+        (:meth:`.face_failure.BondFailure.group`: itself, or its face's intact bonds): :meth:`break_bonds`."""
+        return self.break_bonds(state, self.failure.group(bond, state.broken), mode)
+
+    def break_bonds(self, state: State, bonds: np.ndarray, mode: int) -> State:
+        """``state`` with ``bonds`` broken at once (JCFpm's broken contact, :func:`.contacts.break_state`), re-solved at
+        its closure (their intact forces released through :meth:`.solver.Equilibrium.release_force`)."""
         n = self.net
         base = state.copy()
-        dn, ds = n.cn[bond] @ state.u, n.ct[bond] @ state.u
-        st, sg, s_p = cl.break_state(np.atleast_1d(dn), np.atleast_1d(ds), np.atleast_1d(state.fs[bond]),
-                                     n.kn[bond:bond + 1], n.ks[bond:bond + 1], n.tan_residual[bond:bond + 1])
-        base.broken[bond], base.status[bond], base.sign[bond], base.s_p[bond] = True, st[0], sg[0], s_p[0]
-        base.break_mode[bond] = mode
+        dn, ds = n.cn[bonds] @ state.u, n.ct[bonds] @ state.u
+        st, sg, s_p = cl.break_state(dn, ds, state.fs[bonds], n.kn[bonds], n.ks[bonds], n.tan_residual[bonds])
+        base.broken[bonds], base.status[bonds], base.sign[bonds], base.s_p[bonds] = True, st, sg, s_p
+        base.break_mode[bonds] = mode
         return self.eq.solve(state.closure, base, self.eq.release_force(state, base))
 
     def soften_bond(self, state: State, bond: int) -> State:
@@ -129,8 +134,8 @@ class Path:
 
     def cascade(self, state: State, first: int | None = None, record: Record | None = None) -> State:
         """Break ``first`` (if given), then every bond at its strength, one at a time, the most overstressed first (a
-        bond with a saw-tooth left takes it instead, :attr:`teeth`); :class:`LargeCascade` after :attr:`max_cascade`
-        broken bonds if that is set."""
+        bond with a saw-tooth left takes it instead, :attr:`teeth`; with face failure its face's intact bonds break
+        with it, :attr:`failure`); :class:`LargeCascade` after :attr:`max_cascade` broken bonds if that is set."""
         broken = 0
         while True:
             self.last_converged = state
@@ -148,11 +153,12 @@ class Path:
             if self.teeth is not None and self.teeth.softens(bond):
                 state = self.soften_bond(state, bond)
                 continue
-            state = self.break_bond(state, bond, int(mode[bond]))
-            broken += 1
+            bonds = self.failure.group(bond, state.broken)
+            state = self.break_bonds(state, bonds, int(mode[bond]))
+            broken += len(bonds)
             if record is not None:
-                record.bonds.append(bond)
-                record.modes.append(int(mode[bond]))
+                record.bonds.extend(int(b) for b in bonds)
+                record.modes.extend([int(mode[bond])] * len(bonds))
 
     # ------------------------------------------------------------------ the path
     def _h(self, state: State, target):
@@ -166,10 +172,9 @@ class Path:
         """One move along the path from ``state``: to the next bond crossing (then its cascade), to the target
         stress, or to ``max_closure``.  Returns (new state, what: "break" / "target" / "end" / "none");
         "none": nothing lies ahead (no crossing, no target reachable, no closure limit)."""
-        n = self.net
         self.last_converged = state
         v, fn1, fs1, p1 = self.eq.response(state)
-        x = cl.crossing_increment(state.fn, state.fs, fn1, fs1, n.area, self.jt, self.jc, n.tan_friction)
+        x = self.failure.crossing_increment(state.fn, state.fs, fn1, fs1, self.jt, self.jc, state.broken)
         x = np.where(state.broken, np.inf, x)
         x_break = float(x.min()) if len(x) else math.inf
         x_target = max(target - state.stress, 0.0) / p1 if target is not None and p1 > 0 else math.inf

@@ -179,6 +179,7 @@ def relax_held(path: Path, anchored: AnchoredEquilibrium, state: State, target: 
     damped = Path(anchored, path.bracket_tol)
     damped.jt, damped.jc = path.jt, path.jc         # the same strengths, not copies
     damped.teeth = path.teeth                       # and the same teeth
+    damped.failure = path.failure                   # and the same failure criterion
     start = state.closure if start_closure is None else float(start_closure)
     broken0 = int(state.broken.sum())
     out = Relaxation(state, None, start)

@@ -31,6 +31,7 @@ import importlib.metadata
 import numpy as np
 
 from ...errors import GrainfracError
+from ...failure_criterion import FAILURE_FACE, reading_refusal
 from ...law import MODE_CORRODED, Stresses, check_finite
 from ...kernel.corrosion import BondCorrosion
 from ...geometry.disc import DiscTessellation
@@ -65,6 +66,9 @@ class StaticCorrosion(BondCorrosion):
         super().__init__(scene, sc_params)
         if not self.law.exact_jump:
             raise GrainfracError(STIFFNESS_LAW_REFUSED)
+        refused = reading_refusal(scene.params)
+        if refused:
+            raise GrainfracError(refused)
         if scene.path.teeth is not None:        # a saw-tooth lowers the law's strengths as the path's
             scene.path.teeth.strength_listeners.append(self.follow_tooth)
 
@@ -74,6 +78,19 @@ class StaticCorrosion(BondCorrosion):
         lay = self.scene.net.order[np.atleast_1d(bonds)]
         self.state = self.state.replaced(lay, {k: self.state[k][lay] * ratio for k in ("tensile_strength",
                                                                                       "cohesion")})
+
+    def stresses(self, idx) -> Stresses:
+        """:meth:`BondCorrosion.stresses`; with face failure (``numerics.static_failure = "face"``) the stresses the law's
+        criteria read are the face's resultant ones, the path's (:meth:`.face_failure.FaceFailure.stresses`), so that
+        the event clock fails a face where the path does, all its bonds in one event (the driving stresses stay the
+        face reading's)."""
+        out = super().stresses(idx)
+        failure, state = self.scene.path.failure, self.scene.state
+        if failure.name != FAILURE_FACE:
+            return out
+        sigma, tau = failure.stresses(state.fn, state.fs, state.broken)
+        c = self.scene.canon[np.asarray(idx, dtype=np.int64)]
+        return Stresses(out.index, sigma[c], tau[c], out.rate_normal, out.rate_shear)
 
     def write(self, idx):
         """The law's strengths of bonds ``idx`` into the scene (no solve: the next one follows them)."""

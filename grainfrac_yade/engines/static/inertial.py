@@ -11,7 +11,8 @@ M lumped (each body's mass and, for rigid cells, its inertia about its node: the
 (omega_max^2 bounded by the largest row sum of M^-1 |K| of the intact tangent, Gershgorin).  Every step evaluates
 the contact law of :mod:`.contacts` at the current displacements: intact bonds linear, broken at paper Eq. 4-5 as
 soon as they reach it (JCFpm's broken state, :func:`.contacts.break_state`; with saw-tooth softening a bond takes
-its next tooth there first, :mod:`.teeth`); broken contacts compression only,
+its next tooth there first, :mod:`.teeth`; with face failure the face's resultant is checked and its intact bonds break
+together, :mod:`.face_failure`); broken contacts compression only,
 with the residual friction by the return mapping from the last step (:func:`.contacts.trial_status`).
 
 The platens hold the target stress through the creep protocol's servo (closing speed (target - stress) x H /
@@ -50,6 +51,7 @@ from ...wave import hold_budget, scene_density
 from . import contacts as cl
 from .cascade import Path, Record
 from .damped import Relaxation, RelaxingPath, relative_force
+from .face_failure import BondFailure
 from .failure import COLLAPSE, FailureRule
 from .solver import Equilibrium, State
 
@@ -156,6 +158,8 @@ class InertialRelaxation:
         self._intact_modulus = None
         #: the path's saw-tooth softening (:class:`.teeth.BondTeeth`, set by :func:`.paths.path_for`); None: brittle
         self.teeth = None
+        #: the path's failure criterion (:mod:`.face_failure`, set by :func:`.paths.path_for`): each bond's own here
+        self.failure = BondFailure(eq.net)
 
     def budget(self, state: State):
         """The creep protocol's :class:`~grainfrac_yade.wave.HoldBudget` of a relaxation from ``state`` (in this
@@ -250,7 +254,7 @@ class InertialMotion(HeldRelaxing):
         jt, jc, inv_m = self.jt, self.jc, self.inv_m
         plat = np.flatnonzero(eq.platen_fixed)     # the driven dofs by index (the same values as by the mask)
         e_plat = eq.e[plat]
-        dt, damping, teeth = self.dyn.dt, self.dyn.damping, self.dyn.teeth
+        dt, damping, teeth, failure = self.dyn.dt, self.dyn.damping, self.dyn.teeth, self.dyn.failure
         u, v, broken, s_p, mode = self.u, self.v, self.broken, self.s_p, self.mode
         status, sign, rows, closure = self.status, self.sign, self.rows, self.closure
         for _ in range(steps):
@@ -258,7 +262,7 @@ class InertialMotion(HeldRelaxing):
             dn, ds = net.cn @ u, net.ct @ u
             status, sign = cl.trial_status(dn, ds, broken, s_p, net.kn, net.ks, net.tan_residual, status, sign)[:2]
             fn, fs = cl.forces(dn, ds, status, sign, s_p, net.kn, net.ks, net.tan_residual)
-            hit = ~broken & cl.failing(fn, fs, net.area, jt, jc, net.tan_friction)
+            hit = ~broken & failure.failing(fn, fs, jt, jc, broken)
             if hit.any() and teeth is not None:     # saw-tooth softening: the next tooth, the force dropping
                 soft = np.flatnonzero(hit)[teeth.softens(hit)]
                 if len(soft):
@@ -267,7 +271,7 @@ class InertialMotion(HeldRelaxing):
                     hit[soft] = False
             if hit.any():
                 idx = np.flatnonzero(hit)
-                _, md = cl.overstress(fn[idx], fs[idx], net.area[idx], jt[idx], jc[idx], net.tan_friction[idx])
+                md = failure.modes(fn, fs, jt, jc, broken, idx)
                 st, sg, sp = cl.break_state(dn[idx], ds[idx], fs[idx], net.kn[idx], net.ks[idx],
                                             net.tan_residual[idx])
                 broken[idx], status[idx], sign[idx], s_p[idx], mode[idx] = True, st, sg, sp, md

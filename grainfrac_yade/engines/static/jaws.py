@@ -229,15 +229,15 @@ class DiscScene(StaticScene):
 
 
 def set_equilibrium(scene, eq: Equilibrium, solve: bool = True) -> None:
-    """``eq`` as ``scene``'s equilibrium: counters and strengths carried over, the state solved again where it is
-    (``solve`` False: a restored state that ``eq``'s constraints already hold is kept as it is, and with it the
-    solver's kept factor that came back with the checkpoint)."""
+    """``eq`` as ``scene``'s equilibrium: counters, strengths and failure criterion carried over, the state solved again
+    where it is (``solve`` False: a restored state that ``eq``'s constraints already hold is kept as it is, and with
+    it the solver's kept factor that came back with the checkpoint)."""
     eq.counters = scene.eq.counters
     if not solve:
         eq.restore_factor_state(scene.eq.factor_state())
-    jt, jc = scene.path.jt, scene.path.jc
+    jt, jc, failure = scene.path.jt, scene.path.jc, type(scene.path.failure)
     scene.eq, scene.path = eq, Path(eq)
-    scene.path.jt, scene.path.jc = jt, jc
+    scene.path.jt, scene.path.jc, scene.path.failure = jt, jc, failure(eq.net)
     if solve:
         scene.state = scene.path.cascade(eq.solve(scene.state.closure, scene.state))
 

@@ -52,6 +52,7 @@ class StaticNetwork:
     tan_residual: np.ndarray    # (m,) tan(phi_r)
     key_point: np.ndarray       # (m, 2) contact point: the tie rule's and the order's key [m]
     order: np.ndarray           # (m,) input bond number of each canonical bond
+    bond_face: np.ndarray       # (m,) face of each bond (the tessellation's; several bonds per face with fem cells)
     top: np.ndarray             # (n,) bool: node moves with the top platen
     bottom: np.ndarray          # (n,) bool
     left: np.ndarray            # (n,) bool: node of a cell on the left side (confinement)
@@ -167,7 +168,8 @@ def from_network(net: Network, *, top, bottom, left, right, width, height, thick
         ks=net.spring_ks[o].astype(float), area=area[o], tensile_strength=np.asarray(tensile_strength, float)[o],
         cohesion=np.asarray(cohesion, float)[o], tan_friction=np.tan(np.asarray(friction_angle, float))[o],
         tan_residual=np.tan(np.asarray(residual_friction_angle, float))[o], key_point=np.asarray(key_point)[o, :2],
-        order=o, top=np.asarray(top, bool), bottom=np.asarray(bottom, bool) & ~np.asarray(top, bool),
+        order=o, bond_face=np.asarray(net.spring_face, np.int64)[o], top=np.asarray(top, bool),
+        bottom=np.asarray(bottom, bool) & ~np.asarray(top, bool),
         left=np.asarray(left, bool), right=np.asarray(right, bool), side_weight=side_w, width=float(width),
         height=float(height), thickness=float(thickness))
 

@@ -9,6 +9,7 @@ not settle (one registry, read once by the static scene).
 from __future__ import annotations
 
 from .cascade import Path
+from .face_failure import failure_for
 from . import damped
 from .inertial import InertialPath, InertialRelaxation
 from .solver import Equilibrium, solver_options
@@ -31,9 +32,13 @@ def path_for(eq: Equilibrium, params, confinement: float = 0.0, masses=None, rel
     ``relaxation`` where a scene relaxes its own way) under the lateral traction ``confinement`` [Pa]; ``masses``: a
     callable giving the network's (ndof,) masses (:func:`.inertial.dof_masses`), called only by a path that moves
     with inertia.  The path's saw-tooth softening (:func:`.teeth.teeth_for`; ``teeth``: a former path's, kept) tells
-    its equilibria when a bond's stiffness changes."""
+    its equilibria when a bond's stiffness changes; its failure criterion (:func:`.face_failure.failure_for`, each bond's
+    own or each face's) is the one its relaxation's dynamics check too."""
     path = PATHS[relaxation or params.numerics.static_relaxation](eq, params, confinement, masses)
     path.teeth = teeth_for(params, eq.net, teeth)
+    path.failure = failure_for(params, eq.net)
+    if hasattr(path, "dynamics"):
+        path.dynamics.failure = path.failure
     if path.teeth is not None:
         path.teeth.equilibria += [e for e in (eq, getattr(path, "anchored", None)) if e is not None]
         if hasattr(path, "dynamics"):

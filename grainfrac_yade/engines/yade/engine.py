@@ -17,7 +17,7 @@ package.
 from __future__ import annotations
 
 from .._interface import EngineModule
-from ...softening import engine_refusal, refuse_on
+from ...failure_criterion import refuse_static_path_settings, static_path_refusal
 from . import batch, bench_timing, load_yade
 from .confinement import consolidate
 from .corrosion_engine import stress_corrosion
@@ -38,14 +38,15 @@ def version() -> str:
 
 
 def refused_settings(params) -> str:
-    """The one line refusing the static engine's saw-tooth softening (``numerics.static_softening``): YADE's JCFpm
-    bonds break at their strength ("" where the run asks for no softening)."""
-    return engine_refusal(params, NAME)
+    """The one line refusing what only the static engine's path models: the saw-tooth softening
+    (``numerics.static_softening``; YADE's JCFpm bonds break at their strength) and face failure
+    (``numerics.static_failure``; YADE breaks bonds one by one) ("" where the run asks for neither)."""
+    return static_path_refusal(params, NAME)
 
 
 def build_scene(specimen, params, layout=None):
     """:func:`.scene.build_scene`, a setting this engine has no model of refused in one line first."""
-    refuse_on(params, NAME)
+    refuse_static_path_settings(params, NAME)
     return _scene.build_scene(specimen, params, layout)
 
 
