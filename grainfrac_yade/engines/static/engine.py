@@ -31,7 +31,7 @@ import importlib.metadata
 import numpy as np
 
 from ...errors import GrainfracError
-from ...failure_criterion import FAILURE_FACE, reading_refusal
+from ...failure_criterion import reading_refusal
 from ...law import MODE_CORRODED, Stresses, check_finite
 from ...kernel.corrosion import BondCorrosion
 from ...geometry.disc import DiscTessellation
@@ -80,17 +80,10 @@ class StaticCorrosion(BondCorrosion):
                                                                                       "cohesion")})
 
     def stresses(self, idx) -> Stresses:
-        """:meth:`BondCorrosion.stresses`; with face failure (``numerics.static_failure = "face"``) the stresses the law's
-        criteria read are the face's resultant ones, the path's (:meth:`.face_failure.FaceFailure.stresses`), so that
-        the event clock fails a face where the path does, all its bonds in one event (the driving stresses stay the
-        face reading's)."""
-        out = super().stresses(idx)
-        failure, state = self.scene.path.failure, self.scene.state
-        if failure.name != FAILURE_FACE:
-            return out
-        sigma, tau = failure.stresses(state.fn, state.fs, state.broken)
-        c = self.scene.canon[np.asarray(idx, dtype=np.int64)]
-        return Stresses(out.index, sigma[c], tau[c], out.rate_normal, out.rate_shear)
+        """:meth:`BondCorrosion.stresses` as the path's failure criterion reads them
+        (:meth:`.face_failure.BondFailure.law_stresses`: the bonds' own, or with face failure their faces' resultant
+        ones, the driving stresses kept)."""
+        return self.scene.path.failure.law_stresses(super().stresses(idx), self.scene.state, self.scene.canon)
 
     def write(self, idx):
         """The law's strengths of bonds ``idx`` into the scene (no solve: the next one follows them)."""

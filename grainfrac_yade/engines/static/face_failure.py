@@ -26,6 +26,7 @@ import numpy as np
 
 from ...errors import GrainfracError
 from ...failure_criterion import FAILURE_BOND, FAILURE_FACE
+from ...law import Stresses
 from . import contacts as cl
 
 
@@ -57,6 +58,12 @@ class BondFailure:
     def group(self, bond: int, broken) -> np.ndarray:
         """The bonds that break with ``bond``: itself."""
         return np.array([bond], np.int64)
+
+    def law_stresses(self, stresses, state, canon):
+        """The :class:`~grainfrac_yade.law.Stresses` a degradation law's criteria read for this criterion, from the
+        bonds' own ``stresses`` (layout numbers; ``state``: the path's, ``canon``: canonical number of each layout
+        bond): those."""
+        return stresses
 
 
 class FaceFailure(BondFailure):
@@ -160,6 +167,13 @@ class FaceFailure(BondFailure):
         """(sigma, tau) [Pa] per bond: its face's resultant stresses (what the criterion reads)."""
         m = self._members(broken)
         return (self._sum(fn, m) / m[3])[self.of_bond], (np.abs(self._sum(fs, m)) / m[3])[self.of_bond]
+
+    def law_stresses(self, stresses, state, canon):
+        """The face's resultant stresses (:meth:`stresses`) in place of the bonds' own, the driving ones kept: the
+        event clock then fails a face where the path does, all its bonds in one event."""
+        sigma, tau = self.stresses(state.fn, state.fs, state.broken)
+        c = canon[stresses.index]
+        return Stresses(stresses.index, sigma[c], tau[c], stresses.rate_normal, stresses.rate_shear)
 
     def group(self, bond: int, broken) -> np.ndarray:
         """The intact bonds of ``bond``'s face (with ``bond``), in canonical order: they break together."""

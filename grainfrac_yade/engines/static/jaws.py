@@ -42,6 +42,7 @@ from ...geometry.disc import DiscTessellation
 from ...grains import rotating_grain_models
 from ...kernel.levers import PRE_EXISTING, Levers, lever_draws
 from .cascade import Path
+from .face_failure import failure_for
 from .network import StaticNetwork, _side_weights
 from .platens import StaticPlatens
 from .scene import StaticScene
@@ -235,9 +236,9 @@ def set_equilibrium(scene, eq: Equilibrium, solve: bool = True) -> None:
     eq.counters = scene.eq.counters
     if not solve:
         eq.restore_factor_state(scene.eq.factor_state())
-    jt, jc, failure = scene.path.jt, scene.path.jc, type(scene.path.failure)
+    jt, jc = scene.path.jt, scene.path.jc
     scene.eq, scene.path = eq, Path(eq)
-    scene.path.jt, scene.path.jc, scene.path.failure = jt, jc, failure(eq.net)
+    scene.path.jt, scene.path.jc, scene.path.failure = jt, jc, failure_for(scene.params, eq.net)
     if solve:
         scene.state = scene.path.cascade(eq.solve(scene.state.closure, scene.state))
 
